@@ -1,0 +1,75 @@
+"""The only bridge between typed Python objects and the compiled kernels.
+
+Kernels see flat float64 arrays. This module fixes their layout with named
+index constants; nothing else in the package indexes them by number.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .parameters import Params
+from .state import TouchdownState
+
+# -- parameter vector P ------------------------------------------------------
+P_M, P_J, P_R, P_K, P_L0, P_G, P_CL, P_OMEGA, P_ALPHA, P_GLOBAL, P_CTRL = range(11)
+P_C0 = 11  # four controller numbers follow (controller.packed())
+NP = 15
+
+# -- integrator options O ----------------------------------------------------
+O_RTOL, O_ATOL, O_H0, O_MAXSTEPS, O_TMAX_STANCE, O_TMAX_FLIGHT, O_HMIN = range(7)
+NO = 7
+
+# -- touch-down state TD (7) -------------------------------------------------
+TD_BETA, TD_PHI, TD_XD, TD_YD, TD_PHID, TD_X, TD_H = range(7)
+NTD = 7
+
+# -- stance state y (6) --------------------------------------------------------
+Y_L, Y_BETA, Y_PHI, Y_LD, Y_BETAD, Y_PHID = range(6)
+
+# -- stride output vector OUT ----------------------------------------------------
+OUT_TD = 0  # 7 values: next touch-down state
+OUT_TS = 7  # stance time
+OUT_TF = 8  # flight time
+OUT_LO = 9  # 10 values: lift-off x_m, y_m, xd, yd, phi, phid, l, beta, ld, betad
+OUT_CLEAR = 19  # foot height above ground right after the leg reset
+OUT_XF = 20  # foot x during the stance
+OUT_NSTEP = 21  # accepted integrator steps in the stance
+OUT_NREJ = 22  # rejected integrator steps
+OUT_FYNEG = 23  # 1.0 if F_y < 0 right at touch-down
+OUT_TFALL = 24  # time of the fall since touch-down (NaN if none)
+OUT_NREC = 25  # number of recorded stance rows
+OUT_RECOVF = 26  # 1.0 if the record buffer overflowed
+NOUT = 27
+
+# -- record row -----------------------------------------------------------
+REC_T, REC_L, REC_BETA, REC_PHI, REC_LD, REC_BETAD, REC_PHID, REC_FX, REC_FY, REC_TAU = range(10)
+NREC = 10
+
+# -- status codes ---------------------------------------------------------------
+ST_OK = 0
+ST_FALL_BACKWARD = 1  # xdot_m < 0 (eq. 2.10)
+ST_FALL_HIP_GROUND = 2  # hip at or below the ground in stance (eq. 2.11)
+ST_FALL_NO_TOUCHDOWN = 3  # hip reaches the ground in flight before the foot
+ST_FALL_TRIP = 4  # foot enters a higher terrain segment below its top (step riser)
+ST_ERR_STEP_UNDERFLOW = 10
+ST_ERR_MAX_STEPS = 11
+ST_ERR_STANCE_TIMEOUT = 12
+ST_ERR_FLIGHT_TIMEOUT = 13
+ST_ERR_NONFINITE = 14
+
+
+def pack_params(p: Params) -> np.ndarray:
+    """``Params`` -> P vector."""
+    out = np.zeros(NP)
+    out[P_M], out[P_J], out[P_R], out[P_K], out[P_L0], out[P_G] = p.m, p.J, p.r, p.k, p.l0, p.g
+    out[P_CL], out[P_OMEGA], out[P_ALPHA] = p.c_l, p.omega_r, p.alpha_r
+    out[P_GLOBAL] = 1.0 if p.leg_reset == "global" else 0.0
+    out[P_CTRL] = p.controller.code
+    out[P_C0 : P_C0 + 4] = p.controller.packed()
+    return out
+
+
+def pack_state(s: TouchdownState) -> np.ndarray:
+    """``TouchdownState`` -> TD vector."""
+    return s.as_array()

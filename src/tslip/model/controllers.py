@@ -1,0 +1,148 @@
+"""Stance-phase hip controllers (thesis Section 2.4, eqs 2.12-2.16).
+
+Each controller is a frozen dataclass. The hip torque ``tau`` acts on the local
+hip angle ``alpha = beta + phi`` (eq. A.9 puts ``+tau`` on both the beta and the
+phi rows), so ``tau * alpha_dot`` is the power the hip delivers.
+
+=====================  =====  ==============================================
+controller             code   torque
+=====================  =====  ==============================================
+``Passive()``          0      ``tau = 0``                          (eq. 2.12)
+``GlobalPD(...)``      1      ``Kp (phi_ref - phi) + Kd (phid_ref - phid)`` (2.13)
+``LocalVelocity(...)`` 2      ``Kd (alphad_ref - alpha_dot)``      (eq. 2.14)
+``ConstantTorque(...)``3      ``tau_c - c_h alpha_dot``        (eqs 2.15-2.16)
+=====================  =====  ==============================================
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+from typing import Any, ClassVar
+
+__all__ = [
+    "Controller",
+    "Passive",
+    "GlobalPD",
+    "LocalVelocity",
+    "ConstantTorque",
+    "CONTROLLERS",
+    "controller_from_dict",
+]
+
+
+def _meta(symbol: str, unit: str, description: str, lower: float = -math.inf) -> dict[str, Any]:
+    return {"symbol": symbol, "unit": unit, "description": description, "lower": lower}
+
+
+def check_finite_fields(obj: Any, prefix: str = "") -> None:
+    """Raise ``ValueError`` for a field that is NaN, infinite or below its bound.
+
+    Each dataclass field's metadata may carry ``lower`` (inclusive) and
+    ``lower_open`` (exclusive) / ``upper_open`` bounds.
+    """
+    for f in fields(obj):
+        value = getattr(obj, f.name)
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            continue
+        name = f"{prefix}{f.name}"
+        unit = f.metadata.get("unit", "")
+        unit_txt = f" [{unit}]" if unit else ""
+        lo = f.metadata.get("lower", -math.inf)
+        lo_open = f.metadata.get("lower_open", False)
+        hi = f.metadata.get("upper", math.inf)
+        hi_open = f.metadata.get("upper_open", False)
+        rng = f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+        if not math.isfinite(value):
+            raise ValueError(f"{name}{unit_txt} must be a finite number in {rng}, got {value!r}")
+        bad_lo = value <= lo if lo_open else value < lo
+        bad_hi = value >= hi if hi_open else value > hi
+        if bad_lo or bad_hi:
+            raise ValueError(f"{name}{unit_txt} must be in {rng}, got {value!r}")
+
+
+@dataclass(frozen=True, slots=True)
+class Controller:
+    """Base class: a hip controller packed to a code and four numbers."""
+
+    code: ClassVar[int] = -1
+    name: ClassVar[str] = ""
+
+    def __post_init__(self) -> None:
+        check_finite_fields(self, prefix=f"{type(self).__name__}.")
+
+    def packed(self) -> tuple[float, float, float, float]:
+        """The controller's numbers in kernel order, padded to four."""
+        vals = [float(getattr(self, f.name)) for f in fields(self)]
+        return tuple(vals + [0.0] * (4 - len(vals)))  # type: ignore[return-value]
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"type": name, **fields}``: the TOML / JSON form."""
+        return {"type": self.name, **{f.name: getattr(self, f.name) for f in fields(self)}}
+
+
+@dataclass(frozen=True, slots=True)
+class Passive(Controller):
+    """No hip torque, ``tau = 0`` (eq. 2.12)."""
+
+    code: ClassVar[int] = 0
+    name: ClassVar[str] = "passive"
+
+
+@dataclass(frozen=True, slots=True)
+class GlobalPD(Controller):
+    """PD control of the inertial trunk pitch (eq. 2.13); needs an IMU."""
+
+    code: ClassVar[int] = 1
+    name: ClassVar[str] = "global_pd"
+    Kp: float = field(default=5.0, metadata=_meta("K_p", "MgL/rad", "proportional gain", 0.0))
+    Kd: float = field(default=0.5, metadata=_meta("K_d", "Mg^1/2 L^3/2/rad", "derivative gain", 0.0))
+    phi_ref: float = field(default=0.0, metadata=_meta("phi_r", "rad", "reference pitch angle"))
+    phid_ref: float = field(
+        default=0.0, metadata=_meta("phidot_r", "rad g^1/2 L^-1/2", "reference pitch rate")
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class LocalVelocity(Controller):
+    """Local hip angular-velocity control (eq. 2.14): a voltage-driven motor."""
+
+    code: ClassVar[int] = 2
+    name: ClassVar[str] = "local_velocity"
+    Kd: float = field(default=0.5, metadata=_meta("K_d", "Mg^1/2 L^3/2/rad", "derivative gain", 0.0))
+    alphad_ref: float = field(
+        default=0.0, metadata=_meta("alphadot_r", "rad g^1/2 L^-1/2", "reference hip rate")
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class ConstantTorque(Controller):
+    """Constant hip torque with optional hip damping (eqs 2.15-2.16)."""
+
+    code: ClassVar[int] = 3
+    name: ClassVar[str] = "constant_torque"
+    tau_c: float = field(default=0.0, metadata=_meta("tau_c", "MgL", "constant hip torque"))
+    c_h: float = field(default=0.0, metadata=_meta("c_h", "Mg^1/2 L^3/2/rad", "hip damping", 0.0))
+
+
+CONTROLLERS: dict[str, type[Controller]] = {
+    c.name: c for c in (Passive, GlobalPD, LocalVelocity, ConstantTorque)
+}
+
+
+def controller_from_dict(data: dict[str, Any] | str) -> Controller:
+    """Build a controller from ``{"type": name, **gains}`` or a bare name."""
+    if isinstance(data, str):
+        data = {"type": data}
+    data = dict(data)
+    kind = str(data.pop("type", "passive")).lower().replace("-", "_")
+    if kind not in CONTROLLERS:
+        raise ValueError(f"controller must be one of {sorted(CONTROLLERS)}, got {kind!r}")
+    cls = CONTROLLERS[kind]
+    allowed = {f.name for f in fields(cls)}
+    unknown = set(data) - allowed
+    if unknown:
+        raise ValueError(
+            f"controller {kind!r} has no field {sorted(unknown)[0]!r}; allowed: {sorted(allowed)}"
+        )
+    return cls(**{k: float(v) for k, v in data.items()})

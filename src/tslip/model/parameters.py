@@ -1,0 +1,298 @@
+"""TSLIP model parameters: one table, one frozen dataclass, named presets.
+
+All quantities are dimensionless in the units of thesis Table 3.1 (body mass M,
+gravity g, rest leg length L). ``dims`` gives each quantity's exponents of
+(M, g, L), used by :mod:`tslip.model.units` to convert to and from SI.
+
+The defaults are thesis Table 2.1 (the passive model). ``alpha_r`` (leg reset
+angle) and the controller references are *solved* for a periodic gait in the
+thesis (Section 2.8); the defaults here are nominal starting values.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal, NamedTuple
+
+from .controllers import (
+    ConstantTorque,
+    Controller,
+    GlobalPD,
+    LocalVelocity,
+    Passive,
+    check_finite_fields,
+    controller_from_dict,
+)
+
+__all__ = [
+    "ParameterInfo",
+    "PARAMETER_TABLE",
+    "Params",
+    "preset",
+    "presets",
+    "LegReset",
+]
+
+LegReset = Literal["local", "global"]
+
+
+class ParameterInfo(NamedTuple):
+    """One row of :data:`PARAMETER_TABLE`."""
+
+    name: str
+    symbol: str
+    unit: str
+    dims: tuple[float, float, float]  # exponents of (M, g, L), Table 3.1
+    default: float
+    lower: float
+    upper: float
+    lower_open: bool
+    upper_open: bool
+    description: str
+    source: str
+
+
+_INF = math.inf
+#: name, symbol, unit, dims(M,g,L), default, lower, upper, lower_open, upper_open, description, source
+PARAMETER_TABLE: tuple[ParameterInfo, ...] = tuple(
+    ParameterInfo(*row)
+    for row in (
+        ("m", "m", "M", (1, 0, 0), 1.0, 0.0, _INF, True, True, "body mass", "Table 2.1"),
+        ("J", "J", "ML^2", (1, 0, 2), 0.1, 0.0, _INF, True, True,
+         "trunk rotational inertia about the CoM", "Table 2.1"),
+        ("r", "r", "L", (0, 0, 1), 0.3, -_INF, _INF, True, True,
+         "CoM offset below the hip (r > 0: hanging mass)", "Table 2.1"),
+        ("k", "k", "MgL^-1", (1, 1, -1), 25.0, 0.0, _INF, True, True,
+         "leg spring stiffness", "Table 2.1, eq. 2.1"),
+        ("l0", "l_0", "L", (0, 0, 1), 1.0, 0.0, _INF, True, True,
+         "rest leg length", "eq. 2.1"),
+        ("g", "g", "g", (0, 1, 0), 1.0, 0.0, _INF, True, True,
+         "gravitational acceleration", "Table 2.1"),
+        ("v0", "v_0", "g^1/2 L^1/2", (0, 0.5, 0.5), 5.0, 0.0, _INF, True, True,
+         "nominal CoM speed at touch-down of the periodic gait", "Table 2.1"),
+        ("beta0", "beta_0", "rad", (0, 0, 0), 1.05, 0.0, math.pi / 2, True, True,
+         "nominal touch-down leg angle of the periodic gait", "Table 2.1"),
+        ("c_l", "c_l", "Mg^1/2 L^-1/2", (1, 0.5, -0.5), 0.0, 0.0, _INF, False, True,
+         "leg damping coefficient", "eq. 2.1, Table 2.1"),
+        ("omega_r", "omega_r", "rad g^1/2 L^-1/2", (0, 0.5, -0.5), 1.0, -_INF, _INF, True, True,
+         "swing-leg retraction rate in flight (+: foot moves back)", "eq. 2.17, Table 2.1"),
+        ("alpha_r", "alpha_r", "rad", (0, 0, 0), 1.0, -_INF, _INF, True, True,
+         "leg reset angle at lift-off (local hip angle unless leg_reset='global')",
+         "Section 2.3.2; solved in Section 2.8"),
+    )
+)
+_TABLE = {row.name: row for row in PARAMETER_TABLE}
+
+
+def _f(name: str) -> Any:
+    row = _TABLE[name]
+    return field(
+        default=row.default,
+        metadata={
+            "symbol": row.symbol,
+            "unit": row.unit,
+            "dims": row.dims,
+            "lower": row.lower,
+            "upper": row.upper,
+            "lower_open": row.lower_open,
+            "upper_open": row.upper_open,
+            "description": row.description,
+            "source": row.source,
+        },
+    )
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Params:
+    """Parameters of the TSLIP model (thesis Table 2.1, Figure 2.1).
+
+    Parameters
+    ----------
+    m, J, r, k, l0, g : float
+        Mass [M], trunk inertia [ML^2], CoM offset below the hip [L], leg
+        stiffness [MgL^-1], rest leg length [L], gravity [g].
+    v0, beta0 : float
+        Nominal touch-down speed [g^1/2 L^1/2] and leg angle [rad] of the gait.
+    c_l : float
+        Leg damping [M g^1/2 L^-1/2] (eq. 2.1).
+    omega_r : float
+        Swing-leg retraction rate [rad g^1/2 L^-1/2] (eq. 2.17, sign of
+        CONVENTIONS.md: ``alpha(t) = alpha_r + omega_r (t - t_LO)``).
+    alpha_r : float
+        Leg angle set at lift-off [rad].
+    controller : Controller
+        Hip controller in stance, default :class:`Passive`.
+    leg_reset : {"local", "global"}
+        ``"local"`` (thesis): ``alpha_r`` and ``omega_r`` are relative to the
+        trunk. ``"global"``: the classic SLIP reset, ``beta(t) = alpha_r +
+        omega_r (t - t_LO)`` in the inertial frame (Section 7.6).
+
+    Examples
+    --------
+    >>> import dataclasses
+    >>> p = preset("table2.1")
+    >>> dataclasses.replace(p, k=30.0).k
+    30.0
+    >>> round(p.omega_r_bar, 3)
+    0.2
+    """
+
+    m: float = _f("m")
+    J: float = _f("J")
+    r: float = _f("r")
+    k: float = _f("k")
+    l0: float = _f("l0")
+    g: float = _f("g")
+    v0: float = _f("v0")
+    beta0: float = _f("beta0")
+    c_l: float = _f("c_l")
+    omega_r: float = _f("omega_r")
+    alpha_r: float = _f("alpha_r")
+    controller: Controller = field(default_factory=Passive)
+    leg_reset: LegReset = "local"
+
+    def __post_init__(self) -> None:
+        for row in PARAMETER_TABLE:
+            value = getattr(self, row.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ValueError(f"{row.name} [{row.unit}] must be a number, got {value!r}")
+            if isinstance(value, int):
+                object.__setattr__(self, row.name, float(value))
+        check_finite_fields(self)
+        if not isinstance(self.controller, Controller):
+            raise ValueError(
+                "controller must be one of Passive, GlobalPD, LocalVelocity, ConstantTorque, "
+                f"got {self.controller!r}"
+            )
+        if self.leg_reset not in ("local", "global"):
+            raise ValueError(f"leg_reset must be 'local' or 'global', got {self.leg_reset!r}")
+
+    # -- derived quantities (never stored) ---------------------------------
+    @property
+    def omega_r_bar(self) -> float:
+        """Normalised retraction rate ``omega_r l0 / v0`` (eq. 2.18)."""
+        return self.omega_r * self.l0 / self.v0
+
+    def with_omega_r_bar(self, omega_r_bar: float) -> Params:
+        """Copy with ``omega_r`` set from the normalised rate of eq. 2.18."""
+        if not math.isfinite(omega_r_bar):
+            raise ValueError(f"omega_r_bar [-] must be finite, got {omega_r_bar!r}")
+        return dataclasses.replace(self, omega_r=omega_r_bar * self.v0 / self.l0)
+
+    @property
+    def bounce_time(self) -> float:
+        """Spring-mass half period ``pi sqrt(m/k)`` (eq. 3.9)."""
+        return math.pi * math.sqrt(self.m / self.k)
+
+    # -- serialisation -------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """Plain ``dict`` (TOML / JSON friendly), controller as a sub-table."""
+        out: dict[str, Any] = {row.name: getattr(self, row.name) for row in PARAMETER_TABLE}
+        out["leg_reset"] = self.leg_reset
+        out["controller"] = self.controller.to_dict()
+        return out
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any], base: Params | None = None) -> Params:
+        """Build from a dict of overrides on ``base`` (default: Table 2.1).
+
+        Accepts the field names, ``omega_r_bar`` (eq. 2.18), ``preset`` (a
+        base preset name) and ``controller`` (a name or a table).
+        """
+        data = dict(data)
+        if "preset" in data:
+            base = preset(str(data.pop("preset")))
+        base = base or cls()
+        changes: dict[str, Any] = {}
+        omega_r_bar = data.pop("omega_r_bar", None)
+        if "controller" in data:
+            changes["controller"] = controller_from_dict(data.pop("controller"))
+        if "leg_reset" in data:
+            changes["leg_reset"] = str(data.pop("leg_reset"))
+        for key, value in data.items():
+            if key not in _TABLE:
+                raise ValueError(
+                    f"unknown parameter {key!r}; allowed: {sorted(_TABLE)} "
+                    "plus omega_r_bar, controller, leg_reset, preset"
+                )
+            try:
+                changes[key] = float(value)
+            except (TypeError, ValueError):
+                raise ValueError(
+                    f"{key} [{_TABLE[key].unit}] must be a number, got {value!r}"
+                ) from None
+        out = dataclasses.replace(base, **changes)
+        if omega_r_bar is not None:
+            out = out.with_omega_r_bar(float(omega_r_bar))
+        return out
+
+    @classmethod
+    def from_toml(cls, path: str | Path, base: Params | None = None) -> Params:
+        """Read parameters from a TOML file (see :meth:`from_dict`)."""
+        try:
+            with open(path, "rb") as fh:
+                data = tomllib.load(fh)
+        except FileNotFoundError:
+            raise ValueError(f"parameter file {str(path)!r} does not exist") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise ValueError(f"parameter file {str(path)!r} is not valid TOML: {exc}") from None
+        return cls.from_dict(data.get("params", data), base=base)
+
+
+# -- presets ----------------------------------------------------------------
+
+def _table21(**kw: Any) -> Params:
+    return Params(**kw)
+
+
+_PRESETS: dict[str, tuple[str, Any]] = {
+    "table2.1": ("Table 2.1 passive model", lambda: _table21()),
+    "table2.1-global-pd": (
+        "Table 2.1 with the global PD pitch controller (Kp 5, Kd 0.5)",
+        lambda: _table21(controller=GlobalPD(Kp=5.0, Kd=0.5)),
+    ),
+    "table2.1-local-velocity": (
+        "Table 2.1 with local hip-velocity control (Kd 0.5; alphad_ref solved)",
+        lambda: _table21(controller=LocalVelocity(Kd=0.5, alphad_ref=5.0)),
+    ),
+    "table2.1-constant-torque": (
+        "Table 2.1 with a constant hip torque and leg damping c_l 0.5 (tau_c solved)",
+        lambda: _table21(c_l=0.5, controller=ConstantTorque(tau_c=0.0, c_h=0.0)),
+    ),
+    "table6.1": (
+        "Table 6.1: fit to the Planar Elliptical Runner (local velocity control, leg damping)",
+        lambda: Params(
+            v0=1.90, J=0.10, m=1.0, r=0.30, k=8.0, beta0=0.93, omega_r=1.50, c_l=0.32,
+            alpha_r=0.93, controller=LocalVelocity(Kd=0.40, alphad_ref=2.42),
+        ),
+    ),
+}
+
+
+def presets() -> list[str]:
+    """Names accepted by :func:`preset`."""
+    return list(_PRESETS)
+
+
+def preset_description(name: str) -> str:
+    """One-line description of a preset."""
+    preset(name)  # validates the name
+    return _PRESETS[name][0]
+
+
+def preset(name: str) -> Params:
+    """Named parameter set from the thesis tables.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not one of :func:`presets`.
+    """
+    key = name.strip().lower()
+    if key not in _PRESETS:
+        raise ValueError(f"preset must be one of {presets()}, got {name!r}")
+    return _PRESETS[key][1]()

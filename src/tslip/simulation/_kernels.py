@@ -1,0 +1,790 @@
+"""Compiled kernels: stance dynamics, Dormand-Prince 5(4), events, closed-form flight.
+
+Private. Arguments are float64 arrays, floats and ints; results are arrays plus
+an int status (codes in :mod:`tslip.model._pack`). Nothing here prints or
+builds Python objects, and everything also runs with ``NUMBA_DISABLE_JIT=1``.
+
+The readable reference for the equations is :mod:`tslip.model.dynamics`; the
+tests check that both agree.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from ..model._pack import (
+    NOUT,
+    NP,
+    NREC,
+    O_ATOL,
+    O_H0,
+    O_HMIN,
+    O_MAXSTEPS,
+    O_RTOL,
+    O_TMAX_FLIGHT,
+    O_TMAX_STANCE,
+    OUT_CLEAR,
+    OUT_FYNEG,
+    OUT_LO,
+    OUT_NREC,
+    OUT_NREJ,
+    OUT_NSTEP,
+    OUT_RECOVF,
+    OUT_TD,
+    OUT_TF,
+    OUT_TFALL,
+    OUT_TS,
+    OUT_XF,
+    P_ALPHA,
+    P_C0,
+    P_CL,
+    P_CTRL,
+    P_G,
+    P_GLOBAL,
+    P_J,
+    P_K,
+    P_L0,
+    P_M,
+    P_OMEGA,
+    P_R,
+    ST_ERR_FLIGHT_TIMEOUT,
+    ST_ERR_MAX_STEPS,
+    ST_ERR_NONFINITE,
+    ST_ERR_STANCE_TIMEOUT,
+    ST_ERR_STEP_UNDERFLOW,
+    ST_FALL_BACKWARD,
+    ST_FALL_HIP_GROUND,
+    ST_FALL_NO_TOUCHDOWN,
+    ST_FALL_TRIP,
+    ST_OK,
+)
+
+_JIT = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
+
+# ---------------------------------------------------------------------------
+# Stance dynamics (eqs 2.1-2.6, A.7-A.14)
+# ---------------------------------------------------------------------------
+
+
+@njit(**_JIT)
+def hip_torque(P, phi, betad, phid):
+    """Hip torque of the stance controller (eqs 2.12-2.16)."""
+    code = int(P[P_CTRL])
+    if code == 0:
+        return 0.0
+    if code == 1:  # global PD: Kp, Kd, phi_ref, phid_ref
+        return P[P_C0] * (P[P_C0 + 2] - phi) + P[P_C0 + 1] * (P[P_C0 + 3] - phid)
+    if code == 2:  # local velocity: Kd, alphad_ref
+        return P[P_C0] * (P[P_C0 + 1] - (betad + phid))
+    # constant torque with hip damping: tau_c, c_h
+    return P[P_C0] - P[P_C0 + 1] * (betad + phid)
+
+
+@njit(**_JIT)
+def stance_accel(P, y):
+    """Generalised accelerations and forces in stance.
+
+    Solves ``M qdd = Q - C`` (eq. 2.3) for ``q = (l, beta, phi)``. The Schur
+    complement of the mass matrix (eq. 2.4) on the phi row is exactly ``J``,
+    so the 3x3 solve is closed form.
+
+    Returns ``(ldd, betadd, phidd, F_l, tau)``.
+    """
+    m = P[P_M]
+    r = P[P_R]
+    g = P[P_G]
+    l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
+    sb = math.sin(b)
+    cb = math.cos(b)
+    sa = math.sin(b + ph)
+    ca = math.cos(b + ph)
+    tau = hip_torque(P, ph, bd, phd)
+    fl = P[P_K] * (P[P_L0] - l) - P[P_CL] * ld  # eq. 2.1
+    # R = Q - C (eq. A.11, A.13)
+    r1 = -m * g * sb + fl - (m * r * phd * phd * sa - m * l * bd * bd)
+    r2 = tau - m * g * l * cb - (m * r * l * phd * phd * ca + 2.0 * m * l * bd * ld)
+    r3 = tau - m * g * r * math.sin(ph) - (m * r * l * bd * bd * ca + 2.0 * m * r * bd * ld * sa)
+    phdd = (r3 + r * ca * r1 - r * sa * r2 / l) / P[P_J]
+    ldd = r1 / m + r * ca * phdd
+    bdd = r2 / (m * l * l) - r * sa / l * phdd
+    return ldd, bdd, phdd, fl, tau
+
+
+@njit(**_JIT)
+def rhs(P, y, out):
+    """Stance state derivative for ``y = (l, beta, phi, ld, betad, phid)``."""
+    ldd, bdd, phdd, _, _ = stance_accel(P, y)
+    out[0] = y[3]
+    out[1] = y[4]
+    out[2] = y[5]
+    out[3] = ldd
+    out[4] = bdd
+    out[5] = phdd
+
+
+@njit(**_JIT)
+def grf(P, y):
+    """Ground reaction force ``(F_x, F_y, tau)`` (eqs 2.5-2.6)."""
+    l, b = y[0], y[1]
+    tau = hip_torque(P, y[2], y[4], y[5])
+    fl = P[P_K] * (P[P_L0] - l) - P[P_CL] * y[3]
+    sb = math.sin(b)
+    cb = math.cos(b)
+    return -fl * cb + tau / l * sb, fl * sb + tau / l * cb, tau
+
+
+@njit(**_JIT)
+def com_velocity(P, y):
+    """CoM velocity from the stance state (eq. A.5)."""
+    l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
+    r = P[P_R]
+    xd = -ld * math.cos(b) + l * math.sin(b) * bd + r * math.cos(ph) * phd
+    yd = ld * math.sin(b) + l * math.cos(b) * bd + r * math.sin(ph) * phd
+    return xd, yd
+
+
+@njit(**_JIT)
+def event_values(P, y, gv):
+    """Stance event functions; each event fires on a crossing from > 0 to <= 0.
+
+    0: lift-off, ``F_y`` (eq. 2.8); 1: hip height above the foot
+    ``l sin(beta)`` (eq. 2.11); 2: ``xdot_m`` (eq. 2.10).
+    """
+    fx, fy, tau = grf(P, y)
+    gv[0] = fy
+    gv[1] = y[0] * math.sin(y[1])
+    xd, yd = com_velocity(P, y)
+    gv[2] = xd
+
+
+# ---------------------------------------------------------------------------
+# Dormand-Prince 5(4) (Dormand & Prince 1980; Hairer, Norsett & Wanner, dopri5)
+# ---------------------------------------------------------------------------
+A21 = 1.0 / 5.0
+A31, A32 = 3.0 / 40.0, 9.0 / 40.0
+A41, A42, A43 = 44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0
+A51, A52, A53, A54 = 19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0
+A61, A62, A63, A64, A65 = (
+    9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0,
+)
+B1, B3, B4, B5, B6 = 35.0 / 384.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0
+E1, E3, E4, E5, E6, E7 = (
+    71.0 / 57600.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0,
+)
+D1, D3, D4, D5, D6, D7 = (
+    -12715105075.0 / 11282082432.0, 87487479700.0 / 32700410799.0,
+    -10690763975.0 / 1880347072.0, 701980252875.0 / 199316789632.0,
+    -1453857185.0 / 822651844.0, 69997945.0 / 29380423.0,
+)
+NSTATE = 6
+
+
+@njit(**_JIT)
+def dopri_step(P, y, h, K, ytmp, ynew):
+    """One Dormand-Prince step of size ``h`` from ``y`` with ``K[0] = f(y)``.
+
+    Fills ``K[1..6]`` and ``ynew`` (5th-order solution; ``K[6] = f(ynew)``)
+    and returns the scaled error estimate vector in ``ytmp``.
+    """
+    n = NSTATE
+    for i in range(n):
+        ytmp[i] = y[i] + h * A21 * K[0, i]
+    rhs(P, ytmp, K[1])
+    for i in range(n):
+        ytmp[i] = y[i] + h * (A31 * K[0, i] + A32 * K[1, i])
+    rhs(P, ytmp, K[2])
+    for i in range(n):
+        ytmp[i] = y[i] + h * (A41 * K[0, i] + A42 * K[1, i] + A43 * K[2, i])
+    rhs(P, ytmp, K[3])
+    for i in range(n):
+        ytmp[i] = y[i] + h * (A51 * K[0, i] + A52 * K[1, i] + A53 * K[2, i] + A54 * K[3, i])
+    rhs(P, ytmp, K[4])
+    for i in range(n):
+        ytmp[i] = y[i] + h * (
+            A61 * K[0, i] + A62 * K[1, i] + A63 * K[2, i] + A64 * K[3, i] + A65 * K[4, i]
+        )
+    rhs(P, ytmp, K[5])
+    for i in range(n):
+        ynew[i] = y[i] + h * (
+            B1 * K[0, i] + B3 * K[2, i] + B4 * K[3, i] + B5 * K[4, i] + B6 * K[5, i]
+        )
+    rhs(P, ynew, K[6])
+    for i in range(n):
+        ytmp[i] = h * (
+            E1 * K[0, i] + E3 * K[2, i] + E4 * K[3, i] + E5 * K[4, i] + E6 * K[5, i]
+            + E7 * K[6, i]
+        )
+
+
+@njit(**_JIT)
+def error_norm(err, y, ynew, rtol, atol):
+    """Hairer's RMS error norm, in units of the tolerance (accept if <= 1)."""
+    s = 0.0
+    for i in range(NSTATE):
+        sk = atol + rtol * max(abs(y[i]), abs(ynew[i]))
+        s += (err[i] / sk) ** 2
+    return math.sqrt(s / NSTATE)
+
+
+@njit(**_JIT)
+def dense_coeffs(y, ynew, h, K, R):
+    """Coefficients of the 4th-order continuous extension (dopri5 ``contd5``)."""
+    for i in range(NSTATE):
+        ydiff = ynew[i] - y[i]
+        bspl = h * K[0, i] - ydiff
+        R[0, i] = y[i]
+        R[1, i] = ydiff
+        R[2, i] = bspl
+        R[3, i] = ydiff - h * K[6, i] - bspl
+        R[4, i] = h * (
+            D1 * K[0, i] + D3 * K[2, i] + D4 * K[3, i] + D5 * K[4, i] + D6 * K[5, i]
+            + D7 * K[6, i]
+        )
+
+
+@njit(**_JIT)
+def dense_eval(R, theta, out):
+    """Evaluate the continuous extension at ``theta`` in [0, 1] of the step."""
+    t1 = 1.0 - theta
+    for i in range(NSTATE):
+        out[i] = R[0, i] + theta * (R[1, i] + t1 * (R[2, i] + theta * (R[3, i] + t1 * R[4, i])))
+
+
+@njit(**_JIT)
+def initial_step(P, y, f0, rtol, atol, ytmp, f1):
+    """Starting step size (Hairer, Norsett & Wanner, II.4)."""
+    d0 = 0.0
+    d1 = 0.0
+    for i in range(NSTATE):
+        sk = atol + rtol * abs(y[i])
+        d0 += (y[i] / sk) ** 2
+        d1 += (f0[i] / sk) ** 2
+    d0 = math.sqrt(d0 / NSTATE)
+    d1 = math.sqrt(d1 / NSTATE)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    for i in range(NSTATE):
+        ytmp[i] = y[i] + h0 * f0[i]
+    rhs(P, ytmp, f1)
+    d2 = 0.0
+    for i in range(NSTATE):
+        sk = atol + rtol * abs(y[i])
+        d2 += ((f1[i] - f0[i]) / sk) ** 2
+    d2 = math.sqrt(d2 / NSTATE) / h0
+    dm = max(d1, d2)
+    h1 = max(1e-6, h0 * 1e-3) if dm <= 1e-15 else (0.01 / dm) ** 0.2
+    return min(100.0 * h0, h1)
+
+
+@njit(**_JIT)
+def _event_root(P, R, ev, g_lo, g_hi, ytmp, gv):
+    """Root in theta of event ``ev`` on the dense output (Illinois method)."""
+    a, b = 0.0, 1.0
+    fa, fb = g_lo, g_hi
+    side = 0
+    c = 1.0
+    for _ in range(100):
+        c = (a * fb - b * fa) / (fb - fa) if fb != fa else 0.5 * (a + b)
+        if not (a < c < b):
+            c = 0.5 * (a + b)
+        dense_eval(R, c, ytmp)
+        event_values(P, ytmp, gv)
+        fc = gv[ev]
+        if fc > 0.0:
+            a, fa = c, fc
+            if side == -1:
+                fb *= 0.5
+            side = -1
+        else:
+            b, fb = c, fc
+            if side == 1:
+                fa *= 0.5
+            side = 1
+        if b - a < 1e-15:
+            break
+    return b  # the earliest theta known to be at or past the crossing
+
+
+@njit(**_JIT)
+def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
+    """Integrate the stance from ``y0`` until lift-off or a fall.
+
+    ``rec`` (rows x NREC) receives ``t, y, F_x, F_y, tau``: at each accepted
+    step if ``rec_dt <= 0``, else on a uniform grid of spacing ``rec_dt``
+    from the dense output. ``stats`` receives
+    ``[t_end, n_accepted, n_rejected, n_recorded, overflow]``.
+    Returns the status code; ``yout`` holds the final state.
+    """
+    rtol = O[O_RTOL]
+    atol = O[O_ATOL]
+    max_steps = int(O[O_MAXSTEPS])
+    t_max = O[O_TMAX_STANCE]
+    h_min = O[O_HMIN]
+    K = np.empty((7, NSTATE))
+    R = np.empty((5, NSTATE))
+    y = np.empty(NSTATE)
+    ynew = np.empty(NSTATE)
+    ytmp = np.empty(NSTATE)
+    gv_old = np.empty(3)
+    gv_new = np.empty(3)
+    gv_tmp = np.empty(3)
+    for i in range(NSTATE):
+        y[i] = y0[i]
+    nrec_max = rec.shape[0]
+    nrec = 0
+    overflow = 0.0
+    t = 0.0
+    event_values(P, y, gv_old)
+    status = ST_OK
+    rhs(P, y, K[0])
+    # record the first row
+    if nrec_max > 0:
+        _record(P, rec, nrec, t, y)
+        nrec += 1
+    t_next_rec = rec_dt
+    # fall right at touch-down?
+    if gv_old[1] <= 0.0:
+        stats[0] = 0.0
+        for i in range(NSTATE):
+            yout[i] = y[i]
+        stats[1] = 0.0
+        stats[2] = 0.0
+        stats[3] = nrec
+        stats[4] = 0.0
+        return ST_FALL_HIP_GROUND
+    if gv_old[2] < 0.0:
+        stats[0] = 0.0
+        for i in range(NSTATE):
+            yout[i] = y[i]
+        stats[1] = 0.0
+        stats[2] = 0.0
+        stats[3] = nrec
+        stats[4] = 0.0
+        return ST_FALL_BACKWARD
+    h = O[O_H0]
+    if h <= 0.0:
+        h = initial_step(P, y, K[0], rtol, atol, ytmp, K[1])
+    n_acc = 0
+    n_rej = 0
+    last_rejected = False
+    done = False
+    while not done:
+        if n_acc + n_rej >= max_steps:
+            status = ST_ERR_MAX_STEPS
+            break
+        if t >= t_max:
+            status = ST_ERR_STANCE_TIMEOUT
+            break
+        if h < h_min:
+            status = ST_ERR_STEP_UNDERFLOW
+            break
+        dopri_step(P, y, h, K, ytmp, ynew)
+        err = error_norm(ytmp, y, ynew, rtol, atol)
+        if not math.isfinite(err):
+            # a NaN/inf stage: shrink hard, give up below h_min
+            h *= 0.1
+            n_rej += 1
+            last_rejected = True
+            continue
+        if err > 1.0:
+            h *= max(0.2, 0.9 * err ** -0.2)
+            n_rej += 1
+            last_rejected = True
+            continue
+        # accepted step: look for events
+        n_acc += 1
+        event_values(P, ynew, gv_new)
+        first_ev = -1
+        theta_ev = 2.0
+        have_dense = False
+        for ev in range(3):
+            if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
+                if not have_dense:
+                    dense_coeffs(y, ynew, h, K, R)
+                    have_dense = True
+                th = _event_root(P, R, ev, gv_old[ev], gv_new[ev], ytmp, gv_tmp)
+                if th < theta_ev:
+                    theta_ev = th
+                    first_ev = ev
+        if rec_dt > 0.0 and nrec_max > 0:
+            if not have_dense:
+                dense_coeffs(y, ynew, h, K, R)
+                have_dense = True
+            t_stop = t + h * min(theta_ev, 1.0)
+            while t_next_rec <= t_stop:
+                if nrec >= nrec_max:
+                    overflow = 1.0
+                    break
+                dense_eval(R, (t_next_rec - t) / h, ytmp)
+                _record(P, rec, nrec, t_next_rec, ytmp)
+                nrec += 1
+                t_next_rec += rec_dt
+        if first_ev >= 0:
+            # exact step to the event time for a 5th-order event state
+            h_ev = theta_ev * h
+            if h_ev > 0.0:
+                dopri_step(P, y, h_ev, K, ytmp, ynew)
+            else:
+                for i in range(NSTATE):
+                    ynew[i] = y[i]
+            t += h_ev
+            for i in range(NSTATE):
+                y[i] = ynew[i]
+            if first_ev == 0:
+                status = ST_OK
+            elif first_ev == 1:
+                status = ST_FALL_HIP_GROUND
+            else:
+                status = ST_FALL_BACKWARD
+            done = True
+        else:
+            t += h
+            for i in range(NSTATE):
+                y[i] = ynew[i]
+                K[0, i] = K[6, i]  # FSAL
+            for i in range(3):
+                gv_old[i] = gv_new[i]
+            fac = 0.9 * err ** -0.2 if err > 0.0 else 10.0
+            fac = min(10.0, max(0.2, fac))
+            if last_rejected:
+                fac = min(1.0, fac)
+            h *= fac
+            last_rejected = False
+        for i in range(NSTATE):
+            if not math.isfinite(y[i]):
+                status = ST_ERR_NONFINITE
+                done = True
+        if rec_dt <= 0.0 and nrec_max > 0:
+            if nrec < nrec_max:
+                _record(P, rec, nrec, t, y)
+                nrec += 1
+            else:
+                overflow = 1.0
+    if rec_dt > 0.0 and nrec_max > 0 and status == ST_OK:
+        # always close the record with the lift-off row
+        if nrec < nrec_max:
+            _record(P, rec, nrec, t, y)
+            nrec += 1
+        else:
+            overflow = 1.0
+    for i in range(NSTATE):
+        yout[i] = y[i]
+    stats[0] = t
+    stats[1] = n_acc
+    stats[2] = n_rej
+    stats[3] = nrec
+    stats[4] = overflow
+    return status
+
+
+@njit(**_JIT)
+def _record(P, rec, row, t, y):
+    rec[row, 0] = t
+    for i in range(NSTATE):
+        rec[row, 1 + i] = y[i]
+    fx, fy, tau = grf(P, y)
+    rec[row, 7] = fx
+    rec[row, 8] = fy
+    rec[row, 9] = tau
+
+
+# ---------------------------------------------------------------------------
+# Flight in closed form (eqs 2.7, 2.17 with the sign of CONVENTIONS.md)
+# ---------------------------------------------------------------------------
+
+
+@njit(**_JIT)
+def flight_leg_angle(P, phi0, phid, t):
+    """Leg angle ``beta(t)`` in flight, ``t`` since lift-off, and its rate."""
+    if P[P_GLOBAL] != 0.0:
+        return P[P_ALPHA] + P[P_OMEGA] * t, P[P_OMEGA]
+    return P[P_ALPHA] + P[P_OMEGA] * t - (phi0 + phid * t), P[P_OMEGA] - phid
+
+
+@njit(**_JIT)
+def flight_state(P, lo, t, out):
+    """Flight state ``t`` after lift-off from ``lo = (x, y, xd, yd, phi, phid)``.
+
+    Writes ``(x, y, xd, yd, phi, phid, beta, foot_x, foot_y, hip_y)`` to ``out``.
+    """
+    g = P[P_G]
+    r = P[P_R]
+    l0 = P[P_L0]
+    x = lo[0] + lo[2] * t
+    y = lo[1] + lo[3] * t - 0.5 * g * t * t
+    ph = lo[4] + lo[5] * t
+    b, _ = flight_leg_angle(P, lo[4], lo[5], t)
+    hip_x = x - r * math.sin(ph)
+    hip_y = y + r * math.cos(ph)
+    out[0] = x
+    out[1] = y
+    out[2] = lo[2]
+    out[3] = lo[3] - g * t
+    out[4] = ph
+    out[5] = lo[5]
+    out[6] = b
+    out[7] = hip_x + l0 * math.cos(b)
+    out[8] = hip_y - l0 * math.sin(b)
+    out[9] = hip_y
+
+
+@njit(**_JIT)
+def _flight_heights(P, lo, t):
+    """Foot and hip height, their rates and the foot x-position at ``t``."""
+    g = P[P_G]
+    r = P[P_R]
+    l0 = P[P_L0]
+    ph = lo[4] + lo[5] * t
+    b, bd = flight_leg_angle(P, lo[4], lo[5], t)
+    y = lo[1] + lo[3] * t - 0.5 * g * t * t
+    yd = lo[3] - g * t
+    hip_y = y + r * math.cos(ph)
+    hip_yd = yd - r * math.sin(ph) * lo[5]
+    foot_y = hip_y - l0 * math.sin(b)
+    foot_yd = hip_yd - l0 * math.cos(b) * bd
+    foot_x = lo[0] + lo[2] * t - r * math.sin(ph) + l0 * math.cos(b)
+    return foot_y, foot_yd, hip_y, hip_yd, foot_x
+
+
+@njit(**_JIT)
+def _segment(tx, x):
+    """Index of the terrain segment holding ``x`` (breakpoints ``tx`` sorted)."""
+    k = 0
+    while k < tx.shape[0] and x >= tx[k]:
+        k += 1
+    return k
+
+
+@njit(**_JIT)
+def _safe_dt(f, fd, K):
+    """Time ``f`` (> 0) surely stays positive given ``|f''| <= K`` and rate ``fd``."""
+    return (fd + math.sqrt(fd * fd + 2.0 * K * f)) / K
+
+
+@njit(**_JIT)
+def find_touchdown(P, O, lo, tx, th, res):
+    """First touch-down after lift-off, by certified safe steps.
+
+    With ``|f''| <= K`` bounding the foot (and hip) height's second
+    derivative, a step of ``_safe_dt`` cannot skip a zero, so the first
+    downward crossing is never missed; near the root the step is Newton-like.
+    The foot must first be above the ground (a reset foot that starts below
+    it has to rise, CONVENTIONS.md). Terrain: heights ``th[k]`` between
+    breakpoints ``tx`` (``len(th) == len(tx) + 1``).
+
+    ``res`` receives ``(t_td, ground_h, clearance_at_reset)``.
+    """
+    g = P[P_G]
+    r = abs(P[P_R])
+    l0 = P[P_L0]
+    phid = lo[5]
+    bd = P[P_OMEGA] if P[P_GLOBAL] != 0.0 else P[P_OMEGA] - phid
+    Kf = g + r * phid * phid + l0 * bd * bd + 1e-300
+    Kh = g + r * phid * phid + 1e-300
+    vx = abs(lo[2]) + r * abs(phid) + l0 * abs(bd) + 1e-300
+    t_max = O[O_TMAX_FLIGHT]
+    tol = 1e-13
+    t = 0.0
+    foot_y, foot_yd, hip_y, hip_yd, foot_x = _flight_heights(P, lo, t)
+    k = _segment(tx, foot_x)
+    res[1] = th[k]
+    res[2] = foot_y - th[k]
+    armed = foot_y - th[k] > 0.0
+    for _ in range(100000):
+        if t > t_max:
+            res[0] = t
+            return ST_ERR_FLIGHT_TIMEOUT
+        H = th[k]
+        hh = hip_y - H
+        if hh <= 0.0:
+            res[0] = t
+            res[1] = H
+            return ST_FALL_NO_TOUCHDOWN
+        f = foot_y - H
+        if armed:
+            if f <= tol:
+                res[0] = t
+                res[1] = H
+                return ST_OK
+            dt = _safe_dt(f, foot_yd, Kf)
+        else:
+            if f > 0.0:
+                armed = True
+                continue
+            # wait for the foot to rise above the ground: -f must reach 0
+            dt = _safe_dt(max(-f, 1e-300), -foot_yd, Kf)
+            dt = max(dt, 1e-12)
+        dt = min(dt, _safe_dt(hh, hip_yd, Kh))
+        # do not step across a terrain breakpoint unnoticed
+        if tx.shape[0] > 0:
+            dist = math.inf
+            if k > 0:
+                dist = foot_x - tx[k - 1]
+            if k < tx.shape[0]:
+                dist = min(dist, tx[k] - foot_x)
+            dt = min(dt, max(dist / vx, 1e-12))
+        t += dt
+        foot_y, foot_yd, hip_y, hip_yd, foot_x = _flight_heights(P, lo, t)
+        knew = _segment(tx, foot_x)
+        if knew != k:
+            k = knew
+            if armed and foot_y - th[k] <= 0.0:
+                res[0] = t
+                res[1] = th[k]
+                return ST_FALL_TRIP
+    res[0] = t
+    return ST_ERR_FLIGHT_TIMEOUT
+
+
+# ---------------------------------------------------------------------------
+# One stride: touch-down -> lift-off -> touch-down
+# ---------------------------------------------------------------------------
+
+
+@njit(**_JIT)
+def stance_initial(P, td, y0):
+    """Stance state at touch-down (l = l0), from eq. A.5 inverted for ld, betad."""
+    l0 = P[P_L0]
+    r = P[P_R]
+    b, ph, xd, yd, phd = td[0], td[1], td[2], td[3], td[4]
+    u = xd - r * math.cos(ph) * phd
+    w = yd - r * math.sin(ph) * phd
+    y0[0] = l0
+    y0[1] = b
+    y0[2] = ph
+    y0[3] = -u * math.cos(b) + w * math.sin(b)
+    y0[4] = (u * math.sin(b) + w * math.cos(b)) / l0
+    y0[5] = phd
+
+
+@njit(**_JIT)
+def stride(P, O, td, tx, th, rec, rec_dt, out):
+    """One stride from the touch-down state ``td`` (7) to the next.
+
+    Fills ``out`` (layout ``OUT_*`` in ``_pack``) and returns the status.
+    """
+    for i in range(NOUT):
+        out[i] = math.nan
+    out[OUT_TS] = 0.0
+    out[OUT_TF] = 0.0
+    out[OUT_NREC] = 0.0
+    out[OUT_RECOVF] = 0.0
+    l0 = P[P_L0]
+    r = P[P_R]
+    y0 = np.empty(NSTATE)
+    y1 = np.empty(NSTATE)
+    stats = np.empty(5)
+    stance_initial(P, td, y0)
+    x_m, h = td[5], td[6]
+    xf = x_m + l0 * math.cos(td[0]) - r * math.sin(td[1])
+    out[OUT_XF] = xf
+    fx0, fy0, _ = grf(P, y0)
+    out[OUT_FYNEG] = 1.0 if fy0 < 0.0 else 0.0
+    status = integrate_stance(P, O, y0, y1, rec, rec_dt, stats)
+    ts = stats[0]
+    out[OUT_TS] = ts
+    out[OUT_NSTEP] = stats[1]
+    out[OUT_NREJ] = stats[2]
+    out[OUT_NREC] = stats[3]
+    out[OUT_RECOVF] = stats[4]
+    # lift-off (or final) CoM state
+    l, b, ph = y1[0], y1[1], y1[2]
+    xd, yd = com_velocity(P, y1)
+    lo = np.empty(6)
+    lo[0] = xf - l * math.cos(b) + r * math.sin(ph)
+    lo[1] = h + l * math.sin(b) - r * math.cos(ph)
+    lo[2] = xd
+    lo[3] = yd
+    lo[4] = ph
+    lo[5] = y1[5]
+    for i in range(6):
+        out[OUT_LO + i] = lo[i]
+    out[OUT_LO + 6] = l
+    out[OUT_LO + 7] = b
+    out[OUT_LO + 8] = y1[3]
+    out[OUT_LO + 9] = y1[4]
+    if status != ST_OK:
+        if status < 10:
+            out[OUT_TFALL] = ts
+        return status
+    if xd < 0.0:
+        out[OUT_TFALL] = ts
+        return ST_FALL_BACKWARD
+    res = np.empty(3)
+    fstatus = find_touchdown(P, O, lo, tx, th, res)
+    tf = res[0]
+    out[OUT_TF] = tf
+    out[OUT_CLEAR] = res[2]
+    if fstatus != ST_OK:
+        if fstatus < 10:
+            out[OUT_TFALL] = ts + tf
+        return fstatus
+    fs = np.empty(10)
+    flight_state(P, lo, tf, fs)
+    out[OUT_TD + 0] = fs[6]
+    out[OUT_TD + 1] = fs[4]
+    out[OUT_TD + 2] = fs[2]
+    out[OUT_TD + 3] = fs[3]
+    out[OUT_TD + 4] = fs[5]
+    out[OUT_TD + 5] = fs[0]
+    out[OUT_TD + 6] = res[1]
+    return ST_OK
+
+
+@njit(**_JIT)
+def stride_simple(P, O, td, tx, th, out):
+    """:func:`stride` without recording (the Poincare map)."""
+    rec = np.empty((0, NREC))
+    return stride(P, O, td, tx, th, rec, 0.0, out)
+
+
+@njit(parallel=True, cache=True, nogil=True)
+def run_batch(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall):
+    """Run ``n_steps`` strides for each row, in parallel over rows.
+
+    ``Ps`` (n, NP), ``TDs`` (n, 7), per-row terrain ``TX`` (n, nb) and
+    ``TH`` (n, nb + 1) (pad breakpoints with ``+inf``). Writes each row's
+    touch-down states into ``td_hist`` (n, n_steps + 1, 7), the final
+    ``status``, the number of completed strides ``n_done`` and the time of
+    the fall ``t_fall`` (NaN if none).
+    """
+    n = Ps.shape[0]
+    for i in prange(n):
+        out = np.empty(NOUT)
+        td = TDs[i].copy()
+        for j in range(7):
+            td_hist[i, 0, j] = td[j]
+        t_total = 0.0
+        st = ST_OK
+        done = 0
+        t_fall[i] = math.nan
+        for s in range(n_steps):
+            st = stride_simple(Ps[i], O, td, TX[i], TH[i], out)
+            if st != ST_OK:
+                if st < 10:
+                    t_fall[i] = t_total + out[OUT_TFALL]
+                break
+            t_total += out[OUT_TS] + out[OUT_TF]
+            for j in range(7):
+                td[j] = out[OUT_TD + j]
+                td_hist[i, s + 1, j] = td[j]
+            done = s + 1
+        status[i] = st
+        n_done[i] = done
+
+
+@njit(parallel=True, cache=True, nogil=True)
+def stride_batch(Ps, O, TDs, TX, TH, OUTs, status):
+    """One stride per row, in parallel over rows (the batched Poincare map)."""
+    n = Ps.shape[0]
+    for i in prange(n):
+        status[i] = stride_simple(Ps[i], O, TDs[i], TX[i], TH[i], OUTs[i])
+
+
+@njit(**_JIT)
+def flight_samples(P, lo, ts, out):
+    """:func:`flight_state` at each time in ``ts``; ``out`` has shape (n, 10)."""
+    for i in range(ts.shape[0]):
+        flight_state(P, lo, ts[i], out[i])

@@ -1,0 +1,58 @@
+"""Integrator options: tolerances and limits, never hard-coded in kernels."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model._pack import (
+    NO,
+    O_ATOL,
+    O_H0,
+    O_HMIN,
+    O_MAXSTEPS,
+    O_RTOL,
+    O_TMAX_FLIGHT,
+    O_TMAX_STANCE,
+)
+from ..model.controllers import check_finite_fields
+
+__all__ = ["IntegratorOptions"]
+
+
+def _m(description: str, lower: float, lower_open: bool = True) -> dict:
+    return {"description": description, "lower": lower, "lower_open": lower_open}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class IntegratorOptions:
+    """Dormand-Prince 5(4) settings for the stance phase.
+
+    The thesis used ``rtol = atol = 1e-8`` (Section 2.7); those are the defaults.
+    """
+
+    rtol: float = field(default=1e-8, metadata=_m("relative tolerance", 0.0))
+    atol: float = field(default=1e-8, metadata=_m("absolute tolerance", 0.0))
+    h0: float = field(default=0.0, metadata=_m("first step size (0: automatic)", 0.0, False))
+    max_steps: int = field(default=100_000, metadata=_m("max steps in one stance", 0.0))
+    t_max_stance: float = field(default=50.0, metadata=_m("max stance duration", 0.0))
+    t_max_flight: float = field(default=1000.0, metadata=_m("max flight duration", 0.0))
+    h_min: float = field(default=1e-13, metadata=_m("smallest step before giving up", 0.0))
+
+    def __post_init__(self) -> None:
+        check_finite_fields(self, prefix="IntegratorOptions.")
+
+    def packed(self) -> np.ndarray:
+        """The O vector for the kernels."""
+        o = np.zeros(NO)
+        o[O_RTOL], o[O_ATOL], o[O_H0] = self.rtol, self.atol, self.h0
+        o[O_MAXSTEPS], o[O_TMAX_STANCE] = self.max_steps, self.t_max_stance
+        o[O_TMAX_FLIGHT], o[O_HMIN] = self.t_max_flight, self.h_min
+        return o
+
+    @classmethod
+    def tight(cls) -> IntegratorOptions:
+        """Tolerance 1e-12, for reference comparisons."""
+        return cls(rtol=1e-12, atol=1e-12)
+

@@ -1,0 +1,284 @@
+"""Typed results: status, one stride (:class:`StepResult`), a run (:class:`Trajectory`)."""
+
+from __future__ import annotations
+
+import enum
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..model import _pack as pk
+from ..model.parameters import Params
+from ..model.state import TouchdownState
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = ["Status", "LiftoffState", "StepResult", "Trajectory", "Event", "IntegrationError"]
+
+
+class IntegrationError(RuntimeError):
+    """The integrator could not proceed (not a fall: a numerical failure)."""
+
+
+class Status(enum.IntEnum):
+    """Outcome of a stride. Falls have codes below 10, integration errors 10+."""
+
+    OK = pk.ST_OK
+    FALL_BACKWARD = pk.ST_FALL_BACKWARD
+    FALL_HIP_GROUND = pk.ST_FALL_HIP_GROUND
+    FALL_NO_TOUCHDOWN = pk.ST_FALL_NO_TOUCHDOWN
+    FALL_TRIP = pk.ST_FALL_TRIP
+    STEP_UNDERFLOW = pk.ST_ERR_STEP_UNDERFLOW
+    MAX_STEPS = pk.ST_ERR_MAX_STEPS
+    STANCE_TIMEOUT = pk.ST_ERR_STANCE_TIMEOUT
+    FLIGHT_TIMEOUT = pk.ST_ERR_FLIGHT_TIMEOUT
+    NONFINITE = pk.ST_ERR_NONFINITE
+
+    @property
+    def fell(self) -> bool:
+        """True for a fall (eqs 2.10-2.11 or a trip), not for an error."""
+        return 0 < self.value < 10
+
+    @property
+    def is_error(self) -> bool:
+        """True if the integration itself failed."""
+        return self.value >= 10
+
+    @property
+    def reason(self) -> str:
+        """One-line human-readable explanation."""
+        return _REASONS[self]
+
+
+_REASONS = {
+    Status.OK: "ok",
+    Status.FALL_BACKWARD: "fall: the CoM moved backward, xdot_m < 0 (eq. 2.10)",
+    Status.FALL_HIP_GROUND: "fall: the hip reached the ground in stance (eq. 2.11)",
+    Status.FALL_NO_TOUCHDOWN: "fall: the hip reached the ground in flight before the foot",
+    Status.FALL_TRIP: "fall: the foot hit a step riser (terrain)",
+    Status.STEP_UNDERFLOW: "error: step size fell below IntegratorOptions.h_min",
+    Status.MAX_STEPS: "error: more than IntegratorOptions.max_steps steps in one stance",
+    Status.STANCE_TIMEOUT: "error: stance longer than IntegratorOptions.t_max_stance",
+    Status.FLIGHT_TIMEOUT: "error: flight longer than IntegratorOptions.t_max_flight",
+    Status.NONFINITE: "error: the state became NaN or infinite",
+}
+
+
+@dataclass(frozen=True, slots=True)
+class LiftoffState:
+    """State at lift-off (or where the stance ended)."""
+
+    x: float
+    y: float
+    xd: float
+    yd: float
+    phi: float
+    phid: float
+    l: float  # noqa: E741 - thesis symbol
+    beta: float
+    ld: float
+    betad: float
+
+    @classmethod
+    def from_out(cls, out: np.ndarray) -> LiftoffState:
+        return cls(*map(float, out[pk.OUT_LO : pk.OUT_LO + 10]))
+
+
+@dataclass(frozen=True, slots=True)
+class StepResult:
+    """One stride: touch-down, stance, lift-off, flight, next touch-down.
+
+    Attributes
+    ----------
+    state : TouchdownState or None
+        The next touch-down state (``None`` after a fall or an error).
+    stance_time, flight_time : float
+        Durations [g^-1/2 L^1/2]; for a fall, up to the fall.
+    status : Status
+    liftoff : LiftoffState
+    grf : ndarray, shape (n, 4)
+        Stance samples ``(t, F_x, F_y, tau)`` at the integrator's steps, with
+        ``t`` since touch-down.
+    stance : ndarray, shape (n, 7)
+        Stance samples ``(t, l, beta, phi, ld, betad, phid)``.
+    foot_x : float
+        Foot position of this stance [L].
+    foot_clearance : float
+        Foot height above ground right after the leg reset [L].
+    fy_negative_at_touchdown : bool
+        ``F_y < 0`` right at touch-down (possible with a hip torque).
+    n_integrator_steps : int
+    """
+
+    state: TouchdownState | None
+    stance_time: float
+    flight_time: float
+    status: Status
+    liftoff: LiftoffState
+    grf: np.ndarray
+    stance: np.ndarray
+    foot_x: float
+    foot_clearance: float
+    fy_negative_at_touchdown: bool
+    n_integrator_steps: int
+    start: TouchdownState
+    params: Params
+
+    @property
+    def fell(self) -> bool:
+        """True if the runner fell in this stride."""
+        return self.status.fell
+
+    @property
+    def ok(self) -> bool:
+        """True if the stride ended in a touch-down."""
+        return self.status == Status.OK
+
+    @property
+    def reason(self) -> str:
+        """Why the stride ended as it did."""
+        return self.status.reason
+
+    @property
+    def impulse(self) -> tuple[float, float]:
+        """Ground impulse over the stance ``(I_x, I_y)`` (eq. 3.3), from momentum.
+
+        ``I = m (v_LO - v_TD) + (0, m g t_s)``, exact for the model because
+        the leg is massless.
+        """
+        p = self.params
+        return (
+            p.m * (self.liftoff.xd - self.start.xd),
+            p.m * (self.liftoff.yd - self.start.yd) + p.m * p.g * self.stance_time,
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class Event:
+    """A touch-down, lift-off or fall, with time and CoM / foot position."""
+
+    kind: str  # "touchdown" | "liftoff" | "fall"
+    step: int
+    t: float
+    x: float
+    y: float
+    foot_x: float
+    foot_y: float
+
+
+#: Columns of :attr:`Trajectory.data`, in order.
+TRAJECTORY_COLUMNS: tuple[str, ...] = (
+    "t", "step", "stance", "x", "y", "xd", "yd", "phi", "phid", "l", "beta", "ld", "betad",
+    "alpha", "foot_x", "foot_y", "hip_x", "hip_y", "Fx", "Fy", "tau", "energy",
+)
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A multi-stride run, sampled in time.
+
+    ``data`` has the columns of :data:`TRAJECTORY_COLUMNS`: time, step index,
+    stance flag, CoM position and velocity, pitch, leg length and angle with
+    rates, local hip angle, foot and hip positions, GRF, hip torque and total
+    mechanical energy. ``steps`` holds the :class:`StepResult` of each stride,
+    ``events`` the touch-down, lift-off and fall events.
+    """
+
+    data: np.ndarray
+    steps: list[StepResult]
+    events: list[Event]
+    status: Status
+    params: Params
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.data[:, TRAJECTORY_COLUMNS.index(name)]
+
+    @property
+    def time(self) -> np.ndarray:
+        """Sample times [g^-1/2 L^1/2]."""
+        return self["t"]
+
+    @property
+    def fell(self) -> bool:
+        """True if the run ended in a fall."""
+        return self.status.fell
+
+    @property
+    def touchdowns(self) -> list[TouchdownState]:
+        """Touch-down states: the start of each stride, then the last one."""
+        out = [s.start for s in self.steps]
+        if self.steps and self.steps[-1].state is not None:
+            out.append(self.steps[-1].state)
+        return out
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """Time series as a tidy ``pandas.DataFrame``."""
+        import pandas as pd
+
+        df = pd.DataFrame(self.data, columns=list(TRAJECTORY_COLUMNS))
+        df["step"] = df["step"].astype(int)
+        df["stance"] = df["stance"].astype(bool)
+        return df
+
+    def steps_dataframe(self) -> pd.DataFrame:
+        """One row per stride: touch-down state, times, outcome."""
+        import pandas as pd
+
+        rows = []
+        for i, s in enumerate(self.steps):
+            rows.append(
+                {
+                    "step": i, "beta": s.start.beta, "phi": s.start.phi, "xd": s.start.xd,
+                    "yd": s.start.yd, "phid": s.start.phid, "v": s.start.v,
+                    "delta": s.start.delta, "x": s.start.x, "h": s.start.h,
+                    "stance_time": s.stance_time, "flight_time": s.flight_time,
+                    "foot_x": s.foot_x, "foot_clearance": s.foot_clearance,
+                    "status": s.status.name,
+                }
+            )
+        return pd.DataFrame(rows)
+
+    def save(self, path: str | Path) -> Path:
+        """Write the time series to ``.csv`` or ``.parquet`` (atomically).
+
+        A ``<name>.json`` beside it records parameters, status and version.
+        """
+        from .. import __version__
+
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix not in (".csv", ".parquet"):
+            raise ValueError(f"output file must end in .csv or .parquet, got {str(path)!r}")
+        df = self.to_dataframe()
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=suffix)
+        os.close(fd)
+        try:
+            if suffix == ".csv":
+                df.to_csv(tmp, index=False)
+            else:
+                df.to_parquet(tmp, index=False)
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+        meta = {
+            "tslip_version": __version__,
+            "params": self.params.to_dict(),
+            "status": self.status.name,
+            "reason": self.status.reason,
+            "n_steps": len(self.steps),
+            **self.meta,
+        }
+        meta_path = path.with_suffix(".json")
+        tmp_meta = meta_path.with_name(f".{meta_path.name}.tmp")
+        tmp_meta.write_text(json.dumps(meta, indent=2, default=str))
+        os.replace(tmp_meta, meta_path)
+        return path
