@@ -6,6 +6,7 @@ Running" (TU Delft / IHMC, 2019), in the dimensionless units of its Table 3.1.
 
 __version__ = "0.1.0"
 
+from .gait import Gait, find_gait  # noqa: E402
 from .model import (  # noqa: E402
     ConstantTorque,
     GlobalPD,
@@ -35,5 +36,5 @@ __all__ = [
     "ConstantTorque", "GlobalPD", "LocalVelocity", "Params", "Passive", "Terrain",
     "TouchdownState", "preset", "presets",
     "Disturbance", "IntegratorOptions", "Status", "StepResult", "Trajectory",
-    "run_batch", "simulate", "step", "step_batch", "step_map",
+    "run_batch", "simulate", "step", "step_batch", "step_map", "Gait", "find_gait",
 ]

@@ -19,7 +19,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-
 from ..model.controllers import ConstantTorque, GlobalPD, LocalVelocity
 from ..model.parameters import Params
 from ..model.state import TouchdownState
@@ -79,7 +78,8 @@ def _apply(params: Params, names: list[str], z: np.ndarray) -> tuple[Params, Tou
             p, controller=dataclasses.replace(p.controller, alphad_ref=values["alphad_ref"])
         )
     if "tau_c" in values:
-        p = dataclasses.replace(p, controller=dataclasses.replace(p.controller, tau_c=values["tau_c"]))
+        ctrl = dataclasses.replace(p.controller, tau_c=values["tau_c"])
+        p = dataclasses.replace(p, controller=ctrl)
     s = TouchdownState.from_velocity(
         v=p.v0, delta=values["delta"], beta=p.beta0, phi=values["phi"], phid=values["phid"]
     )

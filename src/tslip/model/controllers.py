@@ -31,6 +31,9 @@ __all__ = [
 ]
 
 
+_ROT_DAMP = "Mg^1/2 L^3/2/rad"
+
+
 def _meta(symbol: str, unit: str, description: str, lower: float = -math.inf) -> dict[str, Any]:
     return {"symbol": symbol, "unit": unit, "description": description, "lower": lower}
 
@@ -96,7 +99,9 @@ class GlobalPD(Controller):
     code: ClassVar[int] = 1
     name: ClassVar[str] = "global_pd"
     Kp: float = field(default=5.0, metadata=_meta("K_p", "MgL/rad", "proportional gain", 0.0))
-    Kd: float = field(default=0.5, metadata=_meta("K_d", "Mg^1/2 L^3/2/rad", "derivative gain", 0.0))
+    Kd: float = field(
+        default=0.5, metadata=_meta("K_d", _ROT_DAMP, "derivative gain", 0.0)
+    )
     phi_ref: float = field(default=0.0, metadata=_meta("phi_r", "rad", "reference pitch angle"))
     phid_ref: float = field(
         default=0.0, metadata=_meta("phidot_r", "rad g^1/2 L^-1/2", "reference pitch rate")
@@ -109,7 +114,9 @@ class LocalVelocity(Controller):
 
     code: ClassVar[int] = 2
     name: ClassVar[str] = "local_velocity"
-    Kd: float = field(default=0.5, metadata=_meta("K_d", "Mg^1/2 L^3/2/rad", "derivative gain", 0.0))
+    Kd: float = field(
+        default=0.5, metadata=_meta("K_d", _ROT_DAMP, "derivative gain", 0.0)
+    )
     alphad_ref: float = field(
         default=0.0, metadata=_meta("alphadot_r", "rad g^1/2 L^-1/2", "reference hip rate")
     )
@@ -122,7 +129,7 @@ class ConstantTorque(Controller):
     code: ClassVar[int] = 3
     name: ClassVar[str] = "constant_torque"
     tau_c: float = field(default=0.0, metadata=_meta("tau_c", "MgL", "constant hip torque"))
-    c_h: float = field(default=0.0, metadata=_meta("c_h", "Mg^1/2 L^3/2/rad", "hip damping", 0.0))
+    c_h: float = field(default=0.0, metadata=_meta("c_h", _ROT_DAMP, "hip damping", 0.0))
 
 
 CONTROLLERS: dict[str, type[Controller]] = {

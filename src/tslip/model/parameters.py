@@ -57,7 +57,8 @@ class ParameterInfo(NamedTuple):
 
 
 _INF = math.inf
-#: name, symbol, unit, dims(M,g,L), default, lower, upper, lower_open, upper_open, description, source
+#: name, symbol, unit, dims (M, g, L), default, lower, upper, lower_open, upper_open,
+#: description, source
 PARAMETER_TABLE: tuple[ParameterInfo, ...] = tuple(
     ParameterInfo(*row)
     for row in (

@@ -1,7 +1,15 @@
 """Hybrid stance/flight simulation: compiled Dormand-Prince stance, closed-form flight."""
 
 from .integrate import (
-    BatchRun, BatchStep, Disturbance, MapResult, run_batch, simulate, step, step_batch, step_map,
+    BatchRun,
+    BatchStep,
+    Disturbance,
+    MapResult,
+    run_batch,
+    simulate,
+    step,
+    step_batch,
+    step_map,
 )
 from .options import IntegratorOptions
 from .result import Event, IntegrationError, LiftoffState, Status, StepResult, Trajectory

@@ -17,7 +17,6 @@ from numba import njit, prange
 
 from ..model._pack import (
     NOUT,
-    NP,
     NREC,
     O_ATOL,
     O_H0,

@@ -80,7 +80,9 @@ def _as_state(state: TouchdownState | Sequence[float] | np.ndarray) -> Touchdown
         return TouchdownState.from_section(arr)
     if arr.shape == (7,):
         return TouchdownState(*map(float, arr))
-    raise ValueError(f"state must be a TouchdownState or have 5 or 7 entries, got shape {arr.shape}")
+    raise ValueError(
+        f"state must be a TouchdownState or have 5 or 7 entries, got shape {arr.shape}"
+    )
 
 
 def _check_params(params: Params) -> Params:

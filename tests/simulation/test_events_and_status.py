@@ -1,0 +1,114 @@
+"""Falls with their reasons, integration failures as statuses, bad input."""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+import tslip
+from tslip import Status
+
+
+@pytest.fixture(scope="module")
+def gait():
+    return tslip.find_gait(tslip.preset("table2.1"))
+
+
+def test_periodic_gait_returns_to_itself(gait):
+    r = tslip.step(gait.params, gait.state, options=tslip.IntegratorOptions.tight())
+    assert r.ok and not r.fell and r.reason == "ok"
+    np.testing.assert_allclose(r.state.section(), gait.state.section(), atol=1e-9)
+    assert r.state.x > gait.state.x  # it ran forward
+
+
+def test_fall_backward_eq_2_10(gait):
+    """Very slow and steep: the runner is thrown back over its foot."""
+    s = tslip.TouchdownState.from_velocity(v=0.3, delta=-0.1, beta=1.0)
+    r = tslip.step(gait.params, s)
+    assert r.fell and r.status == Status.FALL_BACKWARD
+    assert "eq. 2.10" in r.reason
+
+
+def test_fall_hip_ground_in_stance(gait):
+    """A soft leg at high downward speed collapses until the hip is at the ground."""
+    p = dataclasses.replace(gait.params, k=2.0)
+    s = tslip.TouchdownState.from_velocity(v=5.0, delta=-1.2, beta=1.0)
+    r = tslip.step(p, s)
+    assert r.status == Status.FALL_HIP_GROUND
+    assert r.liftoff.l * math.sin(r.liftoff.beta) == pytest.approx(0.0, abs=1e-8)
+
+
+def test_fall_no_touchdown_leg_pointing_up(gait):
+    """A leg reset pointing upward never reaches the ground: the hip lands first."""
+    p = dataclasses.replace(gait.params, alpha_r=-1.0, omega_r=0.0)
+    r = tslip.step(p, gait.state)
+    assert r.status == Status.FALL_NO_TOUCHDOWN and r.fell
+    assert r.flight_time > 0
+
+
+def test_trip_on_step_up(gait):
+    """A riser higher than the swinging foot, in its path, trips the runner."""
+    tr = tslip.simulate(gait.params, gait.state, 1, dt=1e-3)
+    flight = tr["stance"] == 0
+    fx, fy = tr["foot_x"][flight], tr["foot_y"][flight]
+    i = int(np.argmax(fy))  # riser where the foot is highest, twice as high as the foot
+    terrain = tslip.Terrain.step(x=fx[i], dh=2 * fy[i])
+    r = tslip.step(gait.params, gait.state, terrain=terrain)
+    assert r.status == Status.FALL_TRIP
+    # a riser lower than the foot there is stepped onto instead
+    low = tslip.step(gait.params, gait.state, terrain=tslip.Terrain.step(x=fx[i], dh=0.5 * fy[i]))
+    assert low.ok and low.state.h == pytest.approx(0.5 * fy[i])
+
+
+@pytest.mark.parametrize(
+    ("opts", "status"),
+    [(tslip.IntegratorOptions(max_steps=3), Status.MAX_STEPS),
+     (tslip.IntegratorOptions(h_min=0.5), Status.STEP_UNDERFLOW),
+     (tslip.IntegratorOptions(t_max_stance=0.01), Status.STANCE_TIMEOUT),
+     (tslip.IntegratorOptions(t_max_flight=0.01), Status.FLIGHT_TIMEOUT)],
+)
+def test_integration_failures_end_with_a_status(gait, opts, status):
+    r = tslip.step(gait.params, gait.state, options=opts)
+    assert r.status == status and r.status.is_error and not r.fell
+    with pytest.raises(tslip.simulation.IntegrationError):
+        tslip.step(gait.params, gait.state, options=opts, raise_on_failure=True)
+
+
+def test_simulate_stops_at_fall_and_records_event(gait):
+    tr = tslip.simulate(gait.params, gait.state, 25, disturbance=tslip.Disturbance(dxd=-4.5))
+    assert tr.fell
+    assert tr.events[-1].kind == "fall"
+    assert len(tr.steps) < 25
+
+
+@pytest.mark.parametrize("kw", [{"rtol": 0.0}, {"atol": -1.0}, {"max_steps": 0},
+                                {"rtol": math.nan}])
+def test_bad_options(kw):
+    with pytest.raises(ValueError, match="IntegratorOptions"):
+        tslip.IntegratorOptions(**kw)
+
+
+def test_bad_simulate_input(gait):
+    with pytest.raises(ValueError, match="n_steps"):
+        tslip.simulate(gait.params, gait.state, 0)
+    with pytest.raises(ValueError, match="dt"):
+        tslip.simulate(gait.params, gait.state, 2, dt=-1.0)
+    with pytest.raises(ValueError, match="state must"):
+        tslip.step(gait.params, [1.0, 2.0])
+    with pytest.raises(ValueError, match="params must be a tslip.Params"):
+        tslip.step({"k": 1}, gait.state)
+    with pytest.raises(ValueError, match="Disturbance.at_step"):
+        tslip.Disturbance(at_step=-1)
+
+
+def test_fy_negative_at_touchdown_is_flagged():
+    """With a large hip torque F_y starts negative; the stance continues until F_y
+    crosses zero from above (CONVENTIONS.md)."""
+    p = dataclasses.replace(tslip.preset("table2.1"),
+                            controller=tslip.ConstantTorque(tau_c=-3.0, c_h=0.0))
+    s = tslip.TouchdownState.from_velocity(v=5.0, delta=-0.2, beta=1.05)
+    r = tslip.step(p, s)
+    assert r.fy_negative_at_touchdown
+    assert r.stance_time > 0.01
+    assert np.any(r.grf[:, 2] > 0)
