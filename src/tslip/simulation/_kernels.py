@@ -603,7 +603,8 @@ def find_touchdown(P, O, lo, tx, th, res):
             return ST_FALL_NO_TOUCHDOWN
         f = foot_y - H
         if armed:
-            if f <= tol:
+            # a downward crossing: just after arming the foot is at the ground but rising
+            if f <= tol and foot_yd <= 0.0:
                 res[0] = t
                 res[1] = H
                 return ST_OK
