@@ -98,14 +98,16 @@ def stance_accel(P, y):
     l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
     sb = math.sin(b)
     cb = math.cos(b)
-    sa = math.sin(b + ph)
-    ca = math.cos(b + ph)
+    sp = math.sin(ph)
+    cp = math.cos(ph)
+    sa = sb * cp + cb * sp  # sin(beta + phi)
+    ca = cb * cp - sb * sp  # cos(beta + phi)
     tau = hip_torque(P, ph, bd, phd)
     fl = P[P_K] * (P[P_L0] - l) - P[P_CL] * ld  # eq. 2.1
     # R = Q - C (eq. A.11, A.13)
     r1 = -m * g * sb + fl - (m * r * phd * phd * sa - m * l * bd * bd)
     r2 = tau - m * g * l * cb - (m * r * l * phd * phd * ca + 2.0 * m * l * bd * ld)
-    r3 = tau - m * g * r * math.sin(ph) - (m * r * l * bd * bd * ca + 2.0 * m * r * bd * ld * sa)
+    r3 = tau - m * g * r * sp - (m * r * l * bd * bd * ca + 2.0 * m * r * bd * ld * sa)
     phdd = (r3 + r * ca * r1 - r * sa * r2 / l) / P[P_J]
     ldd = r1 / m + r * ca * phdd
     bdd = r2 / (m * l * l) - r * sa / l * phdd
@@ -152,11 +154,14 @@ def event_values(P, y, gv):
     0: lift-off, ``F_y`` (eq. 2.8); 1: hip height above the foot
     ``l sin(beta)`` (eq. 2.11); 2: ``xdot_m`` (eq. 2.10).
     """
-    fx, fy, tau = grf(P, y)
-    gv[0] = fy
-    gv[1] = y[0] * math.sin(y[1])
-    xd, yd = com_velocity(P, y)
-    gv[2] = xd
+    l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
+    sb = math.sin(b)
+    cb = math.cos(b)
+    tau = hip_torque(P, ph, bd, phd)
+    fl = P[P_K] * (P[P_L0] - l) - P[P_CL] * ld
+    gv[0] = fl * sb + tau / l * cb  # F_y, eq. 2.6
+    gv[1] = l * sb
+    gv[2] = -ld * cb + l * sb * bd + P[P_R] * math.cos(ph) * phd  # xdot_m, eq. A.5
 
 
 # ---------------------------------------------------------------------------
@@ -398,13 +403,16 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
         first_ev = -1
         theta_ev = 2.0
         have_dense = False
-        for ev in range(3):
+        # falls first: lift-off wins only if strictly earlier (F_y = F_l sin(beta)
+        # and the hip height l sin(beta) vanish together when beta reaches 0)
+        for j in range(3):
+            ev = (1, 2, 0)[j]
             if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
                 if not have_dense:
                     dense_coeffs(y, ynew, h, K, R)
                     have_dense = True
                 th = _event_root(P, R, ev, gv_old[ev], gv_new[ev], ytmp, gv_tmp)
-                if th < theta_ev:
+                if th < theta_ev - 1e-9:
                     theta_ev = th
                     first_ev = ev
         if rec_dt > 0.0 and nrec_max > 0:
