@@ -182,7 +182,13 @@ def find_gait(
             best = (err, sol.x)
         if err <= tol:
             break
-    assert best is not None
+    if best is None:  # every start failed inside the solver
+        z = starts[0]
+        p, s = _apply(params, names, z)
+        r, ts, tf = gait_residual(p, s, options)
+        return Gait(state=s, params=p, residual=float(np.max(np.abs(r))), stance_time=ts,
+                    flight_time=tf, converged=False,
+                    message="no periodic gait found: the least-squares solver failed to start")
     err, z = best
     p, s = _apply(params, names, z)
     r, ts, tf = gait_residual(p, s, options)

@@ -228,7 +228,11 @@ class Params:
                 ) from None
         out = dataclasses.replace(base, **changes)
         if omega_r_bar is not None:
-            out = out.with_omega_r_bar(float(omega_r_bar))
+            try:
+                omega_r_bar = float(omega_r_bar)
+            except (TypeError, ValueError):
+                raise ValueError(f"omega_r_bar [-] must be a number, got {omega_r_bar!r}") from None
+            out = out.with_omega_r_bar(omega_r_bar)
         return out
 
     @classmethod

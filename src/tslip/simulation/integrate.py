@@ -6,6 +6,7 @@ and turns their flat arrays into typed results.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -292,8 +293,14 @@ def simulate(
                 Event("touchdown", i + 1, t0, *_com_xy(params, td), _foot_x(params, td), td.h)
             )
     data = np.vstack(chunks) if chunks else np.empty((0, len(TRAJECTORY_COLUMNS)))
+    meta = {
+        "dt": dt,
+        "start": dataclasses.asdict(_as_state(state)),
+        "options": dataclasses.asdict(options or IntegratorOptions()),
+        "disturbance": None if disturbance is None else dataclasses.asdict(disturbance),
+    }
     return Trajectory(data=data, steps=steps, events=events, status=status, params=params,
-                      meta={"dt": dt})
+                      terrain=terrain, meta=meta)
 
 
 def _foot_x(params: Params, td: TouchdownState) -> float:

@@ -22,7 +22,8 @@ __all__ = ["IntegratorOptions"]
 
 
 def _m(description: str, lower: float, lower_open: bool = True) -> dict:
-    return {"description": description, "lower": lower, "lower_open": lower_open}
+    return {"description": description, "lower": lower, "lower_open": lower_open,
+            "upper_open": True}
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -15,6 +15,7 @@ import numpy as np
 from ..model import _pack as pk
 from ..model.parameters import Params
 from ..model.state import TouchdownState
+from ..model.terrain import Terrain
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -186,7 +187,8 @@ class Trajectory:
     ``data`` has the columns of :data:`TRAJECTORY_COLUMNS`: time, step index,
     stance flag, CoM position and velocity, pitch, leg length and angle with
     rates, local hip angle, foot and hip positions, GRF, hip torque and total
-    mechanical energy. ``steps`` holds the :class:`StepResult` of each stride,
+    mechanical energy. ``terrain`` is the ground the run used (including a
+step-down from a :class:`Disturbance`). ``steps`` holds the :class:`StepResult` of each stride,
     ``events`` the touch-down, lift-off and fall events.
     """
 
@@ -195,6 +197,7 @@ class Trajectory:
     events: list[Event]
     status: Status
     params: Params
+    terrain: Terrain = field(default_factory=Terrain)
     meta: dict[str, Any] = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
@@ -260,6 +263,9 @@ class Trajectory:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=suffix)
         os.close(fd)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the usual file mode
         try:
             if suffix == ".csv":
                 df.to_csv(tmp, index=False)
@@ -275,6 +281,8 @@ class Trajectory:
             "status": self.status.name,
             "reason": self.status.reason,
             "n_steps": len(self.steps),
+            "terrain": {"breakpoints": self.terrain.breakpoints, "heights": self.terrain.heights},
+            "git": _git_hash(),
             **self.meta,
         }
         meta_path = path.with_suffix(".json")
@@ -282,3 +290,15 @@ class Trajectory:
         tmp_meta.write_text(json.dumps(meta, indent=2, default=str))
         os.replace(tmp_meta, meta_path)
         return path
+
+
+def _git_hash() -> str | None:
+    """The source checkout's commit, if the package runs from one."""
+    import subprocess
+
+    try:
+        out = subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent,
+                             capture_output=True, text=True, timeout=5)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() or None if out.returncode == 0 else None

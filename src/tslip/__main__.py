@@ -1,0 +1,5 @@
+"""``python -m tslip``: the command line."""
+
+from tslip.cli.main import main
+
+main()

@@ -1,0 +1,18 @@
+"""Plots and animations of TSLIP results: a result in, a Figure or a file out.
+
+Nothing here calls ``pyplot``; figures are built with the matplotlib object
+API so they work headless. Save with ``fig.savefig(path)``.
+"""
+
+from .animation import animate, frame_times, render_frames
+from .trajectories import flight_intervals, ground_profile, plot_touchdowns, plot_trajectory
+
+__all__ = [
+    "animate",
+    "flight_intervals",
+    "frame_times",
+    "ground_profile",
+    "plot_touchdowns",
+    "plot_trajectory",
+    "render_frames",
+]

@@ -1,0 +1,410 @@
+"""Animation of a run: the runner drawn frame by frame to a GIF or MP4.
+
+Frames are rendered off-screen with matplotlib's Agg canvas and written with
+Pillow (``.gif``) or imageio-ffmpeg / libx264 (``.mp4``).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from collections.abc import Callable, Iterable, Iterator
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import LineCollection
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle, Ellipse, FancyArrowPatch
+
+from ..simulation.result import TRAJECTORY_COLUMNS
+from .trajectories import ground_profile
+
+if TYPE_CHECKING:
+    from ..model.terrain import Terrain
+    from ..simulation.result import Trajectory
+
+__all__ = ["animate", "frame_times", "render_frames", "TIME_UNIT_1M"]
+
+#: Seconds per model time unit g^-1/2 L^1/2 for a 1 m leg on Earth.
+TIME_UNIT_1M = math.sqrt(1.0 / 9.81)
+
+_SUFFIXES = (".gif", ".mp4")
+_COL = {name: i for i, name in enumerate(TRAJECTORY_COLUMNS)}
+
+
+def frame_times(
+    traj: Trajectory, fps: float = 30.0, speed: float = 0.25, time_unit: float = TIME_UNIT_1M
+) -> np.ndarray:
+    """Model times [g^-1/2 L^1/2] of the video frames.
+
+    One second of video shows ``speed / time_unit`` model time units, so
+    ``speed = 0.25`` is quarter speed for a runner with ``time_unit``
+    seconds per model time unit (default: 1 m leg, Earth gravity).
+    """
+    for name, value in (("fps", fps), ("speed", speed), ("time_unit", time_unit)):
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    t = traj["t"]
+    if len(t) == 0:
+        raise ValueError("trajectory has no samples to animate")
+    step = speed / (fps * time_unit)
+    ts = np.arange(float(t[0]), float(t[-1]), step)
+    return np.append(ts, float(t[-1])) if len(ts) == 0 or ts[-1] < t[-1] - 1e-12 else ts
+
+
+def _sample(data: np.ndarray, t_frames: np.ndarray) -> np.ndarray:
+    """Rows of ``data`` at ``t_frames``: linear in time within a phase.
+
+    Across a touch-down or lift-off (where the leg is reset) the nearer
+    sample is used instead, so the leg never sweeps through the reset.
+    """
+    t = data[:, _COL["t"]]
+    n = len(t)
+    if n == 1:
+        return np.repeat(data, len(t_frames), axis=0)
+    k = np.clip(np.searchsorted(t, t_frames, side="right") - 1, 0, n - 2)
+    span = t[k + 1] - t[k]
+    w = np.where(span > 0, (t_frames - t[k]) / np.where(span > 0, span, 1.0), 0.0)
+    w = np.clip(w, 0.0, 1.0)
+    stance = data[:, _COL["stance"]]
+    jump = stance[k] != stance[k + 1]
+    w = np.where(jump, np.round(w), w)
+    return data[k] * (1.0 - w)[:, None] + data[k + 1] * w[:, None]
+
+
+def _spring(hip: np.ndarray, foot: np.ndarray, l0: float, n_coils: int = 7) -> np.ndarray:
+    """Zig-zag polyline from hip to foot, straight near both ends."""
+    d = foot - hip
+    length = float(np.hypot(*d))
+    if length < 1e-12:
+        return np.array([hip, foot])
+    u = d / length
+    nrm = np.array([-u[1], u[0]])
+    lead = min(0.18 * l0, 0.3 * length)
+    s = np.linspace(lead, length - lead, 2 * n_coils + 1)
+    amp = 0.06 * l0 * np.ones_like(s)
+    amp[0] = amp[-1] = 0.0
+    amp[1:-1] *= np.where(np.arange(1, len(s) - 1) % 2 == 0, 1.0, -1.0)
+    pts = hip + s[:, None] * u + amp[:, None] * nrm
+    return np.vstack([hip, pts, foot])
+
+
+class _Scene:
+    """The matplotlib artists of one frame, updated in place."""
+
+    def __init__(
+        self,
+        traj: Trajectory,
+        width_px: int,
+        height_px: int,
+        dpi: float,
+        terrain: Terrain | None,
+        view_width: float | None,
+    ) -> None:
+        p = traj.params
+        self.l0 = p.l0
+        self.fig = Figure(figsize=(width_px / dpi, height_px / dpi), dpi=dpi)
+        self.canvas = FigureCanvasAgg(self.fig)
+        ax = self.fig.add_axes((0.0, 0.0, 1.0, 1.0))
+        ax.set_axis_off()
+        self.ax = ax
+        gx, gy = ground_profile(traj, terrain, margin=4.0 * p.l0)
+        self.gx, self.gy = gx, gy
+        self.view_w = view_width or 4.0 * p.l0
+        self.view_h = self.view_w * height_px / width_px
+        # ground: filled, with tick marks that move with the camera
+        ax.fill_between(gx, gy, float(np.min(gy)) - self.view_h, color="0.85", lw=0, zorder=0)
+        ax.plot(gx, gy, color="k", lw=1.5, zorder=1)
+        ticks_x = np.arange(gx[0], gx[-1], 0.25 * p.l0)
+        ticks_h = np.interp(ticks_x, gx, gy)
+        segs = np.stack(
+            [
+                np.column_stack([ticks_x, ticks_h]),
+                np.column_stack([ticks_x - 0.08 * p.l0, ticks_h - 0.08 * p.l0]),
+            ],
+            axis=1,
+        )
+        ax.add_collection(LineCollection(segs, colors="0.45", lw=0.8, zorder=1))
+        # footholds of the run (faint marks)
+        feet = [(e.foot_x, e.foot_y) for e in traj.events if e.kind == "touchdown"]
+        if feet:
+            fx, fy = np.array(feet).T
+            ax.plot(fx, fy, ls="none", marker="|", ms=8, color="0.5", zorder=1)
+        (self.trail,) = ax.plot([], [], color="C0", lw=1, alpha=0.6, zorder=2)
+        (self.leg,) = ax.plot([], [], color="0.15", lw=1.6, solid_joinstyle="miter", zorder=5)
+        self.trunk_len = trunk_len = abs(p.r) + 0.5 * p.l0
+        self.body = Ellipse(
+            (0, 0), trunk_len, 0.26 * p.l0, angle=90.0, fc="#9ecae1", ec="#08519c", lw=1.5, zorder=3
+        )
+        ax.add_patch(self.body)
+        (self.axis,) = ax.plot([], [], color="#08519c", lw=1.2, zorder=4)
+        self.hip = Circle((0, 0), 0.035 * p.l0, fc="white", ec="k", lw=1.2, zorder=6)
+        ax.add_patch(self.hip)
+        self.com = Circle((0, 0), 0.045 * p.l0, fc="k", ec="k", lw=1.0, zorder=6)
+        ax.add_patch(self.com)
+        self.foot = Circle((0, 0), 0.03 * p.l0, fc="C3", ec="k", lw=1.0, zorder=6)
+        ax.add_patch(self.foot)
+        self.grf = FancyArrowPatch(
+            (0, 0),
+            (0, 1),
+            arrowstyle="-|>",
+            mutation_scale=12,
+            color="#e34a33",
+            alpha=0.6,
+            lw=3.0,
+            zorder=7,
+        )
+        ax.add_patch(self.grf)
+        self.force_scale = 0.15 * p.l0  # L per Mg
+        self.text = ax.text(
+            0.015,
+            0.97,
+            "",
+            transform=ax.transAxes,
+            va="top",
+            ha="left",
+            family="monospace",
+            fontsize=9,
+            zorder=8,
+        )
+
+    def update(self, row: np.ndarray, trail: np.ndarray, step_no: int) -> None:
+        c = _COL
+        x, y, phi = row[c["x"]], row[c["y"]], row[c["phi"]]
+        hip = np.array([row[c["hip_x"]], row[c["hip_y"]]])
+        foot = np.array([row[c["foot_x"]], row[c["foot_y"]]])
+        stance = row[c["stance"]] > 0.5
+        self.ax.set_xlim(x - 0.4 * self.view_w, x + 0.6 * self.view_w)
+        ground = float(np.interp(x, self.gx, self.gy))
+        self.ax.set_ylim(ground - 0.12 * self.view_h, ground + 0.88 * self.view_h)
+        self.trail.set_data(trail[:, 0], trail[:, 1])
+        spring = _spring(hip, foot, self.l0)
+        self.leg.set_data(spring[:, 0], spring[:, 1])
+        # trunk: an ellipse along the axis through hip and CoM,
+        # hip = CoM + r (-sin phi, cos phi) (CONVENTIONS.md)
+        up = np.array([-math.sin(phi), math.cos(phi)])
+        centre = 0.5 * (hip + np.array([x, y]))
+        self.body.set_center(tuple(centre))
+        self.body.set_angle(math.degrees(phi) + 90.0)
+        a, b = centre - 0.5 * self.trunk_len * up, centre + 0.5 * self.trunk_len * up
+        self.axis.set_data([a[0], b[0]], [a[1], b[1]])
+        self.hip.set_center(tuple(hip))
+        self.com.set_center((x, y))
+        self.foot.set_center(tuple(foot))
+        self.foot.set_facecolor("C3" if stance else "white")
+        fx, fy = row[c["Fx"]], row[c["Fy"]]
+        if stance and math.hypot(fx, fy) > 1e-3:
+            self.grf.set_positions(tuple(foot), tuple(foot + self.force_scale * np.array([fx, fy])))
+            self.grf.set_visible(True)
+        else:
+            self.grf.set_visible(False)
+        self.text.set_text(
+            f"t = {row[c['t']]:6.3f}  step {step_no:3d}  {'stance' if stance else 'flight'}"
+        )
+
+    def render(self) -> np.ndarray:
+        self.canvas.draw()
+        return np.asarray(self.canvas.buffer_rgba())[..., :3].copy()
+
+
+def render_frames(
+    traj: Trajectory,
+    t_frames: np.ndarray,
+    *,
+    size: tuple[int, int] = (640, 360),
+    dpi: float = 100.0,
+    terrain: Terrain | None = None,
+    view_width: float | None = None,
+    trail_time: float = 3.0,
+) -> Iterator[np.ndarray]:
+    """Yield RGB frames, ``uint8`` arrays of shape ``(height, width, 3)``.
+
+    Parameters
+    ----------
+    traj : Trajectory
+    t_frames : ndarray
+        Model times [g^-1/2 L^1/2] of the frames (see :func:`frame_times`).
+    size : (int, int)
+        Frame width and height in pixels.
+    dpi : float
+        Resolution; the figure is ``size / dpi`` inches, so a larger ``dpi``
+        draws thicker lines and larger text in the same frame.
+    terrain : Terrain, optional
+        Ground to draw; rebuilt from the touch-downs by default.
+    view_width : float, optional
+        Width of the camera view [L], default ``4 l0``.
+    trail_time : float
+        Length of the CoM trail [g^-1/2 L^1/2].
+    """
+    width, height = (int(v) for v in size)
+    if width < 16 or height < 16:
+        raise ValueError(f"size must be at least 16 x 16 pixels, got {size!r}")
+    if not (math.isfinite(dpi) and dpi > 0):
+        raise ValueError(f"dpi must be a finite number > 0, got {dpi!r}")
+    scene = _Scene(traj, width, height, dpi, terrain, view_width)
+    rows = _sample(traj.data, np.asarray(t_frames, dtype=float))
+    t = traj["t"]
+    com = traj.data[:, [_COL["x"], _COL["y"]]]
+    step_col = traj["step"]
+    for tf, row in zip(t_frames, rows, strict=True):
+        k = int(np.searchsorted(t, tf, side="right"))
+        k0 = int(np.searchsorted(t, tf - trail_time, side="left"))
+        trail = np.vstack([com[k0:k], row[[_COL["x"], _COL["y"]]]])
+        scene.update(row, trail, int(step_col[max(k - 1, 0)]))
+        frame = scene.render()
+        if frame.shape[:2] != (height, width):  # dpi rounding: pad/crop to size
+            out = np.full((height, width, 3), 255, dtype=np.uint8)
+            h, w = min(height, frame.shape[0]), min(width, frame.shape[1])
+            out[:h, :w] = frame[:h, :w]
+            frame = out
+        yield frame
+
+
+def animate(
+    traj: Trajectory,
+    path: str | os.PathLike[str],
+    fps: float = 30.0,
+    speed: float = 0.25,
+    dpi: float = 100.0,
+    *,
+    size: tuple[int, int] = (640, 360),
+    time_unit: float = TIME_UNIT_1M,
+    terrain: Terrain | None = None,
+    view_width: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Path:
+    """Write an animation of the runner to ``.gif`` or ``.mp4``.
+
+    The trunk is drawn as an ellipse along the hip-CoM axis with the hip
+    (white) and CoM (black) marked, the leg as a zig-zag spring from the hip
+    to the foot (at rest length ``l0`` in flight), the ground reaction force
+    as a red arrow at the foot in stance (0.15 l0 per Mg), and the CoM trail.
+    The camera follows the CoM. GIFs are written with Pillow (each frame
+    quantised to 64 colours, which is about five times faster than letting
+    the encoder choose), MP4s with imageio-ffmpeg (libx264, yuv420p).
+
+    Parameters
+    ----------
+    traj : Trajectory
+    path : str or PathLike
+        Output file, ending in ``.gif`` or ``.mp4``; written atomically.
+    fps : float
+        Frames per second. GIF frame delays are whole hundredths of a
+        second, so for ``.gif`` the rate is rounded to ``100 / round(100 / fps)``.
+    speed : float
+        Playback speed relative to real time (0.25: four times slower).
+    dpi : float
+        Figure resolution (scales lines and text; the frame stays ``size``).
+    size : (int, int)
+        Frame width and height in pixels (``.mp4`` needs multiples of 8).
+    time_unit : float
+        Seconds per model time unit g^-1/2 L^1/2 (default: 1 m leg, 9.81 m/s^2).
+    terrain : Terrain, optional
+        Ground to draw; rebuilt from the touch-downs by default.
+    view_width : float, optional
+        Width of the camera view [L], default ``4 l0``.
+    progress : callable, optional
+        Called as ``progress(done, total)`` after each frame.
+
+    Returns
+    -------
+    Path
+        The written file.
+
+    Raises
+    ------
+    ValueError
+        For a bad suffix, a non-positive ``fps``/``speed``/``dpi``, or an
+        empty trajectory.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in _SUFFIXES:
+        raise ValueError(f"animation file must end in .gif or .mp4, got {str(path)!r}")
+    if not (math.isfinite(fps) and fps > 0):
+        raise ValueError(f"fps must be a finite number > 0, got {fps!r}")
+    if suffix == ".gif":
+        delay_cs = max(2, round(100.0 / fps))  # browsers treat < 2 cs as 10 cs
+        fps = 100.0 / delay_cs
+    elif size[0] % 8 or size[1] % 8:
+        raise ValueError(f"size must be multiples of 8 pixels for .mp4, got {size!r}")
+    t_frames = frame_times(traj, fps, speed, time_unit)
+    frames = render_frames(
+        traj, t_frames, size=size, dpi=dpi, terrain=terrain, view_width=view_width
+    )
+    total = len(t_frames)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=suffix)
+    os.close(fd)
+    os.unlink(tmp)  # the writers create the file themselves
+    try:
+        if suffix == ".gif":
+            _write_gif(tmp, frames, 10 * delay_cs, total, progress)
+        else:
+            _write_mp4(tmp, frames, fps, total, progress)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def _write_gif(
+    path: str,
+    frames: Iterable[np.ndarray],
+    duration_ms: int,
+    total: int,
+    progress: Callable[[int, int], None] | None,
+) -> None:
+    from PIL import Image
+
+    def quantised() -> Iterator[Image.Image]:
+        for i, frame in enumerate(frames):
+            yield Image.fromarray(frame).quantize(
+                colors=64, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE
+            )
+            if progress is not None:
+                progress(i + 1, total)
+
+    images = quantised()
+    first = next(images)
+    first.save(
+        path,
+        format="GIF",
+        save_all=True,
+        append_images=images,
+        duration=duration_ms,
+        loop=0,
+        disposal=1,
+    )
+
+
+def _write_mp4(
+    path: str,
+    frames: Iterable[np.ndarray],
+    fps: float,
+    total: int,
+    progress: Callable[[int, int], None] | None,
+) -> None:
+    import imageio.v2 as iio2
+
+    writer = iio2.get_writer(
+        path,
+        format="FFMPEG",
+        mode="I",
+        fps=fps,
+        codec="libx264",
+        macro_block_size=8,
+        pixelformat="yuv420p",
+        ffmpeg_log_level="error",
+    )
+    try:
+        for i, frame in enumerate(frames):
+            writer.append_data(frame)
+            if progress is not None:
+                progress(i + 1, total)
+    finally:
+        writer.close()
