@@ -13,7 +13,7 @@ from .state import TouchdownState
 
 # -- parameter vector P ------------------------------------------------------
 P_M, P_J, P_R, P_K, P_L0, P_G, P_CL, P_OMEGA, P_ALPHA, P_GLOBAL, P_CTRL = range(11)
-P_C0 = 11  # four controller numbers follow (controller.packed())
+P_C0 = 11  # tau = P[P_C0] + P[P_C0+1] phi + P[P_C0+2] betad + P[P_C0+3] phid
 NP = 15
 
 # -- integrator options O ----------------------------------------------------
@@ -66,7 +66,7 @@ def pack_params(p: Params) -> np.ndarray:
     out[P_CL], out[P_OMEGA], out[P_ALPHA] = p.c_l, p.omega_r, p.alpha_r
     out[P_GLOBAL] = 1.0 if p.leg_reset == "global" else 0.0
     out[P_CTRL] = p.controller.code
-    out[P_C0 : P_C0 + 4] = p.controller.packed()
+    out[P_C0 : P_C0 + 4] = p.controller.torque_coefficients()
     return out
 
 

@@ -74,10 +74,13 @@ class Controller:
     def __post_init__(self) -> None:
         check_finite_fields(self, prefix=f"{type(self).__name__}.")
 
-    def packed(self) -> tuple[float, float, float, float]:
-        """The controller's numbers in kernel order, padded to four."""
-        vals = [float(getattr(self, f.name)) for f in fields(self)]
-        return tuple(vals + [0.0] * (4 - len(vals)))  # type: ignore[return-value]
+    def torque_coefficients(self) -> tuple[float, float, float, float]:
+        """``(a0, a1, a2, a3)`` of ``tau = a0 + a1 phi + a2 betad + a3 phid``.
+
+        Every controller of eqs 2.12-2.16 is linear in the state, so the
+        kernels (and the exact Jacobians) need only these four numbers.
+        """
+        raise NotImplementedError
 
     def to_dict(self) -> dict[str, Any]:
         """``{"type": name, **fields}``: the TOML / JSON form."""
@@ -90,6 +93,9 @@ class Passive(Controller):
 
     code: ClassVar[int] = 0
     name: ClassVar[str] = "passive"
+
+    def torque_coefficients(self) -> tuple[float, float, float, float]:
+        return (0.0, 0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True, slots=True)
@@ -107,6 +113,9 @@ class GlobalPD(Controller):
         default=0.0, metadata=_meta("phidot_r", "rad g^1/2 L^-1/2", "reference pitch rate")
     )
 
+    def torque_coefficients(self) -> tuple[float, float, float, float]:
+        return (self.Kp * self.phi_ref + self.Kd * self.phid_ref, -self.Kp, 0.0, -self.Kd)
+
 
 @dataclass(frozen=True, slots=True)
 class LocalVelocity(Controller):
@@ -121,6 +130,9 @@ class LocalVelocity(Controller):
         default=0.0, metadata=_meta("alphadot_r", "rad g^1/2 L^-1/2", "reference hip rate")
     )
 
+    def torque_coefficients(self) -> tuple[float, float, float, float]:
+        return (self.Kd * self.alphad_ref, 0.0, -self.Kd, -self.Kd)
+
 
 @dataclass(frozen=True, slots=True)
 class ConstantTorque(Controller):
@@ -130,6 +142,9 @@ class ConstantTorque(Controller):
     name: ClassVar[str] = "constant_torque"
     tau_c: float = field(default=0.0, metadata=_meta("tau_c", "MgL", "constant hip torque"))
     c_h: float = field(default=0.0, metadata=_meta("c_h", _ROT_DAMP, "hip damping", 0.0))
+
+    def torque_coefficients(self) -> tuple[float, float, float, float]:
+        return (self.tau_c, 0.0, -self.c_h, -self.c_h)
 
 
 CONTROLLERS: dict[str, type[Controller]] = {

@@ -40,7 +40,6 @@ from ..model._pack import (
     P_ALPHA,
     P_C0,
     P_CL,
-    P_CTRL,
     P_G,
     P_GLOBAL,
     P_J,
@@ -70,16 +69,12 @@ _JIT = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
 
 @njit(**_JIT)
 def hip_torque(P, phi, betad, phid):
-    """Hip torque of the stance controller (eqs 2.12-2.16)."""
-    code = int(P[P_CTRL])
-    if code == 0:
-        return 0.0
-    if code == 1:  # global PD: Kp, Kd, phi_ref, phid_ref
-        return P[P_C0] * (P[P_C0 + 2] - phi) + P[P_C0 + 1] * (P[P_C0 + 3] - phid)
-    if code == 2:  # local velocity: Kd, alphad_ref
-        return P[P_C0] * (P[P_C0 + 1] - (betad + phid))
-    # constant torque with hip damping: tau_c, c_h
-    return P[P_C0] - P[P_C0 + 1] * (betad + phid)
+    """Hip torque of the stance controller (eqs 2.12-2.16), linear in the state.
+
+    ``tau = a0 + a1 phi + a2 betad + a3 phid`` with the coefficients from
+    ``Controller.torque_coefficients``.
+    """
+    return P[P_C0] + P[P_C0 + 1] * phi + P[P_C0 + 2] * betad + P[P_C0 + 3] * phid
 
 
 @njit(**_JIT)
