@@ -9,6 +9,7 @@ from .integrate import (
     simulate,
     step,
     step_batch,
+    step_jacobian,
     step_map,
 )
 from .options import IntegratorOptions
@@ -16,6 +17,6 @@ from .result import Event, IntegrationError, LiftoffState, Status, StepResult, T
 
 __all__ = [
     "BatchRun", "BatchStep", "Disturbance", "MapResult", "run_batch", "simulate", "step",
-    "step_batch", "step_map", "IntegratorOptions", "Event", "IntegrationError",
-    "LiftoffState", "Status", "StepResult", "Trajectory",
+    "step_batch", "step_jacobian", "step_map", "IntegratorOptions", "Event",
+    "IntegrationError", "LiftoffState", "Status", "StepResult", "Trajectory",
 ]

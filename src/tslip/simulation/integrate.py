@@ -34,6 +34,7 @@ __all__ = [
     "Disturbance",
     "step",
     "step_map",
+    "step_jacobian",
     "simulate",
     "step_batch",
     "run_batch",
@@ -213,6 +214,36 @@ def step_map(
         out[pk.OUT_TD : pk.OUT_TD + 5].copy(), float(out[pk.OUT_TS]), float(out[pk.OUT_TF]),
         status,
     )
+
+
+def step_jacobian(
+    params: Params,
+    q: Sequence[float] | np.ndarray,
+    *,
+    h: float = 0.0,
+    options: IntegratorOptions | None = None,
+) -> tuple[MapResult, np.ndarray]:
+    """The Poincare map and its exact Jacobian ``dq'/dq`` (5 x 5).
+
+    The stance sensitivity is the variational equation integrated by the same
+    Dormand-Prince steps (internal differentiation), corrected at lift-off by
+    the saltation (event-time) term; the closed-form flight is differentiated
+    analytically, including the touch-down time. See
+    :mod:`tslip.simulation._variational`. The Jacobian is NaN after a fall.
+    """
+    from . import _variational as va
+
+    P = pk.pack_params(params)
+    td = np.zeros(pk.NTD)
+    td[:5] = q
+    td[6] = h
+    out = np.empty(pk.NOUT)
+    J = np.empty((5, 5))
+    tx, th = _FLAT.arrays()
+    status = Status(int(va.stride_jacobian(P, _options(options), td, tx, th + h, J, out)))
+    res = MapResult(out[pk.OUT_TD : pk.OUT_TD + 5].copy(), float(out[pk.OUT_TS]),
+                    float(out[pk.OUT_TF]), status)
+    return res, J
 
 
 def simulate(

@@ -1,0 +1,284 @@
+"""Compiled kernels for the exact Jacobian of the touch-down map.
+
+The stride map ``q -> q'`` on the section ``q = (beta, phi, xd, yd, phid)`` is a
+chain; each link is differentiated exactly:
+
+1. touch-down state -> stance state ``y0`` (eq. A.5 inverted), analytic;
+2. the stance flow, by *internal numerical differentiation*: the same
+   Dormand-Prince step sequence is replayed with each stage's sensitivity
+   ``dK_i = Df(Y_i) dY_i``, which is the variational equation integrated by the
+   same Runge-Kutta scheme (so it is the derivative of the computed map);
+3. the lift-off event ``F_y = 0`` by the saltation (event-time) correction
+   ``dy_LO = Phi - f (grad F_y . Phi) / (grad F_y . f)``;
+4. lift-off -> CoM flight state, analytic;
+5. the closed-form flight, with the touch-down time's implicit derivative
+   ``dt_TD = -(df/dlo) / (df/dt)`` for the foot height ``f``.
+
+``Df`` comes from differentiating ``M qdd = R`` (eq. 2.3, ``R = Q - C``):
+``d qdd = M^-1 (dR - dM qdd)``, with the closed-form ``M^-1`` of
+:func:`._kernels.stance_accel`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..model._pack import (
+    NREC,
+    OUT_LO,
+    OUT_TF,
+    P_C0,
+    P_CL,
+    P_G,
+    P_GLOBAL,
+    P_J,
+    P_K,
+    P_L0,
+    P_M,
+    P_R,
+    ST_OK,
+)
+from ._kernels import (
+    _JIT,
+    NSTATE,
+    flight_leg_angle,
+    hip_torque,
+    rhs,
+    stance_accel,
+    stance_initial,
+    stride,
+)
+
+# Dormand-Prince 5(4) tableau as arrays (same numbers as _kernels)
+_A = np.zeros((7, 7))
+_A[1, 0] = 1.0 / 5.0
+_A[2, :2] = (3.0 / 40.0, 9.0 / 40.0)
+_A[3, :3] = (44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0)
+_A[4, :4] = (19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0)
+_A[5, :5] = (9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0)
+_B = np.array([35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0])
+
+
+@njit(**_JIT)
+def _solve_m(P, l, sa, ca, v1, v2, v3):
+    """``M^-1 v`` in closed form (Schur complement on the phi row is ``J``)."""
+    r = P[P_R]
+    x3 = (v3 + r * ca * v1 - r * sa * v2 / l) / P[P_J]
+    return v1 / P[P_M] + r * ca * x3, v2 / (P[P_M] * l * l) - r * sa / l * x3, x3
+
+
+@njit(**_JIT)
+def rhs_jacobian(P, y, Jf):
+    """Jacobian ``Df`` (6 x 6) of the stance right-hand side at ``y``."""
+    m = P[P_M]
+    r = P[P_R]
+    g = P[P_G]
+    k = P[P_K]
+    cl = P[P_CL]
+    a1, a2, a3 = P[P_C0 + 1], P[P_C0 + 2], P[P_C0 + 3]
+    l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
+    sb, cb = math.sin(b), math.cos(b)
+    sp, cp = math.sin(ph), math.cos(ph)
+    sa = sb * cp + cb * sp
+    ca = cb * cp - sb * sp
+    ldd, bdd, phdd, _, _ = stance_accel(P, y)
+    for i in range(6):
+        for j in range(6):
+            Jf[i, j] = 0.0
+    Jf[0, 3] = 1.0
+    Jf[1, 4] = 1.0
+    Jf[2, 5] = 1.0
+    # dR/dy_j - dM/dy_j qdd, column by column (R = Q - C of eqs A.11, A.13)
+    # d/dl: dM22 = 2 m l, dM23 = m r sa
+    c1 = -k + m * bd * bd
+    c2 = -m * g * cb - m * r * phd * phd * ca - 2.0 * m * bd * ld - (2.0 * m * l * bdd
+                                                                       + m * r * sa * phdd)
+    c3 = -m * r * bd * bd * ca - m * r * sa * bdd
+    Jf[3, 0], Jf[4, 0], Jf[5, 0] = _solve_m(P, l, sa, ca, c1, c2, c3)
+    # d/dbeta and d/dphi share dM: dM13 = m r sa, dM23 = m r l ca
+    dm1 = m * r * sa * phdd
+    dm2 = m * r * l * ca * phdd
+    dm3 = m * r * sa * ldd + m * r * l * ca * bdd
+    c1 = -m * g * cb - m * r * phd * phd * ca - dm1
+    c2 = m * g * l * sb + m * r * l * phd * phd * sa - dm2
+    c3 = m * r * l * bd * bd * sa - 2.0 * m * r * bd * ld * ca - dm3
+    Jf[3, 1], Jf[4, 1], Jf[5, 1] = _solve_m(P, l, sa, ca, c1, c2, c3)
+    c1 = -m * r * phd * phd * ca - dm1
+    c2 = a1 + m * r * l * phd * phd * sa - dm2
+    c3 = a1 - m * g * r * cp + m * r * l * bd * bd * sa - 2.0 * m * r * bd * ld * ca - dm3
+    Jf[3, 2], Jf[4, 2], Jf[5, 2] = _solve_m(P, l, sa, ca, c1, c2, c3)
+    # velocities: M does not depend on them
+    Jf[3, 3], Jf[4, 3], Jf[5, 3] = _solve_m(P, l, sa, ca, -cl, -2.0 * m * l * bd,
+                                            -2.0 * m * r * bd * sa)
+    Jf[3, 4], Jf[4, 4], Jf[5, 4] = _solve_m(
+        P, l, sa, ca, 2.0 * m * l * bd, a2 - 2.0 * m * l * ld,
+        a2 - 2.0 * m * r * l * bd * ca - 2.0 * m * r * ld * sa)
+    Jf[3, 5], Jf[4, 5], Jf[5, 5] = _solve_m(
+        P, l, sa, ca, -2.0 * m * r * phd * sa, a3 - 2.0 * m * r * l * phd * ca, a3)
+
+
+@njit(**_JIT)
+def fy_gradient(P, y, gr):
+    """Gradient of ``F_y`` (eq. 2.6) with respect to the stance state."""
+    l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
+    sb, cb = math.sin(b), math.cos(b)
+    tau = hip_torque(P, ph, bd, phd)
+    fl = P[P_K] * (P[P_L0] - l) - P[P_CL] * ld
+    gr[0] = -P[P_K] * sb - tau * cb / (l * l)
+    gr[1] = fl * cb - tau / l * sb
+    gr[2] = P[P_C0 + 1] * cb / l
+    gr[3] = -P[P_CL] * sb
+    gr[4] = P[P_C0 + 2] * cb / l
+    gr[5] = P[P_C0 + 3] * cb / l
+
+
+@njit(**_JIT)
+def _sens_step(P, y, h, Phi, Ys, K, dK, Jf, tmp):
+    """One Dormand-Prince step of ``y`` and its sensitivity ``Phi`` (in place)."""
+    n = NSTATE
+    for s in range(6):
+        # stage state and its sensitivity
+        for i in range(n):
+            acc = y[i]
+            for j in range(s):
+                acc += h * _A[s, j] * K[j, i]
+            Ys[i] = acc
+        rhs(P, Ys, K[s])
+        rhs_jacobian(P, Ys, Jf)
+        for i in range(n):
+            for c in range(n):
+                acc = Phi[i, c]
+                for j in range(s):
+                    acc += h * _A[s, j] * dK[j, i, c]
+                tmp[i, c] = acc
+        for i in range(n):
+            for c in range(n):
+                acc = 0.0
+                for q in range(n):
+                    acc += Jf[i, q] * tmp[q, c]
+                dK[s, i, c] = acc
+    for i in range(n):
+        acc = y[i]
+        for s in range(6):
+            acc += h * _B[s] * K[s, i]
+        y[i] = acc
+        for c in range(n):
+            acc = Phi[i, c]
+            for s in range(6):
+                acc += h * _B[s] * dK[s, i, c]
+            Phi[i, c] = acc
+
+
+@njit(**_JIT)
+def stride_jacobian(P, O, td, tx, th, Jq, out):
+    """Next touch-down state and its exact Jacobian ``Jq = dq'/dq`` (5 x 5).
+
+    Returns the stride status; ``out`` is filled as by :func:`._kernels.stride`.
+    """
+    rec = np.empty((4096, NREC))
+    status = stride(P, O, td, tx, th, rec, 0.0, out)
+    if status != ST_OK or out[26] != 0.0:  # OUT_RECOVF
+        for i in range(5):
+            for j in range(5):
+                Jq[i, j] = math.nan
+        return status
+    nrec = int(out[25])  # OUT_NREC
+    l0 = P[P_L0]
+    r = P[P_R]
+    g = P[P_G]
+    # 1. dy0/dq (6 x 5), q = (beta, phi, xd, yd, phid)
+    y = np.empty(NSTATE)
+    stance_initial(P, td, y)
+    b, ph, xd, yd, phd = td[0], td[1], td[2], td[3], td[4]
+    sb, cb = math.sin(b), math.cos(b)
+    sp, cp = math.sin(ph), math.cos(ph)
+    u = xd - r * cp * phd
+    w = yd - r * sp * phd
+    du = np.array([0.0, r * sp * phd, 1.0, 0.0, -r * cp])
+    dw = np.array([0.0, -r * cp * phd, 0.0, 1.0, -r * sp])
+    D0 = np.zeros((NSTATE, 5))
+    D0[1, 0] = 1.0
+    D0[2, 1] = 1.0
+    D0[5, 4] = 1.0
+    for j in range(5):
+        D0[3, j] = -cb * du[j] + sb * dw[j]
+        D0[4, j] = (sb * du[j] + cb * dw[j]) / l0
+    D0[3, 0] += u * sb + w * cb
+    D0[4, 0] += (u * cb - w * sb) / l0
+    # 2. replay the accepted steps with sensitivities
+    Phi = np.eye(NSTATE)
+    Ys = np.empty(NSTATE)
+    K = np.empty((7, NSTATE))
+    dK = np.empty((6, NSTATE, NSTATE))
+    Jf = np.empty((NSTATE, NSTATE))
+    tmp = np.empty((NSTATE, NSTATE))
+    for k in range(1, nrec):
+        h = rec[k, 0] - rec[k - 1, 0]
+        if h > 0.0:
+            _sens_step(P, y, h, Phi, Ys, K, dK, Jf, tmp)
+    # 3. saltation at lift-off: dt_LO = -(grad Fy . Phi) / (grad Fy . f)
+    f = np.empty(NSTATE)
+    rhs(P, y, f)
+    gr = np.empty(NSTATE)
+    fy_gradient(P, y, gr)
+    gf = 0.0
+    for i in range(NSTATE):
+        gf += gr[i] * f[i]
+    S = Phi @ D0  # dy_LO/dq before the event correction
+    dtlo = np.zeros(5)
+    for j in range(5):
+        acc = 0.0
+        for i in range(NSTATE):
+            acc += gr[i] * S[i, j]
+        dtlo[j] = -acc / gf
+    for i in range(NSTATE):
+        for j in range(5):
+            S[i, j] += f[i] * dtlo[j]
+    # 4. lift-off CoM state lo = (y_m, xd, yd, phi, phid) and its Jacobian (5 x 6)
+    l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
+    sb, cb = math.sin(b), math.cos(b)
+    sp, cp = math.sin(ph), math.cos(ph)
+    L = np.zeros((5, NSTATE))
+    L[0, 0], L[0, 1], L[0, 2] = sb, l * cb, r * sp
+    L[1, 0], L[1, 1], L[1, 2] = sb * bd, ld * sb + l * cb * bd, -r * sp * phd
+    L[1, 3], L[1, 4], L[1, 5] = -cb, l * sb, r * cp
+    L[2, 0], L[2, 1], L[2, 2] = cb * bd, ld * cb - l * sb * bd, r * cp * phd
+    L[2, 3], L[2, 4], L[2, 5] = sb, l * cb, r * sp
+    L[3, 2] = 1.0
+    L[4, 5] = 1.0
+    G = L @ S  # d lo / dq
+    # 5. flight: foot height f(t) = y + yd t - g t^2/2 + r cos(phi(t)) - l0 sin(beta(t)) - H
+    tf = out[OUT_TF]
+    phi0 = out[OUT_LO + 4]
+    phid0 = out[OUT_LO + 5]
+    yd0 = out[OUT_LO + 3]
+    bt, bdot = flight_leg_angle(P, phi0, phid0, tf)
+    pht = phi0 + phid0 * tf
+    local = P[P_GLOBAL] == 0.0
+    dbdphi = -1.0 if local else 0.0
+    dbdphid = -tf if local else 0.0
+    spt, cbt = math.sin(pht), math.cos(bt)
+    # partials of f with respect to lo = (y, xd, yd, phi, phid) and t
+    df = np.array([1.0, 0.0, tf, -r * spt - l0 * cbt * dbdphi,
+                   -r * spt * tf - l0 * cbt * dbdphid])
+    dfdt = yd0 - g * tf - r * spt * phid0 - l0 * cbt * bdot
+    dttd = np.zeros(5)
+    for j in range(5):
+        acc = 0.0
+        for i in range(5):
+            acc += df[i] * G[i, j]
+        dttd[j] = -acc / dfdt
+    # q' = (beta(t), phi(t), xd, yd - g t, phid)
+    for j in range(5):
+        Jq[0, j] = dbdphi * G[3, j] + dbdphid * G[4, j] + bdot * dttd[j]
+        Jq[1, j] = G[3, j] + tf * G[4, j] + phid0 * dttd[j]
+        Jq[2, j] = G[1, j]
+        Jq[3, j] = G[2, j] - g * dttd[j]
+        Jq[4, j] = G[4, j]
+    return status
+
+
+
