@@ -112,3 +112,14 @@ def test_fy_negative_at_touchdown_is_flagged():
     assert r.fy_negative_at_touchdown
     assert r.stance_time > 0.01
     assert np.any(r.grf[:, 2] > 0)
+
+
+def test_hip_reaching_ground_in_flight_is_a_fall_not_a_timeout():
+    """The safe steps approach the hip's contact from above; it must still end the
+    flight as a fall (it once ran into the iteration limit as FLIGHT_TIMEOUT)."""
+    g = tslip.find_gait(tslip.preset("table6.1"))
+    s = g.state
+    xf = s.x + g.params.l0 * math.cos(s.beta) - g.params.r * math.sin(s.phi)
+    tr = tslip.simulate(g.params, s, 25, terrain=tslip.Terrain.step(xf, -0.13))
+    assert tr.status == Status.FALL_NO_TOUCHDOWN
+    assert tr.steps[-1].flight_time < 10.0

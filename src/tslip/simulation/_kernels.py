@@ -600,7 +600,7 @@ def find_touchdown(P, O, lo, tx, th, res):
             return ST_ERR_FLIGHT_TIMEOUT
         H = th[k]
         hh = hip_y - H
-        if hh <= 0.0:
+        if hh <= tol:  # the safe steps approach the hip's contact without crossing it
             res[0] = t
             res[1] = H
             return ST_FALL_NO_TOUCHDOWN

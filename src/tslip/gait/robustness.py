@@ -1,0 +1,567 @@
+"""Robustness to large disturbances: the largest survivable disturbance (Section 3.1.3).
+
+Robustness is "the largest disturbance from the periodic limit cycle which
+does not result in a fall within 25 steps", found by a search over three
+disturbances (thesis Section 3.1.3; where and with which sign each is applied
+follows CONVENTIONS.md, "Disturbances for robustness"):
+
+``"step_down"`` (``dh`` [L])
+    The first stance starts on the original ground; every later touch-down is
+    on ground shifted by ``dh`` (a terrain step at the first stance's foot,
+    ``x_f = x + l0 cos(beta) - r sin(phi)``, eq. A.3).
+``"push"`` (``dxd`` [g^1/2 L^1/2])
+    Added to the CoM horizontal velocity of the touch-down state that starts
+    stride 0, keeping ``yd`` and the pitch rate; the leg rates follow from the
+    kinematics (eq. A.5).
+``"pitch_rate"`` (``dphid`` [rad g^1/2 L^-1/2])
+    Added to the pitch rate of the same state, keeping the CoM velocity.
+
+Signs follow the thesis: with ``sign=-1`` (default) the limits are negative
+(down, backward, negative pitch rate); ``sign=+1`` searches the opposite
+direction (step up, forward push, positive pitch rate).
+
+The search (:func:`limit_search`) is pure: it sees only a predicate
+``survives(magnitudes) -> bool array``, so the simulation stays outside the
+algorithm. Survival need not be monotone in the magnitude, so the limit is
+*defined* by the procedure, as in the thesis's binary search:
+
+1. bracketing: a geometric ladder ``start * 2**j`` (doubling) is evaluated in
+   one batch; the first failing rung ``hi`` and the rung below it ``lo``
+   (0 for the first rung: the periodic gait itself) bracket the limit;
+2. k-section: ``k`` equally spaced interior points of ``(lo, hi)`` are
+   evaluated in one batch; the smallest failing one becomes ``hi`` and the
+   point below it ``lo``, so each round shrinks the bracket ``k + 1`` times,
+   until ``hi - lo <= tol``.
+
+The reported limit is ``lo``: a magnitude that survives, within ``tol`` of a
+magnitude ``hi`` that fails. Larger surviving islands beyond the first
+failure are not searched for. Every batch is one :func:`tslip.run_batch`
+call (parallel over rows), which keeps Python round trips few.
+
+Runs that end in an integration error (:class:`Status` >= 10) are not falls;
+they count as failures of the disturbance, and the result records the reason.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from ..model.parameters import Params
+from ..model.state import TouchdownState
+from ..model.terrain import Terrain
+from ..simulation.integrate import BatchRun, run_batch
+from ..simulation.options import IntegratorOptions
+from ..simulation.result import Status
+from .fixed_point import Gait
+
+__all__ = [
+    "KINDS",
+    "LimitSearch",
+    "RobustnessLimit",
+    "RobustnessResult",
+    "check_gait",
+    "limit_search",
+    "robustness",
+    "robustness_report",
+    "run_disturbed",
+]
+
+Kind = Literal["step_down", "push", "pitch_rate"]
+
+#: The three disturbances of thesis Section 3.1.3, in the thesis's order.
+KINDS: tuple[Kind, ...] = ("step_down", "push", "pitch_rate")
+
+#: Unit of each disturbance (Table 3.1, dimensionless units).
+UNITS: dict[str, str] = {
+    "step_down": "L",
+    "push": "g^1/2 L^1/2",
+    "pitch_rate": "rad g^1/2 L^-1/2",
+}
+
+_SECTION_COLUMN = {"push": 2, "pitch_rate": 4}  # xd, phid in TouchdownState.as_array()
+
+
+# ---------------------------------------------------------------------------
+# The search: bracketing by doubling, then k-section (pure)
+# ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class LimitSearch:
+    """Outcome of :func:`limit_search` (magnitudes, all >= 0).
+
+    Attributes
+    ----------
+    lo : float
+        Largest magnitude known to survive below the first failure (the
+        limit); 0 if the first rung failed, ``inf`` if nothing failed up to
+        ``max_magnitude``.
+    hi : float
+        Smallest failing magnitude found, ``hi - lo <= tol`` (``inf`` if none).
+    n_calls : int
+        Calls of the predicate (batches).
+    n_evals : int
+        Magnitudes evaluated in all calls.
+    magnitudes, survived : ndarray, shape (n_evals,)
+        Every evaluated magnitude and its outcome, in evaluation order.
+    """
+
+    lo: float
+    hi: float
+    n_calls: int
+    n_evals: int
+    magnitudes: np.ndarray = field(repr=False)
+    survived: np.ndarray = field(repr=False)
+
+    @property
+    def bounded(self) -> bool:
+        """True if a failing magnitude was found."""
+        return math.isfinite(self.hi)
+
+
+def limit_search(
+    survives: Callable[[np.ndarray], np.ndarray],
+    *,
+    start: float = 0.01,
+    tol: float = 1e-4,
+    ladder: int = 8,
+    k: int = 3,
+    max_magnitude: float = 100.0,
+) -> LimitSearch:
+    """Largest surviving magnitude: bracketing by doubling, then k-section.
+
+    Parameters
+    ----------
+    survives : callable
+        ``survives(m)`` with ``m`` an ndarray of magnitudes (> 0) returns a
+        bool array of the same shape: True where the disturbance of that
+        magnitude is survived. Called once per batch.
+    start : float
+        First rung of the doubling ladder (> 0).
+    tol : float
+        Final bracket width ``hi - lo`` (> 0), in the magnitude's unit.
+    ladder : int
+        Rungs ``start * 2**j`` evaluated per bracketing call (>= 1); if all
+        survive, the next call continues the ladder.
+    k : int
+        Interior points per k-section call (>= 1; 1 is bisection). Each call
+        shrinks the bracket ``k + 1`` times.
+    max_magnitude : float
+        Stop bracketing here (the last rung is clipped to it).
+
+    Returns
+    -------
+    LimitSearch
+        ``lo`` survives and ``hi`` fails, with ``hi - lo <= tol``; when
+        survival is not monotone, ``hi`` is the first failure met by the
+        ladder and the k-section inside its bracket (see the module notes).
+
+    Raises
+    ------
+    ValueError
+        For non-positive ``start``/``tol``/``max_magnitude``, ``ladder < 1``,
+        ``k < 1``, or a predicate answer of the wrong shape.
+
+    Examples
+    --------
+    >>> s = limit_search(lambda m: m < 0.3, tol=1e-3)
+    >>> s.lo < 0.3 <= s.hi, s.hi - s.lo <= 1e-3, s.n_calls
+    (True, True, 5)
+    """
+    for name, v in (("start", start), ("tol", tol), ("max_magnitude", max_magnitude)):
+        if not (math.isfinite(v) and v > 0):
+            raise ValueError(f"{name} must be in (0, inf), got {v!r}")
+    if start > max_magnitude:
+        raise ValueError(f"start ({start!r}) must not exceed max_magnitude ({max_magnitude!r})")
+    for name, n in (("ladder", ladder), ("k", k)):
+        if not isinstance(n, (int, np.integer)) or n < 1:
+            raise ValueError(f"{name} must be an integer >= 1, got {n!r}")
+    mags: list[np.ndarray] = []
+    oks: list[np.ndarray] = []
+
+    def ask(m: np.ndarray) -> np.ndarray:
+        ok = np.asarray(survives(m), dtype=bool)
+        if ok.shape != m.shape:
+            raise ValueError(f"survives must return shape {m.shape}, got {ok.shape}")
+        mags.append(m)
+        oks.append(ok)
+        return ok
+
+    lo, hi = 0.0, math.inf
+    first = start
+    while not math.isfinite(hi):  # bracketing: a doubling ladder per call
+        rungs = first * 2.0 ** np.arange(int(ladder))
+        rungs = rungs[rungs < max_magnitude]
+        if len(rungs) < ladder:
+            rungs = np.append(rungs, max_magnitude)
+        ok = ask(rungs)
+        fail = np.flatnonzero(~ok)
+        if fail.size:
+            i = int(fail[0])
+            hi = float(rungs[i])
+            lo = float(rungs[i - 1]) if i > 0 else lo
+        else:
+            lo = float(rungs[-1])
+            if lo >= max_magnitude:
+                return _done(math.inf, math.inf, mags, oks)
+            first = 2.0 * lo
+    while hi - lo > tol:  # k-section: k interior points per call
+        pts = lo + (hi - lo) * np.arange(1, int(k) + 1) / (k + 1)
+        pts = pts[(pts > lo) & (pts < hi)]  # guard against rounding at tiny brackets
+        if pts.size == 0:
+            break
+        ok = ask(pts)
+        fail = np.flatnonzero(~ok)
+        if fail.size:
+            i = int(fail[0])
+            hi = float(pts[i])
+            lo = float(pts[i - 1]) if i > 0 else lo
+        else:
+            lo = float(pts[-1])
+    return _done(lo, hi, mags, oks)
+
+
+def _done(lo: float, hi: float, mags: list[np.ndarray], oks: list[np.ndarray]) -> LimitSearch:
+    m = np.concatenate(mags) if mags else np.empty(0)
+    s = np.concatenate(oks) if oks else np.empty(0, dtype=bool)
+    return LimitSearch(lo=lo, hi=hi, n_calls=len(mags), n_evals=len(m), magnitudes=m, survived=s)
+
+
+# ---------------------------------------------------------------------------
+# Disturbed runs (the simulation side)
+# ---------------------------------------------------------------------------
+
+
+def run_disturbed(
+    params: Params,
+    state: TouchdownState,
+    kind: Kind,
+    values: Sequence[float] | np.ndarray,
+    *,
+    n_steps: int = 25,
+    options: IntegratorOptions | None = None,
+) -> BatchRun:
+    """Run ``n_steps`` strides after each disturbance, in one batch.
+
+    Parameters
+    ----------
+    params : Params
+    state : TouchdownState
+        Touch-down state that starts stride 0 (the gait's).
+    kind : {"step_down", "push", "pitch_rate"}
+    values : array_like, shape (n,)
+        Signed disturbances: ``dh`` [L] (negative: step down), ``dxd``
+        [g^1/2 L^1/2] (negative: backward push) or ``dphid``
+        [rad g^1/2 L^-1/2].
+    n_steps : int
+    options : IntegratorOptions, optional
+
+    Returns
+    -------
+    BatchRun
+        Row ``i`` for ``values[i]``; the same runs as :func:`tslip.simulate`
+        with ``Disturbance(at_step=0, dh=|dxd=|dphid=values[i])``.
+    """
+    _check_kind(kind)
+    d = np.asarray(values, dtype=float).reshape(-1)
+    if not np.all(np.isfinite(d)):
+        raise ValueError("disturbance values must be finite")
+    S = np.tile(state.as_array(), (len(d), 1))
+    terrain: list[Terrain] | None = None
+    if kind == "step_down":
+        xf = state.x + params.l0 * math.cos(state.beta) - params.r * math.sin(state.phi)
+        ground = Terrain.flat(state.h)
+        terrain = [ground.shifted_after(xf, float(v)) for v in d]
+    else:
+        S[:, _SECTION_COLUMN[kind]] += d
+    return run_batch(params, S, n_steps, terrain=terrain, options=options)
+
+
+def _check_kind(kind: str) -> None:
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+
+
+def check_gait(gait: Gait) -> None:
+    """Refuse a gait the thesis would not analyse (Section 3.1.3).
+
+    Raises
+    ------
+    ValueError
+        If the gait is not converged, or is unstable (a Floquet multiplier
+        outside the unit circle): robustness is computed only for at least
+        neutrally stable limit cycles.
+    """
+    from .stability import floquet
+
+    if not gait.converged:
+        raise ValueError(
+            f"robustness needs a periodic gait, but this one is not converged (residual "
+            f"{gait.residual:.2e}: {gait.message}); pass check=False to analyse it anyway"
+        )
+    f = floquet(gait)
+    if not f.stable:
+        raise ValueError(
+            f"robustness is computed only for at least neutrally stable gaits (thesis Section "
+            f"3.1.3), but this one is {f.stability} (largest multiplier {f.max_nontrivial:.4g}); "
+            f"pass check=False to analyse it anyway"
+        )
+
+
+# ---------------------------------------------------------------------------
+# Public API
+# ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class RobustnessLimit:
+    """The robustness limit for one disturbance and direction.
+
+    Attributes
+    ----------
+    kind : {"step_down", "push", "pitch_rate"}
+    sign : {-1, +1}
+        Direction searched (-1: down, backward, negative pitch rate).
+    limit : float
+        Largest surviving disturbance, signed [unit of ``kind``]: ``dh`` [L],
+        ``dxd`` [g^1/2 L^1/2] or ``dphid`` [rad g^1/2 L^-1/2]. ``sign * inf``
+        if nothing failed up to ``max_magnitude``.
+    first_failing : float
+        The failing disturbance that bounds ``limit`` (signed,
+        ``|first_failing - limit| <= tol``); ``sign * inf`` if none.
+    fall_stride : int
+        Stride (0-based) in which the ``first_failing`` run ended; -1 if none.
+    status : Status
+        How it ended: a fall (``status.fell``) or an integration error
+        (``status.is_error``), which is not a fall but counts as a failure.
+    n_batches : int
+        Batched evaluations (:func:`tslip.run_batch` calls).
+    n_runs : int
+        Disturbed runs simulated.
+    n_errors : int
+        Runs of the search that ended in an integration error.
+    """
+
+    kind: str
+    sign: int
+    limit: float
+    first_failing: float
+    fall_stride: int
+    status: Status
+    n_batches: int
+    n_runs: int
+    n_errors: int
+
+    @property
+    def reason(self) -> str:
+        """Why the first failing disturbance failed (one line)."""
+        return self.status.reason
+
+    @property
+    def unit(self) -> str:
+        """Unit of the disturbance."""
+        return UNITS[self.kind]
+
+
+@dataclass(frozen=True, slots=True)
+class RobustnessResult:
+    """Robustness limits of a periodic gait (thesis Section 3.1.3).
+
+    Attributes
+    ----------
+    limits : tuple of RobustnessLimit
+        One per searched kind and sign.
+    params : Params
+    state : TouchdownState
+        The gait's touch-down state the disturbances start from.
+    n_steps : int
+        Strides a disturbed run must survive.
+    tol : float
+        Bracket width of the search.
+    options : IntegratorOptions
+    """
+
+    limits: tuple[RobustnessLimit, ...]
+    params: Params
+    state: TouchdownState
+    n_steps: int
+    tol: float
+    options: IntegratorOptions
+
+    def get(self, kind: str, sign: int = -1) -> RobustnessLimit:
+        """Return the :class:`RobustnessLimit` for ``kind`` and ``sign``."""
+        for lim in self.limits:
+            if lim.kind == kind and lim.sign == sign:
+                return lim
+        raise KeyError(f"no limit for kind={kind!r}, sign={sign!r} in this result")
+
+    @property
+    def step_down(self) -> float:
+        """Maximum step-down ``dh`` [L] (negative)."""
+        return self.get("step_down").limit
+
+    @property
+    def push(self) -> float:
+        """Maximum backward push ``dxd`` [g^1/2 L^1/2] (negative)."""
+        return self.get("push").limit
+
+    @property
+    def pitch_rate(self) -> float:
+        """Maximum negative pitch-rate disturbance ``dphid`` [rad g^1/2 L^-1/2]."""
+        return self.get("pitch_rate").limit
+
+    @property
+    def n_batches(self) -> int:
+        """Batched evaluations over all searches."""
+        return sum(lim.n_batches for lim in self.limits)
+
+
+def robustness(
+    gait: Gait,
+    kind: Kind,
+    *,
+    n_steps: int = 25,
+    sign: int = -1,
+    tol: float = 1e-4,
+    options: IntegratorOptions | None = None,
+    check: bool = True,
+    start: float = 0.01,
+    ladder: int = 8,
+    k: int = 3,
+    max_magnitude: float = 100.0,
+) -> float:
+    """Largest disturbance of one kind the gait survives for ``n_steps`` strides.
+
+    Parameters
+    ----------
+    gait : Gait
+        A converged, at least neutrally stable periodic gait
+        (:func:`tslip.find_gait`).
+    kind : {"step_down", "push", "pitch_rate"}
+        Ground step ``dh`` [L], horizontal push ``dxd`` [g^1/2 L^1/2] or
+        pitch-rate change ``dphid`` [rad g^1/2 L^-1/2] (see the module notes).
+    n_steps : int
+        Strides to survive without a fall (thesis: 25).
+    sign : {-1, +1}
+        -1: step down, backward push, negative pitch rate (the thesis's
+        limits); +1: step up, forward push, positive pitch rate.
+    tol : float
+        Accuracy of the limit, in the unit of ``kind`` (thesis: 1e-4).
+    options : IntegratorOptions, optional
+        Integrator of the disturbed runs (default: the thesis's 1e-8).
+    check : bool
+        Refuse unconverged or unstable gaits (see :func:`check_gait`).
+    start, ladder, k, max_magnitude
+        Search settings (:func:`limit_search`).
+
+    Returns
+    -------
+    float
+        The signed limit (``sign * inf`` if no failure up to ``max_magnitude``).
+
+    Raises
+    ------
+    ValueError
+        For a bad ``kind`` or ``sign``, or (with ``check``) an unconverged or
+        unstable gait.
+
+    References
+    ----------
+    Thesis Section 3.1.3; Table 6.1 model: -0.12 L, -0.73 g^1/2 L^1/2,
+    -1.50 rad g^1/2 L^-1/2 (Section 6.1).
+
+    Examples
+    --------
+    >>> import tslip
+    >>> gait = tslip.find_gait(tslip.preset("table6.1"))
+    >>> round(robustness(gait, "step_down", tol=1e-3), 2)
+    -0.12
+    """
+    _check_kind(kind)
+    if check:
+        check_gait(gait)
+    return _limit(gait, kind, sign, n_steps=n_steps, tol=tol, options=options, start=start,
+                  ladder=ladder, k=k, max_magnitude=max_magnitude).limit
+
+
+def robustness_report(
+    gait: Gait,
+    *,
+    n_steps: int = 25,
+    kinds: Sequence[Kind] = KINDS,
+    both_signs: bool = False,
+    tol: float = 1e-4,
+    options: IntegratorOptions | None = None,
+    check: bool = True,
+    start: float = 0.01,
+    ladder: int = 8,
+    k: int = 3,
+    max_magnitude: float = 100.0,
+) -> RobustnessResult:
+    """Robustness limits of a gait for several disturbances, with reasons.
+
+    Parameters are those of :func:`robustness`; ``kinds`` selects the
+    disturbances and ``both_signs`` adds the +1 direction (step up, forward
+    push, positive pitch rate) to the thesis's -1.
+
+    Returns
+    -------
+    RobustnessResult
+        Per kind and sign: the limit, the failing disturbance that bounds it,
+        the stride in which and the :class:`Status` with which that run
+        ended, and the number of batched evaluations.
+
+    Raises
+    ------
+    ValueError
+        As :func:`robustness`.
+    """
+    for kind in kinds:
+        _check_kind(kind)
+    if check:
+        check_gait(gait)
+    signs = (-1, 1) if both_signs else (-1,)
+    limits = tuple(
+        _limit(gait, kind, s, n_steps=n_steps, tol=tol, options=options, start=start,
+               ladder=ladder, k=k, max_magnitude=max_magnitude)
+        for kind in kinds for s in signs
+    )
+    return RobustnessResult(limits=limits, params=gait.params, state=gait.state,
+                            n_steps=int(n_steps), tol=float(tol),
+                            options=options or IntegratorOptions())
+
+
+def _limit(gait: Gait, kind: Kind, sign: int, *, n_steps: int, tol: float,
+           options: IntegratorOptions | None, start: float, ladder: int, k: int,
+           max_magnitude: float) -> RobustnessLimit:
+    if sign not in (-1, 1):
+        raise ValueError(f"sign must be -1 or +1, got {sign!r}")
+    if not isinstance(n_steps, (int, np.integer)) or n_steps < 1:
+        raise ValueError(f"n_steps must be an integer >= 1, got {n_steps!r}")
+    outcome: dict[float, tuple[int, int]] = {}  # magnitude -> (status, n_done)
+    n_errors = 0
+
+    def survives(m: np.ndarray) -> np.ndarray:
+        nonlocal n_errors
+        run = run_disturbed(gait.params, gait.state, kind, sign * m, n_steps=int(n_steps),
+                            options=options)
+        for mi, st, nd in zip(m, run.status, run.n_done, strict=True):
+            outcome[float(mi)] = (int(st), int(nd))
+        n_errors += int(np.count_nonzero(run.status >= 10))
+        return (run.status == Status.OK) & (run.n_done == n_steps)
+
+    s = limit_search(survives, start=start, tol=tol, ladder=ladder, k=k,
+                     max_magnitude=max_magnitude)
+    if s.bounded:
+        st, nd = outcome[s.hi]
+        status, stride = Status(st), nd
+    else:
+        status, stride = Status.OK, -1
+    return RobustnessLimit(kind=kind, sign=sign, limit=sign * s.lo, first_failing=sign * s.hi,
+                           fall_stride=stride, status=status, n_batches=s.n_calls,
+                           n_runs=s.n_evals, n_errors=n_errors)

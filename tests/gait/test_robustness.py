@@ -1,0 +1,203 @@
+"""Robustness limits (thesis Section 3.1.3) against the thesis, simulate() and the search itself."""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+import tslip
+from tslip.gait.robustness import (
+    KINDS,
+    limit_search,
+    robustness,
+    robustness_report,
+    run_disturbed,
+)
+
+TOL = 1e-4  # thesis search accuracy (CONVENTIONS.md)
+FIELD = {"step_down": "dh", "push": "dxd", "pitch_rate": "dphid"}
+
+
+@pytest.fixture(scope="module")
+def fit():
+    return tslip.find_gait(tslip.preset("table6.1"))
+
+
+@pytest.fixture(scope="module")
+def report(fit):
+    return robustness_report(fit, tol=TOL)
+
+
+# ---------------------------------------------------------------------------
+# Thesis numbers (Section 6.1, Table 6.1 model)
+# ---------------------------------------------------------------------------
+
+
+def test_table_6_1_step_down_and_push_limits(report):
+    """Section 6.1: maximum step-down -0.12 L, maximum push -0.73 g^1/2 L^1/2 (within 0.01)."""
+    assert report.step_down == pytest.approx(-0.12, abs=0.01)
+    assert report.push == pytest.approx(-0.73, abs=0.01)
+
+
+def test_table_6_1_pitch_rate_limit_measured(report):
+    """Pitch-rate limit: measured -0.7330 rad g^1/2 L^-1/2; the thesis reports -1.50.
+
+    CONVENTIONS.md lists -1.50 among the numbers an independent implementation
+    did not reproduce. Here the first failing disturbance (-0.7330) ends in
+    the first flight (stride 0) with the hip reaching the ground before the
+    foot; the value is the same for n_steps from 1 to 50 and at tolerance
+    1e-12. Only its sign and finiteness are asserted.
+    """
+    lim = report.get("pitch_rate")
+    assert math.isfinite(lim.limit) and lim.limit < 0
+
+
+def test_report_records_why_and_where_the_first_failure_ends(report):
+    for lim in report.limits:
+        assert lim.sign == -1 and lim.kind in KINDS
+        assert 0 < lim.limit - lim.first_failing <= TOL  # negative limits: failing is lower
+        assert lim.status != tslip.Status.OK and lim.reason == lim.status.reason
+        assert 0 <= lim.fall_stride < report.n_steps
+        assert lim.n_batches >= 2 and lim.n_runs >= lim.n_batches
+    assert report.n_batches == sum(lim.n_batches for lim in report.limits)
+
+
+# ---------------------------------------------------------------------------
+# Batch evaluation == tslip.simulate with a Disturbance
+# ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_limit_survives_and_beyond_falls_in_simulate(fit, report, kind):
+    """Just inside survives 25 strides in simulate(); limit + 2 tol (in magnitude) does not.
+
+    simulate() and the batch agree on the outcome and on the stride it ends in.
+    """
+    lim = report.get(kind)
+    inside, beyond = lim.limit, lim.limit - 2 * TOL
+    batch = run_disturbed(fit.params, fit.state, kind, [inside, beyond])
+    for i, d in enumerate((inside, beyond)):
+        tr = tslip.simulate(fit.params, fit.state, 25,
+                            disturbance=tslip.Disturbance(at_step=0, **{FIELD[kind]: d}))
+        assert tr.status == batch.status[i]
+        if i == 0:
+            assert tr.status == tslip.Status.OK and len(tr.steps) == 25
+            assert batch.n_done[i] == 25
+        else:
+            assert tr.status != tslip.Status.OK and len(tr.steps) <= 25
+            assert len(tr.steps) - 1 == batch.n_done[i]  # strides completed before the fall
+
+
+@pytest.mark.parametrize("kind", ["step_down", "push"])
+def test_reported_limit_is_within_tol_of_the_true_boundary(fit, report, kind):
+    """A grid of spacing tol/10 around the limit: all below it survive, one within tol fails."""
+    m = abs(report.get(kind).limit)
+    grid = m + TOL * np.linspace(-2.0, 2.0, 41)
+    run = run_disturbed(fit.params, fit.state, kind, -grid)
+    ok = (run.status == 0) & (run.n_done == 25)
+    assert ok[grid <= m].all()
+    first_fail = grid[np.flatnonzero(~ok)[0]]
+    assert m < first_fail <= m + TOL * (1 + 1e-9)
+
+
+# ---------------------------------------------------------------------------
+# Refusals and options
+# ---------------------------------------------------------------------------
+
+
+def test_refuses_an_unstable_gait():
+    g = tslip.find_gait(dataclasses.replace(tslip.preset("table2.1"), r=-0.3))
+    assert g.converged
+    with pytest.raises(ValueError, match=r"only for at least neutrally stable gaits.*unstable"):
+        robustness(g, "step_down")
+    with pytest.raises(ValueError, match="neutrally stable"):
+        robustness_report(g)
+
+
+def test_refuses_an_unconverged_gait_unless_check_false():
+    g = tslip.find_gait(tslip.preset("table2.1-global-pd"))
+    assert not g.converged
+    with pytest.raises(ValueError, match=r"not converged \(residual .*check=False"):
+        robustness(g, "push")
+    lim = robustness(g, "step_down", tol=1e-2, check=False)
+    assert -1.0 < lim < 0.0
+
+
+def test_bad_kind_and_sign():
+    g = tslip.find_gait(tslip.preset("table2.1"))
+    with pytest.raises(ValueError, match="kind must be one of"):
+        robustness(g, "shove")
+    with pytest.raises(ValueError, match="sign must be -1 or"):
+        robustness(g, "push", sign=0)
+
+
+def test_integration_errors_fail_but_are_not_reported_as_falls(fit):
+    """A flight limit below the stepped-down flight time makes the first failure an error."""
+    opts = tslip.IntegratorOptions(t_max_flight=1.5 * fit.flight_time)
+    r = robustness_report(fit, kinds=("step_down",), options=opts, tol=1e-3)
+    lim = r.get("step_down")
+    assert lim.status == tslip.Status.FLIGHT_TIMEOUT and not lim.status.fell
+    assert lim.reason.startswith("error:") and lim.n_errors >= 1
+    assert robustness(fit, "step_down", tol=1e-3) < lim.limit < 0  # the cap lowers the limit
+
+
+def test_both_signs_give_opposite_directions():
+    g = tslip.find_gait(tslip.preset("table2.1-local-velocity"))
+    r = robustness_report(g, both_signs=True, tol=1e-3)
+    for kind in KINDS:
+        assert r.get(kind, -1).limit < 0 < r.get(kind, +1).limit
+        assert r.get(kind, +1).limit == pytest.approx(robustness(g, kind, sign=1, tol=1e-3))
+
+
+def test_push_limit_tracks_a_minimum_speed_over_velocity():
+    """Thesis Fig. 4.9: push limit ~ linear in v0; step-down limit falls above v0 = 5.
+
+    The push limit keeps a constant minimum speed ``v0 + push``.
+    """
+    p = tslip.preset("table2.1")
+    rows = [robustness_report(tslip.find_gait(p, v0=v), kinds=("step_down", "push"), tol=1e-3)
+            for v in (5.0, 6.0, 7.0, 8.0)]
+    v_min = np.array([v + r.push for v, r in zip((5.0, 6.0, 7.0, 8.0), rows)])
+    assert np.ptp(v_min) < 0.4 and 2.4 < v_min.mean() < 3.0
+    drops = [r.step_down for r in rows]
+    assert all(a < b for a, b in zip(drops, drops[1:]))  # less negative: smaller step-down
+
+
+# ---------------------------------------------------------------------------
+# The search alone (pure predicate)
+# ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 7])
+@pytest.mark.parametrize("ladder", [1, 4, 8])
+def test_search_finds_a_monotone_threshold_within_tol(rng, k, ladder):
+    for thr in rng.uniform(0.003, 30.0, 5):
+        s = limit_search(lambda m, t=thr: m < t, tol=1e-4, k=k, ladder=ladder)
+        assert s.lo < thr <= s.hi and s.hi - s.lo <= 1e-4
+        assert s.n_evals == len(s.magnitudes) == len(s.survived)
+        assert np.array_equal(s.survived, s.magnitudes < thr)
+
+
+def test_k_section_needs_fewer_calls_than_bisection():
+    calls = {k: limit_search(lambda m: m < 0.7317, k=k).n_calls for k in (1, 3, 7)}
+    # width 0.64 -> 1e-4: 13 bisection rounds, 7 quadrisections, 5 octasections, +1 ladder
+    assert calls == {1: 14, 3: 8, 7: 6}
+
+
+def test_search_definition_for_non_monotone_survival():
+    """Survival on [0, 0.3) and [0.5, 0.6): the limit is the first failure, 0.3."""
+    s = limit_search(lambda m: (m < 0.3) | ((m >= 0.5) & (m < 0.6)), tol=1e-5)
+    assert s.lo == pytest.approx(0.3, abs=1e-5) and s.hi >= 0.3
+
+
+def test_search_edge_cases():
+    s = limit_search(lambda m: np.ones_like(m, dtype=bool), max_magnitude=50.0)
+    assert not s.bounded and s.lo == math.inf
+    assert s.magnitudes.max() == 50.0
+    s = limit_search(lambda m: m < 1e-3, start=0.01, tol=1e-5)  # the first rung fails
+    assert s.lo < 1e-3 <= s.hi and s.hi - s.lo <= 1e-5
+    with pytest.raises(ValueError, match="tol must be in"):
+        limit_search(lambda m: m < 1, tol=0.0)
+    with pytest.raises(ValueError, match="survives must return shape"):
+        limit_search(lambda m: True)
