@@ -1,0 +1,469 @@
+"""Natural-parameter continuation of periodic gaits (thesis Sections 3.4-3.7).
+
+The thesis's parameter studies (Figures 4.8-4.24) follow one gait of Table
+2.1 while a single parameter varies: speed ``v0``, leg damping ``c_l``, hip
+damping ``c_h``, mass offset ``r``, stiffness ``k``, touch-down angle
+``beta0`` and the normalised retraction rate of eq. 2.18. Here each point is
+solved by :func:`~tslip.gait.fixed_point.find_gait`, warm-started from its
+neighbours (a secant predictor through the last two points), with the
+automatic guesses as a fallback; the multipliers are
+:func:`~tslip.gait.stability.floquet` (exact Jacobian). Natural continuation
+cannot turn around a fold: the branch ends where the gait ceases to exist,
+which is what the thesis reports as "no periodic limit cycles are found".
+
+Parameter names: the :class:`~tslip.model.parameters.Params` fields (``v0``,
+``k``, ``beta0``, ``r``, ``omega_r``, ``c_l``, ``m``, ``J``, ``l0``, ``g``),
+``"omega_r_bar"`` (eq. 2.18, at the point's ``v0``) and controller gains by
+dotted name (``"controller.c_h"``, ``"controller.Kd"``, ``"controller.Kp"``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import brentq
+
+from ..model.parameters import PARAMETER_TABLE, Params
+from ..simulation.options import IntegratorOptions
+from .fixed_point import Gait, GaitProblem, find_gait
+from .stability import floquet
+
+__all__ = [
+    "Branch",
+    "continue_gait",
+    "get_param",
+    "set_param",
+    "stability_boundaries",
+]
+
+_FIELDS = {row.name for row in PARAMETER_TABLE}
+_SOLVED = {"alpha_r", "controller.alphad_ref", "controller.tau_c"}
+
+Progress = Callable[[int, int, float, "Gait | None"], None]
+
+
+# ---------------------------------------------------------------------------
+# parameter access by name
+# ---------------------------------------------------------------------------
+
+
+def _check_name(params: Params, name: str) -> None:
+    if name in _SOLVED:
+        raise ValueError(f"{name!r} is solved for by the gait search (Section 2.8); it cannot "
+                         "be a continuation parameter")
+    if name in _FIELDS or name == "omega_r_bar":
+        return
+    if name.startswith("controller."):
+        gain = name.split(".", 1)[1]
+        allowed = [f.name for f in dataclasses.fields(params.controller)]
+        if gain in allowed:
+            return
+        raise ValueError(f"controller {type(params.controller).__name__} has no field "
+                         f"{gain!r}; allowed: {allowed}")
+    raise ValueError(f"unknown parameter {name!r}; allowed: {sorted(_FIELDS - {'alpha_r'})}, "
+                     "'omega_r_bar' or 'controller.<gain>'")
+
+
+def get_param(params: Params, name: str) -> float:
+    """Value of a continuation parameter (see :func:`set_param`)."""
+    _check_name(params, name)
+    if name == "omega_r_bar":
+        return params.omega_r_bar
+    if name.startswith("controller."):
+        return float(getattr(params.controller, name.split(".", 1)[1]))
+    return float(getattr(params, name))
+
+
+def set_param(params: Params, name: str, value: float) -> Params:
+    """Copy of ``params`` with one scalar parameter changed.
+
+    Parameters
+    ----------
+    params : Params
+        Base parameters (unchanged).
+    name : str
+        A :class:`Params` field, ``"omega_r_bar"`` (eq. 2.18: sets ``omega_r
+        = value * v0 / l0``) or ``"controller.<gain>"``.
+    value : float
+        New value, in the parameter's unit (Table 3.1).
+
+    Returns
+    -------
+    Params
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, a solved-for variable (``alpha_r``,
+        ``controller.alphad_ref``, ``controller.tau_c``) or an invalid value.
+    """
+    _check_name(params, name)
+    value = float(value)
+    if name == "omega_r_bar":
+        return params.with_omega_r_bar(value)
+    if name.startswith("controller."):
+        ctrl = dataclasses.replace(params.controller, **{name.split(".", 1)[1]: value})
+        return dataclasses.replace(params, controller=ctrl)
+    return dataclasses.replace(params, **{name: value})
+
+
+# ---------------------------------------------------------------------------
+# the result
+# ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class Branch:
+    """A gait followed along one parameter.
+
+    Attributes
+    ----------
+    param : str
+        Name of the continuation parameter.
+    values : ndarray, shape (n,)
+        Parameter values, ascending.
+    gaits : tuple of (Gait or None)
+        The gait at each value; None where none was found or the point was
+        not attempted (past the end of the branch).
+    converged : ndarray of bool, shape (n,)
+    residual : ndarray, shape (n,)
+        Best max-norm residual (NaN where not attempted).
+    stance_time, flight_time : ndarray, shape (n,)
+        [g^-1/2 L^1/2], NaN where there is no gait.
+    multipliers : ndarray of complex, shape (n, 5)
+        Floquet multipliers (exact Jacobian), largest first; NaN where none.
+    trivial : ndarray of bool, shape (n, 5)
+        Structural multipliers (energy; pitch rate at ``r = 0``).
+    max_nontrivial : ndarray, shape (n,)
+        Largest non-trivial magnitude, NaN where none.
+    stability : tuple of str
+        ``"asymptotic"``, ``"neutral"``, ``"unstable"``, ``"none"`` (no gait)
+        or ``"unknown"`` (a perturbed stride fails).
+    messages : tuple of str
+        Per point: how it was found or why not.
+    base : float
+        The parameter's value in the starting gait or parameters.
+    params : Params
+        The starting parameters.
+    tol : float
+        Residual tolerance used.
+    options : IntegratorOptions or None
+        Integrator settings used (None: the default, tolerance 1e-12).
+    seconds : ndarray, shape (n,)
+        Wall time per point [s] (solve plus multipliers).
+    """
+
+    param: str
+    values: np.ndarray
+    gaits: tuple[Gait | None, ...]
+    converged: np.ndarray
+    residual: np.ndarray
+    stance_time: np.ndarray
+    flight_time: np.ndarray
+    multipliers: np.ndarray
+    trivial: np.ndarray
+    max_nontrivial: np.ndarray
+    stability: tuple[str, ...]
+    messages: tuple[str, ...]
+    base: float
+    params: Params
+    tol: float
+    options: IntegratorOptions | None
+    seconds: np.ndarray = field(repr=False)
+
+    def __len__(self) -> int:
+        return len(self.values)
+
+    @property
+    def stable(self) -> np.ndarray:
+        """At least neutrally stable (the thesis's green areas)."""
+        return np.array([s in ("asymptotic", "neutral") for s in self.stability])
+
+    def exists(self) -> tuple[float, float]:
+        """Smallest and largest value with a gait (NaN if none)."""
+        v = self.values[self.converged]
+        return (float(v.min()), float(v.max())) if v.size else (math.nan, math.nan)
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """Tidy table, one row per point.
+
+        Columns: ``param``, ``value``, ``converged``, ``residual``, ``delta``,
+        ``phi``, ``phid``, ``alpha_r``, the controller reference
+        (``alphad_ref`` or ``tau_c`` when the controller has one),
+        ``stance_time``, ``flight_time``, ``abs_lambda_1`` ... ``abs_lambda_5``
+        (descending), ``max_nontrivial``, ``stability``, ``message``.
+        """
+        ctrl = self.params.controller
+        ref = next((n for n in ("alphad_ref", "tau_c") if hasattr(ctrl, n)), None)
+        rows = []
+        for i, g in enumerate(self.gaits):
+            row: dict[str, object] = {
+                "param": self.param, "value": float(self.values[i]),
+                "converged": bool(self.converged[i]), "residual": float(self.residual[i]),
+                "delta": g.state.delta if g else math.nan,
+                "phi": g.state.phi if g else math.nan,
+                "phid": g.state.phid if g else math.nan,
+                "alpha_r": g.params.alpha_r if g else math.nan,
+            }
+            if ref is not None:
+                row[ref] = float(getattr(g.params.controller, ref)) if g else math.nan
+            row["stance_time"] = float(self.stance_time[i])
+            row["flight_time"] = float(self.flight_time[i])
+            mags = np.sort(np.abs(self.multipliers[i]))[::-1]
+            for j, m in enumerate(mags, 1):
+                row[f"abs_lambda_{j}"] = float(m)
+            row["max_nontrivial"] = float(self.max_nontrivial[i])
+            row["stability"] = self.stability[i]
+            row["message"] = self.messages[i]
+            rows.append(row)
+        return pd.DataFrame(rows)
+
+
+# ---------------------------------------------------------------------------
+# continuation
+# ---------------------------------------------------------------------------
+
+
+def _solve_point(
+    base: Params, param: str, value: float, history: list[tuple[float, Gait]], tol: float,
+    options: IntegratorOptions | None, predictor: str,
+) -> tuple[Gait, str]:
+    """One point: secant predictor, then the neighbour, then the automatic guesses."""
+    p = set_param(history[-1][1].params if history else base, param, value)
+    prob = GaitProblem.from_params(p, options)
+    starts: list[tuple[str, np.ndarray]] = []
+    if history:
+        z1 = prob.encode(history[-1][1])
+        if predictor == "secant" and len(history) >= 2:
+            (v0, g0), (v1, _) = history[-2], history[-1]
+            z0 = prob.encode(g0)
+            if v1 != v0:
+                starts.append(("secant predictor", z1 + (z1 - z0) * (value - v1) / (v1 - v0)))
+        starts.append(("neighbour", z1))
+    best: Gait | None = None
+    for how, z in starts:
+        g = find_gait(p, guess=z, tol=tol, options=options)
+        if g.converged:
+            return g, f"{g.message} (warm start: {how})"
+        if best is None or g.residual < best.residual:
+            best = g
+    g = find_gait(p, tol=tol, options=options)
+    if g.converged or best is None or g.residual < best.residual:
+        best = g
+    how = "automatic guess" + (" after the warm start failed" if starts else "")
+    return best, f"{best.message} ({how})"
+
+
+def continue_gait(
+    gait_or_params: Gait | Params,
+    param: str,
+    values: Sequence[float] | np.ndarray,
+    *,
+    tol: float = 1e-10,
+    options: IntegratorOptions | None = None,
+    progress: Progress | None = None,
+    predictor: str = "secant",
+    max_failures: int | None = 2,
+    multipliers: bool = True,
+) -> Branch:
+    """Follow a periodic gait along one scalar parameter.
+
+    Starts at the value nearest the base value (the parameter's value in
+    ``gait_or_params``) and walks up and down from it, warm-starting each
+    point from its neighbours. A point that fails is retried from the
+    automatic guesses; after ``max_failures`` consecutive failures in one
+    direction the branch ends there and the remaining points are marked
+    "not attempted".
+
+    Parameters
+    ----------
+    gait_or_params : Gait or Params
+        A solved gait (warm start at the base value) or parameters (solved
+        first with :func:`find_gait`).
+    param : str
+        Parameter name (module docstring), e.g. ``"v0"``, ``"omega_r_bar"``,
+        ``"controller.c_h"``.
+    values : sequence of float
+        Parameter values, in the parameter's unit; sorted ascending.
+    tol : float
+        Max-norm residual for a point to count as a gait. For the global PD
+        controller, which has no exact fixed point, pass ``tol=1e-2`` (the
+        thesis's ``C1 < 1e-4``).
+    options : IntegratorOptions, optional
+        Integrator settings (default tolerance 1e-12).
+    progress : callable, optional
+        ``progress(done, total, value, gait_or_None)`` after each point.
+    predictor : {"secant", "constant"}
+        Warm start from the secant through the last two points (then the
+        last point), or from the last point only.
+    max_failures : int or None
+        Consecutive failures that end the branch in one direction; None
+        attempts every value.
+    multipliers : bool
+        Compute the Floquet multipliers (exact Jacobian) of each gait.
+
+    Returns
+    -------
+    Branch
+
+    Raises
+    ------
+    ValueError
+        For an unknown or solved-for parameter, or values that are empty,
+        not finite or repeated.
+
+    Examples
+    --------
+    >>> import tslip
+    >>> b = continue_gait(tslip.preset("table2.1"), "v0", [4.0, 5.0, 6.0])
+    >>> b.converged.tolist(), b.stability
+    ([True, True, True], ('neutral', 'neutral', 'neutral'))
+    """
+    params = gait_or_params.params if isinstance(gait_or_params, Gait) else gait_or_params
+    base_value = get_param(params, param)
+    vals = np.sort(np.asarray(values, dtype=float).ravel())
+    if vals.size == 0 or not np.all(np.isfinite(vals)):
+        raise ValueError("values must be a non-empty sequence of finite numbers")
+    if np.any(np.diff(vals) == 0):
+        raise ValueError("values must not repeat")
+    if predictor not in ("secant", "constant"):
+        raise ValueError(f"predictor must be 'secant' or 'constant', got {predictor!r}")
+    n = vals.size
+    gaits: list[Gait | None] = [None] * n
+    best: list[Gait | None] = [None] * n
+    msgs = ["not attempted: past the end of the branch"] * n
+    seconds = np.full(n, math.nan)
+
+    anchor = gait_or_params if isinstance(gait_or_params, Gait) else None
+    if anchor is None or not anchor.converged:
+        anchor = find_gait(params, tol=tol, options=options)
+    start: list[tuple[float, Gait]] = [(base_value, anchor)] if anchor.converged else []
+    i0 = int(np.argmin(np.abs(vals - base_value)))
+    done = 0
+
+    def walk(indices: range, history: list[tuple[float, Gait]]) -> None:
+        nonlocal done
+        failures = 0
+        for i in indices:
+            if max_failures is not None and failures >= max_failures:
+                break
+            t0 = time.perf_counter()
+            g, msg = _solve_point(params, param, float(vals[i]), history, tol, options,
+                                  predictor)
+            seconds[i] = time.perf_counter() - t0
+            best[i], msgs[i] = g, msg
+            if g.converged:
+                gaits[i] = g
+                history = (history + [(float(vals[i]), g)])[-2:]
+                failures = 0
+            else:
+                failures += 1
+            done += 1
+            if progress is not None:
+                progress(done, n, float(vals[i]), gaits[i])
+
+    walk(range(i0, n), list(start))
+    first = [(float(vals[i0]), gaits[i0])] if gaits[i0] is not None else []
+    walk(range(i0 - 1, -1, -1), (start + first)[-2:] if first else list(start))
+
+    lam = np.full((n, 5), np.nan, dtype=complex)
+    triv = np.zeros((n, 5), dtype=bool)
+    mnt = np.full(n, math.nan)
+    stab = ["none"] * n
+    for i, g in enumerate(gaits):
+        if g is None or not multipliers:
+            continue
+        t0 = time.perf_counter()
+        try:
+            f = floquet(g, method="exact", options=options)
+        except ValueError:
+            stab[i] = "unknown"
+        else:
+            lam[i], triv[i], mnt[i], stab[i] = f.multipliers, f.trivial, f.max_nontrivial, \
+                f.stability
+        seconds[i] += time.perf_counter() - t0
+
+    def arr(attr: str) -> np.ndarray:
+        return np.array([getattr(g, attr) if g is not None else math.nan for g in gaits])
+
+    return Branch(
+        param=param, values=vals, gaits=tuple(gaits),
+        converged=np.array([g is not None for g in gaits]),
+        residual=np.array([b.residual if b is not None else math.nan for b in best]),
+        stance_time=arr("stance_time"), flight_time=arr("flight_time"),
+        multipliers=lam, trivial=triv, max_nontrivial=mnt, stability=tuple(stab),
+        messages=tuple(msgs), base=base_value, params=params, tol=tol, options=options,
+        seconds=seconds,
+    )
+
+
+# ---------------------------------------------------------------------------
+# where stability changes
+# ---------------------------------------------------------------------------
+
+
+def stability_boundaries(
+    branch: Branch,
+    *,
+    level: float = 1.0,
+    refine: bool = True,
+    xtol: float = 1e-6,
+) -> np.ndarray:
+    """Parameter values where the largest non-trivial multiplier crosses ``level``.
+
+    Parameters
+    ----------
+    branch : Branch
+        From :func:`continue_gait` with multipliers.
+    level : float
+        Magnitude to cross (1: the unit circle, Section 3.1.2).
+    refine : bool
+        Solve ``max_nontrivial(value) = level`` between the two bracketing
+        points by Brent's method, each evaluation a gait warm-started from
+        the nearer end; otherwise interpolate linearly.
+    xtol : float
+        Tolerance on the parameter value (``refine=True``).
+
+    Returns
+    -------
+    ndarray
+        Crossing values, ascending (empty if none).
+    """
+    out = []
+    v, m = branch.values, branch.max_nontrivial - level
+    for i in range(len(v) - 1):
+        if not (np.isfinite(m[i]) and np.isfinite(m[i + 1])) or m[i] * m[i + 1] > 0:
+            continue
+        if m[i] == 0 or m[i + 1] == 0:
+            out.append(float(v[i] if m[i] == 0 else v[i + 1]))
+            continue
+        x_lin = float(v[i] - m[i] * (v[i + 1] - v[i]) / (m[i + 1] - m[i]))
+        if not refine:
+            out.append(x_lin)
+            continue
+        ga, gb = branch.gaits[i], branch.gaits[i + 1]
+        if ga is None or gb is None:  # multipliers without gaits: not from continue_gait
+            out.append(x_lin)
+            continue
+
+        def f(x: float, ga: Gait = ga, gb: Gait = gb, va: float = v[i],
+              vb: float = v[i + 1]) -> float:
+            near = ga if abs(x - va) <= abs(x - vb) else gb
+            p = set_param(near.params, branch.param, x)
+            z = GaitProblem.from_params(p, branch.options).encode(near)
+            g = find_gait(p, guess=z, tol=branch.tol, options=branch.options)
+            if not g.converged:
+                raise RuntimeError(f"no gait at {branch.param} = {x}: {g.message}")
+            return floquet(g, options=branch.options).max_nontrivial - level
+
+        try:
+            out.append(float(brentq(f, float(v[i]), float(v[i + 1]), xtol=xtol)))
+        except (RuntimeError, ValueError):
+            out.append(x_lin)
+    return np.array(out)
