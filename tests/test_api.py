@@ -13,6 +13,7 @@ DOCTEST_MODULES = [
     "tslip.model.terrain",
     "tslip.model.units",
     "tslip.simulation.integrate",
+    "tslip.gait.robustness",
 ]
 
 

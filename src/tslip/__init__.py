@@ -6,7 +6,16 @@ Running" (TU Delft / IHMC, 2019), in the dimensionless units of its Table 3.1.
 
 __version__ = "0.1.0"
 
-from .gait import Gait, find_gait  # noqa: E402
+from .gait import (  # noqa: E402
+    Branch,
+    Floquet,
+    Gait,
+    continue_gait,
+    find_gait,
+    floquet,
+    robustness,
+    robustness_report,
+)
 from .model import (  # noqa: E402
     ConstantTorque,
     GlobalPD,
@@ -28,6 +37,7 @@ from .simulation import (  # noqa: E402
     simulate,
     step,
     step_batch,
+    step_jacobian,
     step_map,
 )
 
@@ -36,5 +46,7 @@ __all__ = [
     "ConstantTorque", "GlobalPD", "LocalVelocity", "Params", "Passive", "Terrain",
     "TouchdownState", "preset", "presets",
     "Disturbance", "IntegratorOptions", "Status", "StepResult", "Trajectory",
-    "run_batch", "simulate", "step", "step_batch", "step_map", "Gait", "find_gait",
+    "run_batch", "simulate", "step", "step_batch", "step_map", "step_jacobian",
+    "Gait", "find_gait", "Floquet", "floquet", "robustness", "robustness_report", "Branch",
+    "continue_gait",
 ]

@@ -1,5 +1,54 @@
-"""Gait analysis on the touch-down map: periodic gaits (more in later modules)."""
+"""Gait analysis on the touch-down map (thesis Sections 2.8, 3.1-3.4, Appendices B-C).
 
-from .fixed_point import Gait, find_gait, gait_residual
+periodic gaits (fixed_point), their continuation along a parameter
+(continuation), Floquet stability (stability), robustness limits
+(robustness), the ground impulse and its response to pitch (impulse), stride
+theory and the no-slip check (stride), energy balance after ground steps
+(energy), and one report of it all (report).
+"""
 
-__all__ = ["Gait", "find_gait", "gait_residual"]
+from .continuation import Branch, continue_gait, get_param, set_param, stability_boundaries
+from .energy import (
+    HeightChangeResult,
+    StepDownResponse,
+    VelocityAngleCase,
+    expected_velocity_change,
+    step_down_response,
+    velocity_after_height_change,
+    velocity_angle_effect,
+)
+from .fixed_point import CMAReport, Gait, GaitProblem, cma_minimize, find_gait, gait_residual
+from .impulse import (
+    Impulse,
+    ImpulseLinearisation,
+    PitchResponse,
+    impulse_linearisation,
+    pitch_disturbance_response,
+    stance_impulse,
+)
+from .report import analyse
+from .robustness import RobustnessLimit, RobustnessResult, robustness, robustness_report
+from .stability import Floquet, floquet, map_jacobian
+from .stride import (
+    FrictionCheck,
+    StrideProperties,
+    bounce_time,
+    fast_running_index,
+    friction_ratio,
+    predicted_flight_time,
+    predicted_stance_time,
+    stride_properties,
+)
+
+__all__ = [
+    "Branch", "continue_gait", "get_param", "set_param", "stability_boundaries",
+    "HeightChangeResult", "StepDownResponse", "VelocityAngleCase", "expected_velocity_change",
+    "step_down_response", "velocity_after_height_change", "velocity_angle_effect",
+    "CMAReport", "Gait", "GaitProblem", "cma_minimize", "find_gait", "gait_residual",
+    "Impulse", "ImpulseLinearisation", "PitchResponse", "impulse_linearisation",
+    "pitch_disturbance_response", "stance_impulse", "analyse",
+    "RobustnessLimit", "RobustnessResult", "robustness", "robustness_report",
+    "Floquet", "floquet", "map_jacobian",
+    "FrictionCheck", "StrideProperties", "bounce_time", "fast_running_index", "friction_ratio",
+    "predicted_flight_time", "predicted_stance_time", "stride_properties",
+]

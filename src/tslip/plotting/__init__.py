@@ -5,6 +5,13 @@ API so they work headless. Save with ``fig.savefig(path)``.
 """
 
 from .animation import animate, frame_times, render_frames
+from .gait import (
+    plot_friction,
+    plot_impulse_linearisation,
+    plot_pitch_impulse,
+    plot_step_down_response,
+    plot_velocity_angle_effect,
+)
 from .trajectories import flight_intervals, ground_profile, plot_touchdowns, plot_trajectory
 
 __all__ = [
@@ -12,7 +19,12 @@ __all__ = [
     "flight_intervals",
     "frame_times",
     "ground_profile",
+    "plot_friction",
+    "plot_impulse_linearisation",
+    "plot_pitch_impulse",
+    "plot_step_down_response",
     "plot_touchdowns",
     "plot_trajectory",
+    "plot_velocity_angle_effect",
     "render_frames",
 ]
