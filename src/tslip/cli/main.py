@@ -1,4 +1,4 @@
-"""``tslip`` command line: presets, simulate, animate, demo.
+"""``tslip`` command line: presets, simulate, animate, demo, gait, continue.
 
 A thin skin over the public API: options are parsed into :class:`tslip.Params`
 (preset, then ``--params`` TOML, then ``--set key=value``), the periodic gait
@@ -517,6 +517,9 @@ def demo_cmd(
         for path in written:
             console.print(f"wrote {path} ({_size(path)})")
         console.print(f"done in {time.perf_counter() - t_start:.1f} s")
+
+
+from . import gait as _gait_commands  # noqa: E402, F401  (registers gait, continue)
 
 
 def main() -> None:

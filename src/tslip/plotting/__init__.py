@@ -12,10 +12,12 @@ from .gait import (
     plot_step_down_response,
     plot_velocity_angle_effect,
 )
+from .sweeps import plot_branch
 from .trajectories import flight_intervals, ground_profile, plot_touchdowns, plot_trajectory
 
 __all__ = [
     "animate",
+    "plot_branch",
     "flight_intervals",
     "frame_times",
     "ground_profile",

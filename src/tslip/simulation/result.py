@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import enum
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._io import atomic_write, write_table
 from ..model import _pack as pk
 from ..model.parameters import Params
 from ..model.state import TouchdownState
@@ -255,26 +254,8 @@ step-down from a :class:`Disturbance`). ``steps`` holds the :class:`StepResult` 
         """
         from .. import __version__
 
+        write_table(self.to_dataframe(), path)
         path = Path(path)
-        suffix = path.suffix.lower()
-        if suffix not in (".csv", ".parquet"):
-            raise ValueError(f"output file must end in .csv or .parquet, got {str(path)!r}")
-        df = self.to_dataframe()
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=suffix)
-        os.close(fd)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the usual file mode
-        try:
-            if suffix == ".csv":
-                df.to_csv(tmp, index=False)
-            else:
-                df.to_parquet(tmp, index=False)
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
         meta = {
             "tslip_version": __version__,
             "params": self.params.to_dict(),
@@ -285,10 +266,8 @@ step-down from a :class:`Disturbance`). ``steps`` holds the :class:`StepResult` 
             "git": _git_hash(),
             **self.meta,
         }
-        meta_path = path.with_suffix(".json")
-        tmp_meta = meta_path.with_name(f".{meta_path.name}.tmp")
-        tmp_meta.write_text(json.dumps(meta, indent=2, default=str))
-        os.replace(tmp_meta, meta_path)
+        atomic_write(path.with_suffix(".json"),
+                     lambda tmp: Path(tmp).write_text(json.dumps(meta, indent=2, default=str)))
         return path
 
 

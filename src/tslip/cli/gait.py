@@ -1,0 +1,222 @@
+"""``tslip gait`` (one gait's report) and ``tslip continue`` (a branch)."""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import typer
+from rich import box
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from .._io import atomic_write, write_table
+from ..gait import analyse, continue_gait, find_gait, get_param, impulse_linearisation
+from ..gait import pitch_disturbance_response as pitch_response
+from ..gait.stride import friction_ratio
+from .main import (
+    _DATA_SUFFIXES,
+    ParamsOpt,
+    PresetOpt,
+    SetOpt,
+    _build_params,
+    _check_suffix,
+    _console,
+    _errors,
+    _fail,
+    _size,
+    app,
+)
+
+__all__ = ["gait_cmd", "continue_cmd"]
+
+
+def _fmt(x: Any, digits: int = 4) -> str:
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "-"
+    if isinstance(x, float):
+        return f"{x:.{digits}f}" if abs(x) >= 1e-3 or x == 0 else f"{x:.2e}"
+    return str(x)
+
+
+def _table(title: str, *cols: str) -> Table:
+    t = Table(title=title, box=box.SIMPLE_HEAD, title_justify="left", pad_edge=False)
+    for i, c in enumerate(cols):
+        t.add_column(c, justify="left" if i == 0 else "right")
+    return t
+
+
+def _print_report(rep: dict[str, Any]) -> None:
+    console = _console()
+    g = rep["gait"]
+    console.print(f"gait: {g['message']}")
+    t = _table("touch-down state of the gait", "beta", "phi", "xd", "yd", "phid", "v", "delta")
+    t.add_row(*(_fmt(g["state"][k]) for k in ("beta", "phi", "xd", "yd", "phid", "v", "delta")))
+    console.print(t)
+    p = g["params"]
+    ctrl = {k: v for k, v in p["controller"].items() if k != "type"}
+    solved = ", ".join([f"alpha_r = {p['alpha_r']:.6f}"]
+                       + [f"{k} = {v:.6f}" for k, v in ctrl.items()])
+    console.print(f"solved: {solved} ({p['controller']['type']})")
+    fl = rep["floquet"]
+    if "error" in fl:
+        console.print(f"multipliers: {fl['error']}")
+    else:
+        t = _table(f"Floquet multipliers: {fl['stability']}, largest non-trivial "
+                   f"{fl['max_nontrivial']:.4f}", "lambda", "|lambda|", "")
+        for m in fl["multipliers"]:
+            z = complex(m["re"], m["im"])
+            t.add_row(f"{z.real:+.5f}{z.imag:+.5f}j", f"{m['abs']:.5f}",
+                      "trivial (conserved quantity)" if m["trivial"] else "")
+        console.print(t)
+    s = rep["stride"]
+    t = _table("stride", "quantity", "model", "theory", "source")
+    t.add_row("stance time t_s", _fmt(s["stance_time"]), _fmt(s["stance_time_predicted"]),
+              "eq. 3.10")
+    t.add_row("flight time t_f", _fmt(s["flight_time"]), _fmt(s["flight_time_predicted"]),
+              "eq. 3.11")
+    t.add_row("duty factor", _fmt(s["duty_factor"]), "", "t_s / (t_s + t_f)")
+    t.add_row("step frequency", _fmt(s["step_frequency"]), "", "1 / (t_s + t_f)")
+    t.add_row("bounce time t_b", "", _fmt(s["bounce_time"]), "eq. 3.9")
+    t.add_row("fast-running index", "", _fmt(s["fast_running_index"]), "eq. 3.12")
+    console.print(t)
+    rb = rep.get("robustness")
+    if rb is not None:
+        if "error" in rb:
+            console.print(f"robustness: {rb['error']}")
+        else:
+            t = _table("robustness (largest survived disturbance, 25 strides)", "disturbance",
+                       "limit", "first failing run")
+            for kind, r in rb.items():
+                t.add_row(kind, _fmt(r["limit"]), f"{r['status']} in stride {r['fall_stride']}"
+                          if r["status"] else "")
+            console.print(t)
+    im = rep["impulse"]
+    if "error" in im:
+        console.print(f"impulse: {im['error']}")
+    else:
+        n = im["nominal"]
+        t = _table(f"ground impulse: I = ({n['I_x']:.4f}, {n['I_y']:.4f}), x_p = "
+                   f"{n['x_p']:.4f}; response to pitch", "dphi", "torque", "restoring",
+                   "distance to hip / r", "direction change")
+        for row in im["pitch"]:
+            t.add_row(_fmt(row["dphi"], 2), _fmt(row["torque"]),
+                      "yes" if row["restoring"] else "no", _fmt(row["hip_distance_over_r"]),
+                      _fmt(row["direction_change"]))
+        console.print(t)
+    fr = rep["friction"]
+    if "error" in fr:
+        console.print(f"no-slip: {fr['error']}")
+    else:
+        console.print(f"no-slip (mu = {fr['mu']:g}): |F_x|/F_y exceeds mu in "
+                      f"{100 * fr['slip_fraction']:.1f}% of stance"
+                      + (f", from t/t_s = {fr['first_slip']:.2f}" if fr["first_slip"] else ""))
+
+
+@app.command("gait")
+def gait_cmd(
+    preset_name: PresetOpt = "table2.1",
+    sets: SetOpt = None,
+    params_file: ParamsOpt = None,
+    method: Annotated[
+        str, typer.Option("--method", help="Gait search: newton (least squares) or cma.")
+    ] = "newton",
+    seed: Annotated[int, typer.Option("--seed", help="CMA-ES seed.")] = 1,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the report as JSON.")] = False,
+    plot: Annotated[
+        Path | None,
+        typer.Option("--plot", metavar="DIR", help="Write GRF / impulse figures to DIR."),
+    ] = None,
+    no_robustness: Annotated[
+        bool, typer.Option("--no-robustness", help="Skip the robustness limits.")
+    ] = False,
+) -> None:
+    """Solve the periodic gait and report stability, strides, robustness, impulse."""
+    with _errors():
+        if method not in ("newton", "cma"):
+            raise ValueError(f"--method must be 'newton' or 'cma', got {method!r}")
+        params = _build_params(preset_name, sets, params_file)
+        gait = find_gait(params, method=method, seed=seed)
+        if not gait.converged:
+            _fail(gait.message, 1)
+        rep = analyse(params, gait=gait, robustness=not no_robustness)
+        if as_json:
+            typer.echo(json.dumps(rep, indent=2))
+        else:
+            _print_report(rep)
+        if plot is not None:
+            from ..plotting import plot_friction, plot_impulse_linearisation, plot_pitch_impulse
+
+            figs = {
+                "pitch_impulse.png": plot_pitch_impulse(pitch_response(gait)),
+                "impulse_linearisation.png": plot_impulse_linearisation(
+                    impulse_linearisation(gait)),
+                "friction.png": plot_friction(friction_ratio(gait.params, gait.state)),
+            }
+            for name, fig in figs.items():
+                atomic_write(plot / name, lambda tmp, fig=fig: fig.savefig(tmp, format="png"))
+                if not as_json:
+                    _console().print(f"wrote {plot / name} ({_size(plot / name)})")
+
+
+@app.command("continue")
+def continue_cmd(
+    param: Annotated[str, typer.Option("--param", help="Parameter to vary, e.g. r, v0, "
+                                       "omega_r_bar, controller.c_h.")],
+    start: Annotated[float, typer.Option("--from", help="First value.")],
+    stop: Annotated[float, typer.Option("--to", help="Last value.")],
+    points: Annotated[int, typer.Option("--points", "-n", help="Number of values.")] = 50,
+    preset_name: PresetOpt = "table2.1",
+    sets: SetOpt = None,
+    params_file: ParamsOpt = None,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="Save the branch (.csv or .parquet).")
+    ] = None,
+    plot: Annotated[
+        Path | None, typer.Option("--plot", help="Save the multiplier plot (.png).")
+    ] = None,
+) -> None:
+    """Follow the periodic gait along a parameter; print and save the branch."""
+    with _errors():
+        if points < 2:
+            raise ValueError(f"--points must be an integer >= 2, got {points}")
+        if not (math.isfinite(start) and math.isfinite(stop) and start < stop):
+            raise ValueError(f"--from must be below --to (both finite), got {start}, {stop}")
+        _check_suffix(out, _DATA_SUFFIXES, "--out")
+        params = _build_params(preset_name, sets, params_file)
+        get_param(params, param)  # validates the name
+        values = np.linspace(start, stop, points)
+        console = _console()
+        t0 = time.perf_counter()
+        with Progress(TextColumn(f"continuing along {param}"), BarColumn(),
+                      MofNCompleteColumn(), TimeRemainingColumn(), console=_console(True),
+                      transient=True) as bar:
+            task = bar.add_task("points", total=points)
+            branch = continue_gait(params, param, values,
+                                   progress=lambda i, n, v, g: bar.update(task, completed=i))
+        df = branch.to_dataframe()
+        t = _table(f"branch along {param} ({time.perf_counter() - t0:.1f} s)", param,
+                   "gait", "max |lambda|", "stability", "t_s", "t_f")
+        for row in df.itertuples():
+            t.add_row(_fmt(row.value), "yes" if row.converged else "no",
+                      _fmt(row.max_nontrivial), row.stability, _fmt(row.stance_time),
+                      _fmt(row.flight_time))
+        console.print(t)
+        lo, hi = branch.exists()
+        stable = branch.values[branch.stable]
+        console.print(f"gait exists for {param} in [{_fmt(lo)}, {_fmt(hi)}]; "
+                      + (f"stable in [{_fmt(stable.min())}, {_fmt(stable.max())}]"
+                         if stable.size else "stable nowhere"))
+        if out is not None:
+            write_table(df, out)
+            console.print(f"wrote {out} ({_size(out)})")
+        if plot is not None:
+            from ..plotting import plot_branch
+
+            fig = plot_branch(branch)
+            atomic_write(plot, lambda tmp: fig.savefig(tmp, format=plot.suffix.lstrip(".")))
+            console.print(f"wrote {plot} ({_size(plot)})")
