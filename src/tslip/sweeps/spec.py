@@ -1,0 +1,226 @@
+"""A parameter study as data: base parameters, swept axes, analyses.
+
+A study is a frozen :class:`StudySpec`. Its points are the grid of its axes
+(one axis: a line; two axes: a grid, computed as one continuation line along
+the last axis per value of the first). Specs come from code or from TOML::
+
+    name = "mass offset"
+    preset = "table2.1"            # base parameters
+    analyses = ["floquet", "robustness"]
+    n_steps = 25                   # strides a disturbed run must survive
+
+    [params]                       # overrides of the preset
+    k = 25.0
+    controller = { type = "local_velocity", Kd = 0.5 }
+
+    [[axis]]
+    param = "r"                    # a Params field, omega_r_bar or controller.<gain>
+    from = -1.0
+    to = 1.0
+    points = 50                    # or: values = [0.1, 0.2, 0.5]
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..gait.continuation import get_param, set_param
+from ..model.parameters import Params, preset
+
+__all__ = ["Axis", "StudySpec", "ANALYSES"]
+
+#: Analyses a study can run at each point. ``floquet`` is always run.
+ANALYSES = ("floquet", "robustness", "stride")
+
+
+@dataclass(frozen=True, slots=True)
+class Axis:
+    """One swept parameter and its values (ascending)."""
+
+    param: str
+    values: tuple[float, ...]
+
+    @classmethod
+    def linspace(cls, param: str, start: float, stop: float, points: int) -> Axis:
+        """``points`` evenly spaced values from ``start`` to ``stop``."""
+        if not isinstance(points, int) or points < 1:
+            raise ValueError(f"axis {param}: points must be an integer >= 1, got {points!r}")
+        if not (math.isfinite(start) and math.isfinite(stop)):
+            raise ValueError(f"axis {param}: from and to must be finite, got {start}, {stop}")
+        if points > 1 and not start < stop:
+            raise ValueError(f"axis {param}: empty range, from ({start:g}) must be below "
+                             f"to ({stop:g})")
+        return cls(param, tuple(float(v) for v in np.linspace(start, stop, points)))
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Axis:
+        data = dict(data)
+        param = data.pop("param", None)
+        if not isinstance(param, str):
+            raise ValueError("every [[axis]] needs a param name")
+        if "values" in data:
+            vals = data.pop("values")
+            if data:
+                raise ValueError(f"axis {param}: give values or from/to/points, not both")
+            if not isinstance(vals, list) or not vals:
+                raise ValueError(f"axis {param}: empty range, values must be a non-empty list")
+            try:
+                values = tuple(sorted(float(v) for v in vals))
+            except (TypeError, ValueError):
+                raise ValueError(f"axis {param}: values must be numbers, got {vals!r}") from None
+            return cls(param, values)
+        unknown = set(data) - {"from", "to", "points"}
+        if unknown:
+            raise ValueError(f"axis {param}: unknown key {sorted(unknown)[0]!r}; use from, to, "
+                             "points or values")
+        try:
+            return cls.linspace(param, float(data["from"]), float(data["to"]),
+                                int(data.get("points", 50)))
+        except KeyError as exc:
+            raise ValueError(f"axis {param}: missing {exc.args[0]!r}") from None
+
+
+@dataclass(frozen=True)
+class StudySpec:
+    """A parameter study.
+
+    Parameters
+    ----------
+    name : str
+        Identifier; also the folder name of its results.
+    base : Params
+        Parameters at every point except the swept ones.
+    axes : tuple of Axis
+        One or two axes. The last is the continuation axis.
+    analyses : tuple of str
+        Subset of :data:`ANALYSES`.
+    n_steps : int
+        Strides a disturbed run must survive (robustness, Section 3.1.3).
+    description : str
+        One line for reports.
+    """
+
+    name: str
+    base: Params
+    axes: tuple[Axis, ...]
+    analyses: tuple[str, ...] = ("floquet",)
+    n_steps: int = 25
+    description: str = ""
+    meta: dict[str, Any] = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        if not self.name or not isinstance(self.name, str) or "/" in self.name:
+            raise ValueError(f"study name must be a non-empty string without '/', got "
+                             f"{self.name!r}")
+        if not 1 <= len(self.axes) <= 2:
+            raise ValueError(f"study {self.name}: needs one or two axes, got {len(self.axes)}")
+        names = [a.param for a in self.axes]
+        if len(set(names)) != len(names):
+            raise ValueError(f"study {self.name}: an axis is given twice: {names}")
+        bad = set(self.analyses) - set(ANALYSES)
+        if bad:
+            raise ValueError(f"study {self.name}: unknown analysis {sorted(bad)[0]!r}; "
+                             f"allowed: {list(ANALYSES)}")
+        if not isinstance(self.n_steps, int) or self.n_steps < 1:
+            raise ValueError(f"study {self.name}: n_steps must be an integer >= 1, got "
+                             f"{self.n_steps!r}")
+        for axis in self.axes:
+            if not axis.values:
+                raise ValueError(f"axis {axis.param}: empty range")
+            get_param(self.base, axis.param)  # unknown names raise here
+        # every value must give valid parameters (e.g. no negative stiffness)
+        for axis in self.axes:
+            for v in (axis.values[0], axis.values[-1]):
+                try:
+                    set_param(self.base, axis.param, v)
+                except ValueError as exc:
+                    raise ValueError(f"axis {axis.param}: {exc}") from None
+
+    # -- points -------------------------------------------------------------
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """Number of values per axis."""
+        return tuple(len(a.values) for a in self.axes)
+
+    @property
+    def n_points(self) -> int:
+        """Total number of points."""
+        return int(np.prod(self.shape))
+
+    def lines(self) -> list[tuple[dict[str, float], Axis]]:
+        """Continuation lines: fixed outer assignments and the inner axis."""
+        inner = self.axes[-1]
+        if len(self.axes) == 1:
+            return [({}, inner)]
+        return [({self.axes[0].param: v}, inner) for v in self.axes[0].values]
+
+    def params_at(self, assignment: dict[str, float]) -> Params:
+        """Base parameters with the given axis values applied, in axis order."""
+        p = self.base
+        for axis in self.axes:
+            if axis.param in assignment:
+                p = set_param(p, axis.param, assignment[axis.param])
+        return p
+
+    def with_resolution(self, points: Sequence[int]) -> StudySpec:
+        """Same study with ``points[i]`` evenly spaced values on axis ``i``."""
+        axes = tuple(Axis.linspace(a.param, a.values[0], a.values[-1], n) if len(a.values) > 1
+                     else a for a, n in zip(self.axes, points))
+        return StudySpec(self.name, self.base, axes, self.analyses, self.n_steps,
+                         self.description, dict(self.meta))
+
+    # -- serialisation ----------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """Plain dict (the TOML form, with the full base parameters)."""
+        return {
+            "name": self.name, "description": self.description,
+            "analyses": list(self.analyses), "n_steps": self.n_steps,
+            "params": self.base.to_dict(),
+            "axis": [{"param": a.param, "values": list(a.values)} for a in self.axes],
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> StudySpec:
+        """Build from the TOML form (see the module docstring)."""
+        data = dict(data)
+        allowed = {"name", "description", "preset", "params", "axis", "analyses", "n_steps"}
+        unknown = set(data) - allowed
+        if unknown:
+            raise ValueError(f"unknown study key {sorted(unknown)[0]!r}; allowed: "
+                             f"{sorted(allowed)}")
+        name = data.get("name", "study")
+        base = preset(str(data.get("preset", "table2.1")))
+        overrides = data.get("params", {})
+        if not isinstance(overrides, dict):
+            raise ValueError("study [params] must be a table")
+        base = Params.from_dict(overrides, base=base)
+        axes_data = data.get("axis")
+        if not isinstance(axes_data, list) or not axes_data:
+            raise ValueError(f"study {name}: needs at least one [[axis]]")
+        axes = tuple(Axis.from_dict(a) for a in axes_data)
+        analyses = data.get("analyses", ["floquet"])
+        if isinstance(analyses, str):
+            analyses = [analyses]
+        return cls(name=str(name), base=base, axes=axes, analyses=tuple(analyses),
+                   n_steps=int(data.get("n_steps", 25)),
+                   description=str(data.get("description", "")))
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> StudySpec:
+        """Read a study from a TOML file."""
+        try:
+            with open(path, "rb") as fh:
+                data = tomllib.load(fh)
+        except FileNotFoundError:
+            raise ValueError(f"study file {str(path)!r} does not exist") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise ValueError(f"study file {str(path)!r} is not valid TOML: {exc}") from None
+        data.setdefault("name", Path(path).stem)
+        return cls.from_dict(data)

@@ -1,0 +1,102 @@
+"""The study runner: serial == parallel, resume, cache invalidation, spec validation."""
+
+import dataclasses
+import json
+
+import pandas as pd
+import pytest
+
+import tslip
+from tslip.sweeps import Axis, StudySpec, run_study
+from tslip.sweeps import run as run_mod
+
+
+def _spec(**kw):
+    base = dict(name="grid", base=tslip.preset("table2.1-local-velocity"),
+                axes=(Axis("v0", (4.0, 5.0)), Axis("k", (20.0, 25.0))), analyses=("floquet",))
+    base.update(kw)
+    return StudySpec(**base)
+
+
+def _cmp(a: pd.DataFrame, b: pd.DataFrame) -> None:
+    pd.testing.assert_frame_equal(a.drop(columns="seconds"), b.drop(columns="seconds"))
+
+
+def test_two_by_two_serial_equals_parallel(tmp_path):
+    spec = _spec(analyses=("floquet", "robustness"))
+    serial = run_study(spec, tmp_path / "s", workers=1)
+    parallel = run_study(spec, tmp_path / "p", workers=2)
+    assert serial.meta["computed"] == parallel.meta["computed"] == 4
+    assert serial.frame["converged"].all()
+    _cmp(serial.frame, parallel.frame)
+
+
+def test_interrupted_study_resumes_only_missing_points(tmp_path, monkeypatch):
+    spec = _spec()
+    calls: list[list[float]] = []
+    real = run_mod.solve_line
+
+    def flaky(spec_, assignment, values):
+        calls.append(list(values))
+        if len(calls) == 2:
+            raise KeyboardInterrupt  # the second line is interrupted
+        return real(spec_, assignment, values)
+
+    monkeypatch.setattr(run_mod, "solve_line", flaky)
+    with pytest.raises(KeyboardInterrupt):
+        run_study(spec, tmp_path, workers=1)
+    assert len(list((tmp_path / "cache").glob("*.json"))) == 2  # first line kept
+    calls.clear()
+    res = run_study(spec, tmp_path, workers=1)
+    assert res.meta["computed"] == 2 and res.meta["cached"] == 2
+    assert calls == [[20.0, 25.0]]  # only the missing line ran
+    again = run_study(spec, tmp_path, workers=1)
+    assert again.meta["computed"] == 0 and calls == [[20.0, 25.0]]
+    _cmp(res.frame, again.frame)
+    assert json.loads((tmp_path / "run.json").read_text())["points"] == 4
+
+
+def test_cache_invalidated_by_parameter_and_version(tmp_path, monkeypatch):
+    spec = _spec()
+    run_study(spec, tmp_path, workers=1)
+    changed = _spec(base=dataclasses.replace(tslip.preset("table2.1-local-velocity"), J=0.12))
+    assert run_study(changed, tmp_path, workers=1).meta["computed"] == 4
+    assert run_study(spec, tmp_path, workers=1).meta["computed"] == 0
+    monkeypatch.setattr(run_mod, "__version__", "999.0")
+    assert run_study(spec, tmp_path, workers=1).meta["computed"] == 4
+
+
+def test_missing_gait_is_recorded_not_raised(tmp_path):
+    spec = StudySpec("low-speed", tslip.preset("table2.1"), (Axis("v0", (1.0, 5.0)),))
+    res = run_study(spec, None, workers=1)
+    df = res.frame.set_index("v0")
+    assert not df.loc[1.0, "converged"] and df.loc[1.0, "stability"] == "none"
+    assert df.loc[5.0, "converged"]
+
+
+@pytest.mark.parametrize(
+    ("toml", "needle"),
+    [('[[axis]]\nparam = "stiffness"\nfrom = 1\nto = 2\npoints = 3\n', "stiffness"),
+     ('[[axis]]\nparam = "r"\nfrom = 1\nto = 1\npoints = 3\n', "empty range"),
+     ('[[axis]]\nparam = "r"\nvalues = []\n', "empty range"),
+     ('[[axis]]\nparam = "k"\nfrom = -5\nto = 20\npoints = 3\n', "k ["),
+     ('[params]\nk = -3\n[[axis]]\nparam = "r"\nfrom = 0\nto = 1\npoints = 3\n', "k ["),
+     ('analyses = ["magic"]\n[[axis]]\nparam = "r"\nvalues = [0.1]\n', "magic"),
+     ('colour = 1\n[[axis]]\nparam = "r"\nvalues = [0.1]\n', "colour")],
+)
+def test_bad_spec_rejected_with_one_line(tmp_path, toml, needle):
+    f = tmp_path / "s.toml"
+    f.write_text(toml)
+    with pytest.raises(ValueError) as exc:
+        StudySpec.from_toml(f)
+    msg = str(exc.value)
+    assert needle in msg and "\n" not in msg
+
+
+def test_toml_roundtrip(tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text('name = "r-sweep"\npreset = "table2.1"\nanalyses = ["floquet", "stride"]\n'
+                 '[params]\nk = 30\n[[axis]]\nparam = "r"\nfrom = 0.1\nto = 0.5\npoints = 5\n')
+    spec = StudySpec.from_toml(f)
+    assert spec.base.k == 30.0 and spec.shape == (5,) and spec.axes[0].values[-1] == 0.5
+    assert StudySpec.from_dict(spec.to_dict()) == spec
