@@ -343,25 +343,16 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
         _record(P, rec, nrec, t, y)
         nrec += 1
     t_next_rec = rec_dt
-    # fall right at touch-down?
-    if gv_old[1] <= 0.0:
-        stats[0] = 0.0
+    # fallen already at touch-down: hip at the ground, or moving backward
+    if gv_old[1] <= 0.0 or gv_old[2] < 0.0:
         for i in range(NSTATE):
             yout[i] = y[i]
+        stats[0] = 0.0
         stats[1] = 0.0
         stats[2] = 0.0
         stats[3] = nrec
         stats[4] = 0.0
-        return ST_FALL_HIP_GROUND
-    if gv_old[2] < 0.0:
-        stats[0] = 0.0
-        for i in range(NSTATE):
-            yout[i] = y[i]
-        stats[1] = 0.0
-        stats[2] = 0.0
-        stats[3] = nrec
-        stats[4] = 0.0
-        return ST_FALL_BACKWARD
+        return ST_FALL_HIP_GROUND if gv_old[1] <= 0.0 else ST_FALL_BACKWARD
     h = O[O_H0]
     if h <= 0.0:
         h = initial_step(P, y, K[0], rtol, atol, ytmp, K[1])
