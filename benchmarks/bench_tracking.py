@@ -1,0 +1,58 @@
+"""Tracking speed at 1024 x 816 px on one core (target >= 150 frames/s).
+
+Renders a synthetic Table 6.1 recording (1000 Hz), writes it as H.264 mp4,
+then times (a) tracking frames already in memory and (b) decoding + tracking
+from the mp4 file, as ``tslip track`` does.
+
+    python benchmarks/bench_tracking.py [--frames 600]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--frames", type=int, default=600)
+    args = ap.parse_args()
+    import cv2
+
+    cv2.setNumThreads(1)
+    import tslip
+    from tslip.experiment.synth import Camera, render_frames, synthesize, write_video
+    from tslip.experiment.video import Calibration, TrackerOptions, track_frames, track_video
+
+    cam = Camera()
+    g = tslip.find_gait(tslip.preset("table6.1"))
+    run = synthesize(g.params, g.state, args.frames / cam.fps, camera=cam)
+    cal = Calibration(cam.px_per_m, cam.ground_px, cam.hip_px)
+    opt = TrackerOptions.for_scale(cam.px_per_m)
+    t0 = time.perf_counter()
+    frames = list(render_frames(run))
+    t_render = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    res = track_frames(iter(frames), cal, opt, fps=cam.fps)
+    t_mem = time.perf_counter() - t0
+    with tempfile.TemporaryDirectory() as d:
+        path = write_video(run, Path(d) / "bench.mp4")
+        t0 = time.perf_counter()
+        res2 = track_video(path, cal, opt)
+        t_file = time.perf_counter() - t0
+    n = len(frames)
+    print(f"{cam.width}x{cam.height} px, {n} frames, one core (cv2.setNumThreads(1))")
+    print(f"render (numpy):            {n / t_render:7.1f} frames/s")
+    print(f"track, frames in memory:   {n / t_mem:7.1f} frames/s  "
+          f"(body detected {100 * res.body_detection_rate:.1f} %)")
+    print(f"decode mp4 + track:        {n / t_file:7.1f} frames/s  "
+          f"(body detected {100 * res2.body_detection_rate:.1f} %)  target >= 150")
+
+
+if __name__ == "__main__":
+    main()

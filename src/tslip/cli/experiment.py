@@ -1,0 +1,254 @@
+"""``tslip synth-video | track | process | fit | experiment``: the experiment pipeline.
+
+Each command writes a file the next one reads: a video (+ ground truth),
+a tracks table, a steps table, the fit (tables 6.2/6.3 and figures).
+Problems print as one line naming the frame range; a fatal one exits
+non-zero after writing what was tracked.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import pandas as pd
+import typer
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+from .._io import atomic_write, write_table
+from .main import PresetOpt, SetOpt, _build_params, _console, _errors, _fail, app
+
+__all__ = ["synth_video_cmd", "track_cmd", "process_cmd", "fit_cmd", "experiment_cmd"]
+
+_SPACING = 0.18
+_MARKER_R = 0.025
+_FOOT_R = 0.016
+
+
+def _write_json(path: Path, data: dict[str, Any]) -> Path:
+    return atomic_write(path, lambda tmp: Path(tmp).write_text(
+        json.dumps(data, indent=2, default=str)))
+
+
+def _bar(label: str) -> Progress:
+    return Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                    console=_console(stderr=True), transient=True)
+
+
+def _read_table(path: Path) -> pd.DataFrame:
+    if not path.exists():
+        raise ValueError(f"file not found: {str(path)!r}")
+    if path.suffix.lower() == ".parquet":
+        return pd.read_parquet(path)
+    if path.suffix.lower() != ".csv":
+        raise ValueError(f"expected a .csv or .parquet table, got {str(path)!r}")
+    return pd.read_csv(path)
+
+
+@app.command("synth-video")
+def synth_video_cmd(
+    out: Annotated[Path, typer.Option("--out", "-o", help="Video: .mp4 or a folder of PNGs.")]
+    = Path("synthetic.mp4"),
+    preset_name: PresetOpt = "table6.1",
+    sets: SetOpt = None,
+    duration: Annotated[float, typer.Option("--duration", help="Length [s].")] = 1.0,
+    fps: Annotated[float, typer.Option("--fps", help="Frame rate [Hz].")] = 1000.0,
+    width: Annotated[int, typer.Option("--width", help="Frame width [px].")] = 1024,
+    height: Annotated[int, typer.Option("--height", help="Frame height [px].")] = 816,
+    field_width: Annotated[float, typer.Option("--field-width",
+                                               help="Scene width in the frame [m].")] = 0.88,
+    noise: Annotated[float, typer.Option("--noise", help="Sensor noise [grey levels].")] = 3.0,
+    seed: Annotated[int, typer.Option("--seed", help="Noise seed.")] = 0,
+) -> None:
+    """Render a simulated run as a treadmill video with a ground-truth CSV."""
+    with _errors():
+        from ..experiment.synth import Camera, RenderOptions, synthesize, write_video
+        from ..gait import find_gait
+
+        cam = Camera(width=width, height=height, fps=fps, field_width=field_width)
+        params = _build_params(preset_name, sets, None)
+        gait = find_gait(params)
+        if not gait.converged:
+            _fail(f"no periodic gait for the preset: {gait.message}", 1)
+        run = synthesize(gait.params, gait.state, duration, camera=cam,
+                         options=RenderOptions(noise=noise, seed=seed))
+        with _bar("rendering") as bar:
+            task = bar.add_task("frames", total=run.n_frames)
+            write_video(run, out, progress=lambda d, n: bar.update(task, completed=d))
+        truth = out.with_name(out.stem + ".truth.csv") if out.suffix else out / "truth.csv"
+        write_table(run.truth, truth)
+        _write_json(truth.with_suffix(".json"), {
+            "params": gait.params.to_dict(), "fps": fps, "px_per_m": cam.px_per_m,
+            "ground_y_px": cam.ground_px, "belt_speed_m_s": run.belt_speed,
+            "stance_time": run.stance_time, "flight_time": run.flight_time,
+            "geometry": {"r": run.geometry.r, "a": run.geometry.a, "b": run.geometry.b,
+                         "marker_radius": run.geometry.marker_radius,
+                         "foot_radius": run.geometry.foot_radius}})
+        c = _console()
+        c.print(f"wrote {out} ({run.n_frames} frames, {width}x{height} px at {fps:g} Hz)")
+        c.print(f"wrote {truth}")
+
+
+def _track(video: Path, out: Path, fps: float | None, scale: float | None,
+           ground: float | None, max_frames: int | None) -> Any:
+    from ..experiment.video import (
+        Calibration,
+        TrackerOptions,
+        measure_calibration,
+        open_video,
+        track_video,
+    )
+
+    if (scale is None) != (ground is None):
+        raise ValueError("give both --scale and --ground, or neither (measured from the frame)")
+    if scale is None:
+        frames, _, _ = open_video(video)
+        first = next(frames, None)
+        if first is None:
+            raise ValueError(f"no frames could be decoded from {str(video)!r} (frames 0-0)")
+        cal = measure_calibration(first, _SPACING, marker_radius_m=_MARKER_R)
+    else:
+        cal = Calibration(px_per_m=scale, ground_y=ground, x0=0.0)
+    opt = TrackerOptions.for_scale(cal.px_per_m, marker_radius=_MARKER_R,
+                                   marker_spacing=_SPACING, foot_radius=_FOOT_R)
+    with _bar("tracking") as bar:
+        task = bar.add_task("frames", total=None)
+        res = track_video(video, cal, opt, fps=fps, max_frames=max_frames,
+                          progress=lambda d, n: bar.update(task, completed=d, total=n or None))
+    write_table(res.tracks, out)
+    _write_json(out.with_suffix(".json"), {
+        "video": str(video), "fps": res.fps, "px_per_m": cal.px_per_m, "ground_y_px":
+        cal.ground_y, "x0_px": cal.x0, "problems": res.problems, "fatal": res.fatal,
+        "body_detection_rate": res.body_detection_rate})
+    c = _console()
+    c.print(f"tracked {len(res.tracks)} frames: body markers in "
+            f"{100 * res.body_detection_rate:.1f} % (scale {cal.px_per_m:.1f} px/m, ground at "
+            f"row {cal.ground_y:.1f})")
+    for p in res.problems:
+        typer.echo(f"warning: {p}", err=True)
+    c.print(f"wrote {out}")
+    if res.fatal:
+        _fail(res.problems[-1] if res.problems else "tracking failed", 1)
+    return res
+
+
+@app.command("track")
+def track_cmd(
+    video: Annotated[Path, typer.Argument(help="Video (.mp4) or folder of frames.")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="Tracks table (.csv/.parquet).")]
+    = Path("tracks.csv"),
+    fps: Annotated[float | None, typer.Option("--fps", help="Frame rate [Hz] (default: "
+                                              "from the file).")] = None,
+    scale: Annotated[float | None, typer.Option("--scale", help="Image scale [px/m] (default: "
+                                                "measured from the disc spacing).")] = None,
+    ground: Annotated[float | None, typer.Option("--ground", help="Ground row [px].")] = None,
+    max_frames: Annotated[int | None, typer.Option("--max-frames")] = None,
+) -> None:
+    """Track body discs and feet in a video; write per-frame positions."""
+    with _errors():
+        _track(video, out, fps, scale, ground, max_frames)
+
+
+def _process(tracks_path: Path, out: Path) -> Any:
+    from ..experiment.signals import process_tracks
+
+    tracks = _read_table(tracks_path)
+    if len(tracks) < 2:
+        raise ValueError(f"too few frames in {str(tracks_path)!r}: {len(tracks)}")
+    fps = 1.0 / float(np.median(np.diff(tracks["t"].to_numpy())))
+    data = process_tracks(tracks, fps)
+    table = data.samples.merge(data.steps[["step", "stance_time", "flight_time"]], on="step")
+    write_table(table, out)
+    _write_json(out.with_suffix(".json"), {"belt_speed_m_s": data.belt_speed,
+                                           "problems": data.problems, **data.meta})
+    write_table(data.frames, out.with_name(out.stem + ".frames" + out.suffix))
+    c = _console()
+    st = data.steps
+    c.print(f"{len(st)} near-foot steps: t_s = {st.stance_time.mean():.4f} +- "
+            f"{st.stance_time.std(ddof=0):.4f}, t_f = {st.flight_time.mean():.4f} +- "
+            f"{st.flight_time.std(ddof=0):.4f} [g^-1/2 L^1/2]; belt {data.belt_speed:.3f} m/s")
+    for p in data.problems:
+        typer.echo(f"warning: {p}", err=True)
+    c.print(f"wrote {out}")
+    return data
+
+
+@app.command("process")
+def process_cmd(
+    tracks: Annotated[Path, typer.Argument(help="Tracks table from `tslip track`.")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="Steps table (.csv/.parquet).")]
+    = Path("steps.csv"),
+) -> None:
+    """Filter tracks, compute states, split and resample the near-foot steps."""
+    with _errors():
+        _process(tracks, out)
+
+
+def _fit(steps_path: Path, out_dir: Path, frames: Any = None) -> Any:
+    from ..experiment.fit import fit_model
+    from ..experiment.signals import average_steps
+    from ..plotting.experiment import plot_foot_trajectory, plot_step_average
+
+    table = _read_table(steps_path)
+    steps = table.groupby("step")[["stance_time", "flight_time"]].first().reset_index()
+    avg = average_steps(table, steps)
+    if avg.n_steps < 2:
+        raise ValueError(f"too few steps to fit in {str(steps_path)!r}: {avg.n_steps}")
+    res = fit_model(avg)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_table(res.times, out_dir / "table6_2.csv")
+    write_table(res.scores, out_dir / "table6_3.csv")
+    _write_json(out_dir / "fit.json", {"values": res.values, "params": res.params.to_dict(),
+                                       "stance_time": res.stance_time,
+                                       "flight_time": res.flight_time, "converged":
+                                       res.converged, "message": res.message,
+                                       "n_steps": avg.n_steps, "n_evals": res.n_evals})
+    fig = plot_step_average(avg, res)
+    atomic_write(out_dir / "figure6_1.png", lambda tmp: fig.savefig(tmp, format="png", dpi=90))
+    if frames is not None:
+        fig2 = plot_foot_trajectory(frames)
+        atomic_write(out_dir / "figureD_2.png",
+                     lambda tmp: fig2.savefig(tmp, format="png", dpi=90))
+    c = _console()
+    c.print(res.message)
+    c.print("fitted: " + ", ".join(f"{k} = {v:.4f}" for k, v in res.values.items()))
+    c.print(res.times.to_string(index=False, float_format=lambda x: f"{x:.4f}"))
+    c.print(res.scores.to_string(index=False, float_format=lambda x: f"{x:.3f}"))
+    c.print(f"wrote {out_dir}/table6_2.csv, table6_3.csv, fit.json, figure6_1.png")
+    if not res.converged:
+        _fail(res.message, 1)
+    return res
+
+
+@app.command("fit")
+def fit_cmd(
+    steps: Annotated[Path, typer.Argument(help="Steps table from `tslip process`.")],
+    out_dir: Annotated[Path, typer.Option("--out-dir", "-o", help="Folder for tables, "
+                                          "figure and fit.json.")] = Path("fit"),
+) -> None:
+    """Fit TSLIP (local velocity control + leg damping) to the step averages."""
+    with _errors():
+        _fit(steps, out_dir)
+
+
+@app.command("experiment")
+def experiment_cmd(
+    video: Annotated[Path, typer.Argument(help="Video (.mp4) or folder of frames.")],
+    out_dir: Annotated[Path, typer.Option("--out-dir", "-o")] = Path("experiment"),
+    fps: Annotated[float | None, typer.Option("--fps", help="Frame rate [Hz].")] = None,
+    scale: Annotated[float | None, typer.Option("--scale", help="[px/m]")] = None,
+    ground: Annotated[float | None, typer.Option("--ground", help="Ground row [px].")] = None,
+) -> None:
+    """Run track -> process -> fit and write everything into one folder."""
+    with _errors():
+        t0 = time.perf_counter()
+        out_dir.mkdir(parents=True, exist_ok=True)
+        _track(video, out_dir / "tracks.csv", fps, scale, ground, None)
+        data = _process(out_dir / "tracks.csv", out_dir / "steps.csv")
+        _fit(out_dir / "steps.csv", out_dir, data)
+        _console().print(f"done in {time.perf_counter() - t0:.1f} s"
+                         if math.isfinite(t0) else "done")

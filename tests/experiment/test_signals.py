@@ -1,0 +1,57 @@
+"""Correlation/VAF (eqs 5.1-5.2) hand cases; contact detection; too few steps."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from tslip.experiment.signals import contact_events, correlation, process_tracks, vaf
+
+
+def test_perfect_fit_gives_one_and_hundred_percent() -> None:
+    y = np.sin(np.linspace(0, 3, 50))
+    assert correlation(y, y) == pytest.approx(1.0, abs=1e-12)
+    assert vaf(y, y) == pytest.approx(100.0, abs=1e-9)
+
+
+def test_constant_offset_keeps_correlation_lowers_vaf() -> None:
+    y = np.array([1.0, 2.0, 3.0, 4.0])
+    # var(y) = 1.25; y - (y + 1) = -1 has zero variance -> VAF stays 100 (eq. 5.2 uses var)
+    assert correlation(y, y + 1.0) == pytest.approx(1.0, abs=1e-12)
+    assert vaf(y, y + 1.0) == pytest.approx(100.0, abs=1e-9)  # eq. 5.2 as printed
+    # a scaled copy: corr 1, VAF = (1 - var(-0.5 y) / var(y)) * 100 = 75 %
+    assert correlation(y, 1.5 * y + 2.0) == pytest.approx(1.0, abs=1e-12)
+    assert vaf(y, 1.5 * y) == pytest.approx(75.0, abs=1e-9)
+    # offset plus noise-free ramp error: yhat = y + (0, 0, 0, 1)
+    yh = y + np.array([0.0, 0.0, 0.0, 1.0])
+    assert vaf(y, yh) == pytest.approx((1 - np.var([0, 0, 0, 1.0]) / 1.25) * 100, abs=1e-9)
+    assert vaf(y, yh) < 100.0
+
+
+def test_anticorrelated_gives_minus_one() -> None:
+    y = np.array([1.0, 2.0, 3.0])
+    assert correlation(y, -y) == pytest.approx(-1.0, abs=1e-12)
+    assert vaf(y, -y) == pytest.approx(-300.0, abs=1e-9)  # var(2y)/var(y) = 4
+
+
+def test_contact_events_subframe_touchdown() -> None:
+    fs = 500.0
+    t = np.arange(200) / fs
+    # foot falls at 2 m/s, lands at t = 0.1013 s, lifts at 0.2507 s
+    h = np.maximum(np.maximum(2.0 * (0.1013 - t), 0.0), 2.0 * (t - 0.2507))
+    ev = contact_events(h, t, 0.0, 0.003)
+    assert len(ev) == 1
+    assert abs(ev[0][0] - 0.1013) < 1e-4   # 0.05 frame
+    assert abs(ev[0][1] - 0.2507) < 1e-4
+
+
+def test_too_few_steps_names_frames() -> None:
+    n = 100
+    tracks = pd.DataFrame({"frame": np.arange(n), "t": np.arange(n) / 500.0, "body_q": 1,
+                           "foot1_q": 1, "foot2_q": 1})
+    for m in ("front", "rear", "foot1", "foot2"):
+        tracks[f"{m}_x_m"] = 0.1 if m == "front" else -0.1
+        tracks[f"{m}_y_m"] = 0.3 if m in ("front", "rear") else 0.05
+    with pytest.raises(ValueError, match=r"too few steps to average.*frames 0-99"):
+        process_tracks(tracks, 500.0)
