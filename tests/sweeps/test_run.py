@@ -36,11 +36,11 @@ def test_interrupted_study_resumes_only_missing_points(tmp_path, monkeypatch):
     calls: list[list[float]] = []
     real = run_mod.solve_line
 
-    def flaky(spec_, assignment, values):
+    def flaky(spec_, assignment, values, seeds=None):
         calls.append(list(values))
         if len(calls) == 2:
             raise KeyboardInterrupt  # the second line is interrupted
-        return real(spec_, assignment, values)
+        return real(spec_, assignment, values, seeds)
 
     monkeypatch.setattr(run_mod, "solve_line", flaky)
     with pytest.raises(KeyboardInterrupt):
@@ -100,3 +100,16 @@ def test_toml_roundtrip(tmp_path):
     spec = StudySpec.from_toml(f)
     assert spec.base.k == 30.0 and spec.shape == (5,) and spec.axes[0].values[-1] == 0.5
     assert StudySpec.from_dict(spec.to_dict()) == spec
+
+
+def test_dask_cluster_gives_the_same_results(tmp_path):
+    """--scheduler ADDRESS: the same lines on a Dask cluster (here a local one)."""
+    from dask.distributed import Client, LocalCluster
+
+    spec = _spec()
+    serial = run_study(spec, tmp_path / "s", workers=1)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster, Client(cluster):
+        dask = run_study(spec, tmp_path / "d", scheduler=cluster.scheduler_address)
+    assert dask.meta["scheduler"] == cluster.scheduler_address
+    _cmp(serial.frame, dask.frame)

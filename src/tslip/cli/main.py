@@ -521,6 +521,7 @@ def demo_cmd(
 
 from . import experiment as _experiment_commands  # noqa: E402, F401  (synth-video ... fit)
 from . import gait as _gait_commands  # noqa: E402, F401  (registers gait, continue)
+from . import studies as _study_commands  # noqa: E402, F401  (study, reproduce)
 
 
 def main() -> None:

@@ -35,8 +35,10 @@ import pandas as pd
 
 from .. import __version__
 from .._io import atomic_write, write_table
-from ..gait.continuation import continue_gait
+from ..gait.continuation import continue_gait, get_param
+from ..gait.fixed_point import Gait, GaitProblem, find_gait
 from ..gait.robustness import KINDS, robustness_report
+from ..gait.stability import floquet
 from ..gait.stride import stride_properties
 from .spec import StudySpec
 
@@ -53,6 +55,10 @@ def point_key(spec: StudySpec, assignment: dict[str, float]) -> str:
         "analyses": sorted(spec.analyses),
         "n_steps": spec.n_steps if "robustness" in spec.analyses else None,
     }
+    if "tol" in spec.meta:  # a non-default gait tolerance (e.g. global PD) changes results
+        payload["tol"] = float(spec.meta["tol"])
+    if "neutral_tol" in spec.meta:
+        payload["neutral_tol"] = float(spec.meta["neutral_tol"])
     blob = json.dumps(payload, sort_keys=True, default=float).encode()
     return hashlib.sha256(blob).hexdigest()[:24]
 
@@ -65,33 +71,111 @@ def _num(x: Any) -> float:
     return x
 
 
-def solve_line(spec: StudySpec, assignment: dict[str, float],
-               values: list[float]) -> list[dict[str, Any]]:
+def _seeded_gaits(spec: StudySpec, assignment: dict[str, float], values: np.ndarray,
+                  seeds: dict[float, list[float]], tol: float) -> list[Gait | None]:
+    """Gaits along a line from the neighbouring line's solutions (2-D continuation).
+
+    Each point starts once from its neighbour's unknowns in the previous line,
+    else from the nearest solved point of this line; no automatic guesses, so a
+    point without a gait costs one short least-squares run.
+    """
+    inner = spec.axes[-1].param
+    gaits: list[Gait | None] = [None] * len(values)
+    base = get_param(spec.base, inner)
+    order = np.argsort(np.abs(values - base), kind="stable")
+    for i in order:
+        p = spec.params_at({**assignment, inner: float(values[i])})
+        names = GaitProblem.from_params(p).names
+        starts = []
+        if float(values[i]) in seeds:
+            starts.append(seeds[float(values[i])])
+        solved = [j for j in range(len(values)) if gaits[j] is not None]
+        if solved:
+            j = min(solved, key=lambda j: abs(values[j] - values[i]))
+            g = gaits[j]
+            starts.append(_unknowns(g, names))
+        for z in starts:
+            if len(z) != len(names) or not np.all(np.isfinite(z)):
+                continue
+            g = find_gait(p, guess=np.asarray(z), tol=tol)
+            if g.converged:
+                gaits[i] = g
+                break
+    return gaits
+
+
+def _unknowns(g: Gait, names: tuple[str, ...]) -> list[float]:
+    src = {"delta": g.state.delta, "phi": g.state.phi, "phid": g.state.phid,
+           "alpha_r": g.params.alpha_r,
+           "alphad_ref": getattr(g.params.controller, "alphad_ref", math.nan),
+           "tau_c": getattr(g.params.controller, "tau_c", math.nan)}
+    return [float(src[n]) for n in names]
+
+
+def seeds_from_records(spec: StudySpec, records: list[dict[str, Any]]) -> dict[float, list]:
+    """Unknowns of a solved line, by inner value, to seed its neighbour line."""
+    inner = spec.axes[-1].param
+    out = {}
+    for rec in records:
+        if rec.get("converged"):
+            out[float(rec[inner])] = [rec.get(n, math.nan) for n in
+                                      ("delta", "phi", "phid", "alpha_r", "alphad_ref",
+                                       "tau_c")]
+    return out
+
+
+def solve_line(spec: StudySpec, assignment: dict[str, float], values: list[float],
+               seeds: dict[float, list] | None = None) -> list[dict[str, Any]]:
     """Solve and analyse the points of one continuation line.
 
     Pure: returns one record (a flat dict of numbers and strings) per value;
-    runs in worker processes.
+    runs in worker processes. Without ``seeds`` the line is followed by
+    :func:`continue_gait` from a cold start; with ``seeds`` (the unknowns of
+    the neighbouring line, see :func:`seeds_from_records`) each point starts
+    from its neighbour's solution, as 2-D continuation.
     """
     inner = spec.axes[-1].param
     params = spec.params_at(assignment)
     t0 = time.perf_counter()
-    branch = continue_gait(params, inner, np.asarray(values, dtype=float), max_failures=3)
+    tol = float(spec.meta.get("tol", 1e-10))  # global PD has no exact fixed point
+    vals = np.sort(np.asarray(values, dtype=float))
+    if seeds is None:
+        branch = continue_gait(params, inner, vals, tol=tol, max_failures=3, multipliers=False)
+        gaits = list(branch.gaits)
+        residual = list(branch.residual)
+        messages = list(branch.messages)
+    else:
+        names = GaitProblem.from_params(params).names
+        full = {v: [z[("delta", "phi", "phid", "alpha_r", "alphad_ref", "tau_c").index(n)]
+                    for n in names] for v, z in seeds.items()}
+        gaits = _seeded_gaits(spec, assignment, vals, full, tol)
+        residual = [g.residual if g is not None else math.nan for g in gaits]
+        messages = ["seeded from the neighbouring line" if g is not None else
+                    "no periodic gait from the neighbouring line's solutions" for g in gaits]
+    neutral_tol = float(spec.meta.get("neutral_tol", 1e-6))
     records = []
-    for i, v in enumerate(branch.values):
-        g = branch.gaits[i]
+    for i, v in enumerate(vals):
+        g = gaits[i]
         rec: dict[str, Any] = {**assignment, inner: float(v)}
-        rec["converged"] = bool(branch.converged[i])
-        rec["residual"] = _num(branch.residual[i])
-        rec["stability"] = branch.stability[i] if g is not None else "none"
-        mags = np.sort(np.abs(branch.multipliers[i]))[::-1]
-        mags_nt = np.abs(branch.multipliers[i])[~branch.trivial[i]]
+        rec["converged"] = g is not None and bool(g.converged)
+        rec["residual"] = _num(residual[i])
+        fl = None
+        if g is not None:
+            try:
+                fl = floquet(g, unit_tol=neutral_tol)
+            except ValueError:
+                fl = None
+        rec["stability"] = (fl.stability if fl is not None else
+                            ("unknown" if g is not None else "none"))
+        mags = np.sort(np.abs(fl.multipliers))[::-1] if fl is not None else np.full(5, np.nan)
         for j in range(5):
-            rec[f"abs_lambda_{j + 1}"] = _num(mags[j]) if j < len(mags) else math.nan
-        rec["max_nontrivial"] = _num(branch.max_nontrivial[i])
-        rec["n_trivial"] = int(np.sum(branch.trivial[i]))
-        rec["min_nontrivial"] = _num(mags_nt.min()) if mags_nt.size and g else math.nan
-        rec["stance_time"] = _num(branch.stance_time[i])
-        rec["flight_time"] = _num(branch.flight_time[i])
+            rec[f"abs_lambda_{j + 1}"] = _num(mags[j])
+        rec["max_nontrivial"] = _num(fl.max_nontrivial) if fl is not None else math.nan
+        rec["n_trivial"] = int(np.sum(fl.trivial)) if fl is not None else 0
+        nt = np.abs(fl.multipliers[~fl.trivial]) if fl is not None else np.array([])
+        rec["min_nontrivial"] = _num(nt.min()) if nt.size else math.nan
+        rec["stance_time"] = _num(g.stance_time) if g is not None else math.nan
+        rec["flight_time"] = _num(g.flight_time) if g is not None else math.nan
         if g is not None:
             s = g.state
             rec.update(delta=s.delta, phi=s.phi, phid=s.phid, alpha_r=g.params.alpha_r)
@@ -108,12 +192,13 @@ def solve_line(spec: StudySpec, assignment: dict[str, float],
             for kind in KINDS:
                 rec[kind] = math.nan
                 rec[f"{kind}_status"] = ""
-            if g is not None and g.converged and rec["stability"] in ("asymptotic", "neutral"):
+            if g is not None and rec["converged"] and rec["stability"] in ("asymptotic",
+                                                                            "neutral"):
                 rr = robustness_report(g, n_steps=spec.n_steps, check=False)
                 for lim in rr.limits:
                     rec[lim.kind] = _num(lim.limit)
                     rec[f"{lim.kind}_status"] = lim.status.name if lim.status else ""
-        rec["message"] = branch.messages[i]
+        rec["message"] = messages[i]
         records.append(rec)
     dt = (time.perf_counter() - t0) / max(len(records), 1)
     for rec in records:
@@ -186,9 +271,9 @@ def run_study(
     inner = spec.axes[-1]
     keys: dict[tuple, str] = {}
     records: dict[str, dict[str, Any]] = {}
-    tasks: list[tuple[dict[str, float], list[float]]] = []
+    missing: list[list[float]] = []
     for assignment, axis in lines:
-        missing = []
+        miss = []
         for v in axis.values:
             point = {**assignment, inner.param: v}
             key = point_key(spec, point)
@@ -197,9 +282,8 @@ def run_study(
             if f is not None and f.exists():
                 records[key] = json.loads(f.read_text())
             else:
-                missing.append(v)
-        if missing:
-            tasks.append((assignment, missing))
+                miss.append(v)
+        missing.append(miss)
     n_total = spec.n_points
     n_cached = len(records)
     done = n_cached
@@ -218,33 +302,49 @@ def run_study(
         if progress:
             progress(done, n_total)
 
+    # 2-D studies: lines form two chains outward from the line nearest the base
+    # value; each line is seeded with its predecessor's solutions.
+    pred, succ = _chains(spec)
+
+    def seeds(i: int) -> dict[float, list] | None:
+        if pred[i] is None:
+            return None
+        assignment, axis = lines[pred[i]]
+        recs = [records[keys[tuple({**assignment, inner.param: v}[a.param]
+                                   for a in spec.axes)]] for v in axis.values]
+        return seeds_from_records(spec, recs)
+
     n_workers = workers if workers is not None else (os.cpu_count() or 1)
     if n_workers < 1:
         raise ValueError(f"workers must be >= 1, got {n_workers}")
-    if scheduler is not None:
-        _run_dask(scheduler, spec, tasks, store)
-    elif n_workers == 1 or len(tasks) <= 1:
-        for assignment, values in tasks:
-            store(solve_line(spec, assignment, values))
-    else:
-        ctx = mp.get_context("spawn")  # numba threads and fork do not mix
-        with cf.ProcessPoolExecutor(max_workers=min(n_workers, len(tasks)), mp_context=ctx,
-                                    initializer=_init_worker) as pool:
-            futures = [pool.submit(solve_line, spec, a, v) for a, v in tasks]
-            try:
-                for fut in cf.as_completed(futures):
-                    store(fut.result())
-            except BaseException:
-                for fut in futures:
-                    fut.cancel()
-                raise
+    ready = [i for i in range(len(lines)) if pred[i] is None]
+    with _executor(scheduler, n_workers, len(lines)) as ex:
+        running: dict[Any, int] = {}
+        try:
+            while ready or running:
+                while ready:
+                    i = ready.pop(0)
+                    if missing[i]:
+                        running[ex.submit(solve_line, spec, lines[i][0], missing[i],
+                                          seeds(i))] = i
+                    else:
+                        ready.extend(succ[i])  # fully cached: its successors may start
+                if running:
+                    for fut in ex.wait_first(list(running)):
+                        i = running.pop(fut)
+                        store(fut.result())
+                        ready.extend(succ[i])
+        except BaseException:
+            for fut in running:
+                fut.cancel()
+            raise
     rows = [records[keys[tuple(pt)]] for pt in _points(spec)]
     frame = pd.DataFrame(rows)
     meta = {
         "tslip_version": __version__, "git": _git_hash(), "study": spec.to_dict(),
         "points": n_total, "computed": n_total - n_cached, "cached": n_cached,
         "seconds": time.perf_counter() - t_start, "workers": n_workers,
-        "scheduler": scheduler,
+        "scheduler": scheduler, "tol": float(spec.meta.get("tol", 1e-10)),
     }
     if out_dir is not None:
         out = Path(out_dir)
@@ -262,12 +362,88 @@ def _points(spec: StudySpec) -> list[tuple[float, ...]]:
     return [(a, b) for a in spec.axes[0].values for b in spec.axes[1].values]
 
 
-def _run_dask(address: str, spec: StudySpec, tasks: list, store: Callable) -> None:
-    try:
-        from dask.distributed import Client, as_completed
-    except ImportError:
-        raise ValueError("--scheduler needs Dask: pip install 'tslip[dask]'") from None
-    with Client(address) as client:
-        futures = [client.submit(solve_line, spec, a, v, pure=False) for a, v in tasks]
-        for fut in as_completed(futures):
-            store(fut.result())
+def _chains(spec: StudySpec) -> tuple[list[int | None], list[list[int]]]:
+    """Predecessor and successors of each line (2-D continuation order)."""
+    n = len(spec.lines())
+    if len(spec.axes) == 1:
+        return [None], [[]]
+    outer = np.asarray(spec.axes[0].values)
+    i0 = int(np.argmin(np.abs(outer - get_param(spec.base, spec.axes[0].param))))
+    pred: list[int | None] = [i + 1 if i < i0 else i - 1 for i in range(n)]
+    pred[i0] = None
+    succ: list[list[int]] = [[] for _ in range(n)]
+    for i, p in enumerate(pred):
+        if p is not None:
+            succ[p].append(i)
+    return pred, succ
+
+
+class _Serial:
+    """Runs each task when submitted; same interface as the pools below."""
+
+    def __enter__(self) -> _Serial:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def submit(self, fn: Callable, *args: Any) -> cf.Future:
+        fut: cf.Future = cf.Future()
+        fut.set_result(fn(*args))
+        return fut
+
+    @staticmethod
+    def wait_first(futs: list) -> list:
+        return futs
+
+
+class _Pool(_Serial):
+    def __init__(self, n: int) -> None:
+        ctx = mp.get_context("spawn")  # numba threads and fork do not mix
+        self.pool = cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx,
+                                           initializer=_init_worker)
+
+    def __enter__(self) -> _Pool:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.pool.shutdown(wait=True, cancel_futures=True)
+
+    def submit(self, fn: Callable, *args: Any) -> cf.Future:
+        return self.pool.submit(fn, *args)
+
+    @staticmethod
+    def wait_first(futs: list) -> list:
+        return list(cf.wait(futs, return_when=cf.FIRST_COMPLETED).done)
+
+
+class _Dask(_Serial):
+    def __init__(self, address: str) -> None:
+        try:
+            from dask.distributed import Client
+        except ImportError:
+            raise ValueError("--scheduler needs Dask: pip install 'tslip[dask]'") from None
+        self.client = Client(address)
+
+    def __enter__(self) -> _Dask:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.client.close()
+
+    def submit(self, fn: Callable, *args: Any) -> Any:
+        return self.client.submit(fn, *args, pure=False)
+
+    @staticmethod
+    def wait_first(futs: list) -> list:
+        from dask.distributed import wait
+
+        return list(wait(futs, return_when="FIRST_COMPLETED").done)
+
+
+def _executor(scheduler: str | None, workers: int, n_lines: int) -> _Serial:
+    if scheduler is not None:
+        return _Dask(scheduler)
+    if workers == 1 or n_lines <= 1:
+        return _Serial()
+    return _Pool(min(workers, n_lines))

@@ -1,0 +1,116 @@
+"""``tslip study SPEC.toml`` (one study) and ``tslip reproduce`` (every thesis study)."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich import box
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+from rich.table import Table
+
+from .main import _console, _errors, app
+
+__all__ = ["study_cmd", "reproduce_cmd"]
+
+WorkersOpt = Annotated[int | None, typer.Option("--workers", min=1,
+                                                help="Worker processes (default: all cores).")]
+SchedulerOpt = Annotated[str | None, typer.Option(
+    "--scheduler", help="Dask scheduler address (needs tslip[dask]).")]
+
+
+class _Rate(TextColumn):
+    """Points per second."""
+
+    def __init__(self) -> None:
+        super().__init__("")
+
+    def render(self, task):  # noqa: ANN001, ANN201
+        from rich.text import Text
+
+        speed = task.finished_speed or task.speed
+        return Text(f"{speed:5.1f} pt/s" if speed else "   -- pt/s")
+
+
+@app.command("study")
+def study_cmd(
+    spec_path: Annotated[Path, typer.Argument(help="Study spec (TOML).", metavar="SPEC.toml")],
+    out: Annotated[Path | None, typer.Option("--out", help="Output folder (default: "
+                                             "studies/<name>).")] = None,
+    workers: WorkersOpt = None,
+    scheduler: SchedulerOpt = None,
+    csv: Annotated[bool, typer.Option("--csv", help="Also write results.csv.")] = False,
+) -> None:
+    """Run (or resume) one parameter study from a TOML spec."""
+    from ..sweeps import StudySpec, run_study
+
+    console = _console()
+    with _errors():
+        spec = StudySpec.from_toml(spec_path)
+        out_dir = out if out is not None else Path("studies") / spec.name
+        with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                      _Rate(), TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(),
+                      console=_console(stderr=True), transient=False) as bar:
+            task = bar.add_task(f"study {spec.name}", total=spec.n_points)
+            res = run_study(spec, out_dir, workers=workers, scheduler=scheduler, csv=csv,
+                            progress=lambda done, total: bar.update(task, completed=done))
+    f = res.frame
+    n_stable = int(f["stability"].isin(["asymptotic", "neutral"]).sum())
+    console.print(f"{spec.name}: {len(f)} points ({res.meta['cached']} cached), "
+                  f"{int(f['converged'].sum())} with a periodic gait, {n_stable} stable or "
+                  f"neutral, {res.meta['seconds']:.1f} s")
+    console.print(f"wrote {out_dir / 'results.parquet'}" + (" and results.csv" if csv else "")
+                  + " and run.json")
+
+
+@app.command("reproduce")
+def reproduce_cmd(
+    quick: Annotated[bool, typer.Option("--quick", help="Coarse resolution (about a "
+                                        "minute).")] = False,
+    out: Annotated[Path, typer.Option("--out", help="Report folder.")] = Path("report"),
+    workers: WorkersOpt = None,
+    scheduler: SchedulerOpt = None,
+) -> None:
+    """Run every thesis study and write a report (out/index.html)."""
+    from ..plotting.report import reproduce
+    from ..sweeps import catalogue
+
+    console = _console()
+    n_studies = len(catalogue.STUDIES)
+    t0 = time.perf_counter()
+    state = {"studies": 0}
+
+    def progress(stage: str, name: str, seconds: float) -> None:
+        el = time.perf_counter() - t0
+        if stage == "study":
+            state["studies"] += 1
+            console.print(f"[{el:6.1f} s] study {state['studies']:2d}/{n_studies} {name} "
+                          f"done ({seconds:.1f} s)")
+        elif stage == "figure":
+            console.print(f"[{el:6.1f} s] figure {name} ({seconds:.1f} s)")
+
+    with _errors():
+        path = reproduce(out, quick=quick, workers=workers, scheduler=scheduler,
+                         progress=progress)
+    import json
+
+    claims = json.loads(path.with_name("claims.json").read_text())
+    t = Table(title="thesis claims", box=box.SIMPLE_HEAD, title_justify="left")
+    t.add_column("figure")
+    t.add_column("claim")
+    t.add_column("holds")
+    for c in claims:
+        t.add_row(c["figure"], c["claim"], "yes" if c["holds"] else "NO")
+    console.print(t)
+    n = sum(c["holds"] for c in claims)
+    console.print(f"{n} of {len(claims)} claims hold; {time.perf_counter() - t0:.1f} s")
+    console.print(f"report: {path}")

@@ -1,0 +1,167 @@
+"""Plots of parameter studies (:class:`tslip.sweeps.StudyResult`).
+
+The thesis's figure types: non-trivial multiplier magnitudes against the
+swept parameter with the stable domain shaded green (4.8, 4.12, ...), the
+three robustness panels (4.9, 4.13, ...), the stable region of a k x beta0
+grid (4.10), stance and flight time against eqs. 3.10-3.11 (4.11) and the
+four controllers overlaid (4.24, 4.25). Results in, Figure out.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.colors import ListedColormap
+from matplotlib.figure import Figure
+
+from .sweeps import _STABLE_GREEN, _runs
+
+if TYPE_CHECKING:
+    from ..sweeps.run import StudyResult
+
+__all__ = ["plot_study_multipliers", "plot_study_robustness", "plot_stable_grid",
+           "plot_stride_times", "plot_controllers_multipliers", "plot_controllers_robustness"]
+
+_ROB = (("step_down", "max step-down Δh [L]"), ("push", "max push Δẋ [g½L½]"),
+        ("pitch_rate", "max pitch rate Δφ̇ [rad g½L-½]"))
+
+
+def _stable(frame) -> np.ndarray:  # noqa: ANN001 - DataFrame
+    return (frame["converged"].to_numpy(bool)
+            & frame["stability"].isin(["asymptotic", "neutral"]).to_numpy()
+            & (frame["max_nontrivial"].to_numpy(float) < 1.0))
+
+
+def _shade(ax: Axes, x: np.ndarray, mask: np.ndarray, color: str = _STABLE_GREEN,
+           alpha: float = 1.0) -> None:
+    for i, j in _runs(mask):
+        lo = x[i] - (0.5 * (x[i] - x[i - 1]) if i > 0 else 0.0)
+        hi = x[j] + (0.5 * (x[j + 1] - x[j]) if j + 1 < len(x) else 0.0)
+        ax.axvspan(lo, hi, color=color, lw=0, zorder=0, alpha=alpha)
+
+
+def _nontrivial(frame) -> np.ndarray:  # noqa: ANN001
+    """|lambda| per point with the ``n_trivial`` values closest to 1 removed."""
+    mags = frame[[f"abs_lambda_{j}" for j in range(1, 6)]].to_numpy(float).copy()
+    for i, n in enumerate(frame["n_trivial"].to_numpy(int)):
+        for _ in range(n):
+            k = np.nanargmin(np.abs(mags[i] - 1.0)) if np.isfinite(mags[i]).any() else None
+            if k is not None:
+                mags[i, k] = np.nan
+    return mags
+
+
+def _fig(ax: Axes | None, size: tuple[float, float]) -> tuple[Figure, Axes]:
+    if ax is None:
+        fig = Figure(figsize=size, layout="constrained")
+        return fig, fig.add_subplot()
+    return ax.figure, ax  # type: ignore[return-value]
+
+
+def plot_study_multipliers(result: StudyResult, ax: Axes | None = None, *,
+                           title: str | None = None) -> Figure:
+    """Non-trivial ``|lambda|`` against the swept parameter; stable domain green."""
+    fig, ax = _fig(ax, (6.4, 3.4))
+    f = result.frame
+    param = result.spec.axes[-1].param
+    x = f[param].to_numpy(float)
+    _shade(ax, x, _stable(f))
+    mags = _nontrivial(f)
+    for k in range(mags.shape[1]):
+        ax.plot(x, mags[:, k], "o", ms=3, color="C0", label="|λ| (non-trivial)" if k == 0 else None)
+    none = ~f["converged"].to_numpy(bool)
+    if none.any():
+        ax.plot(x[none], np.zeros(none.sum()), "x", color="C3", ms=4, label="no periodic gait")
+    ax.axhline(1.0, color="k", ls="--", lw=0.8)
+    top = np.nanmax(mags) if np.isfinite(mags).any() else 1.5
+    ax.set_ylim(0, min(max(1.5, top * 1.05), 3.0))
+    ax.set_xlabel(param)
+    ax.set_ylabel("|λ|")
+    ax.legend(loc="upper right", fontsize=7)
+    ax.set_title(title or f"{result.spec.name}: Floquet multipliers (green: stable)", fontsize=9)
+    return fig
+
+
+def plot_study_robustness(result: StudyResult, axes: Sequence[Axes] | None = None, *,
+                          label: str | None = None, color: str = "C0",
+                          shade: bool = True) -> Figure:
+    """The three robustness limits (step-down, push, pitch rate) against the parameter."""
+    if axes is None:
+        fig = Figure(figsize=(6.4, 6.0), layout="constrained")
+        axes = list(fig.subplots(3, 1, sharex=True))
+    else:
+        fig = axes[0].figure  # type: ignore[assignment]
+    f = result.frame
+    param = result.spec.axes[-1].param
+    x = f[param].to_numpy(float)
+    for a, (col, ylabel) in zip(axes, _ROB):
+        if shade:
+            _shade(a, x, _stable(f))
+        a.plot(x, f[col].to_numpy(float) if col in f else np.full(len(x), np.nan), "o-",
+               ms=3, lw=1, color=color, label=label)
+        a.set_ylabel(ylabel, fontsize=8)
+    axes[-1].set_xlabel(param)
+    if label:
+        axes[0].legend(fontsize=7)
+    return fig
+
+
+def plot_stable_grid(results: Mapping[float, StudyResult]) -> Figure:
+    """Figure 4.10: one k x beta0 panel per speed; stable / unstable / no gait."""
+    n = len(results)
+    fig = Figure(figsize=(3.0 * n, 3.2), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(1, n, sharey=True))
+    cmap = ListedColormap(["white", "#f4b6b6", _STABLE_GREEN])
+    for a, (v, res) in zip(axes, results.items()):
+        f = res.frame
+        code = np.where(_stable(f), 2, np.where(f["converged"].to_numpy(bool), 1, 0))
+        grid = code.reshape(res.spec.shape)
+        k, b = res.spec.axes[0].values, res.spec.axes[1].values
+        a.pcolormesh(b, k, grid, cmap=cmap, vmin=0, vmax=2, shading="nearest")
+        a.set_title(f"v0 = {v:g}: stable {np.mean(grid == 2):.0%}", fontsize=9)
+        a.set_xlabel("β0 [rad]")
+    axes[0].set_ylabel("k [Mg/L]")
+    return fig
+
+
+def plot_stride_times(results: Mapping[str, StudyResult]) -> Figure:
+    """Figure 4.11: stance and flight time (model, dots) against eqs. 3.10-3.11 (lines)."""
+    n = len(results)
+    fig = Figure(figsize=(3.2 * n, 4.8), layout="constrained")
+    axes = fig.subplots(2, n, squeeze=False)
+    for j, res in enumerate(results.values()):
+        f = res.frame
+        param = res.spec.axes[-1].param
+        x = f[param].to_numpy(float)
+        for i, (col, lab) in enumerate((("stance_time", "t_s"), ("flight_time", "t_f"))):
+            a = axes[i, j]
+            a.plot(x, f[col], "o", ms=3, label=f"{lab} model")
+            pred = f.get(f"{col}_predicted")
+            if pred is not None:
+                a.plot(x, pred, "-", color="C1", label=f"{lab} eq. {3.10 if i == 0 else 3.11}")
+            a.set_ylabel(f"{lab} [g-½L½]")
+            a.legend(fontsize=7)
+        axes[1, j].set_xlabel(param)
+    return fig
+
+
+def plot_controllers_multipliers(results: Mapping[str, StudyResult]) -> Figure:
+    """Figure 4.24: one multiplier panel per controller over r."""
+    n = len(results)
+    fig = Figure(figsize=(6.4, 2.2 * n), layout="constrained")
+    axes = fig.subplots(n, 1, sharex=True)
+    for a, (name, res) in zip(np.atleast_1d(axes), results.items()):
+        plot_study_multipliers(res, a, title=name)
+    return fig
+
+
+def plot_controllers_robustness(results: Mapping[str, StudyResult]) -> Figure:
+    """Figure 4.25: the three robustness panels with the controllers overlaid."""
+    fig = Figure(figsize=(6.4, 6.0), layout="constrained")
+    axes = list(fig.subplots(3, 1, sharex=True))
+    for i, (name, res) in enumerate(results.items()):
+        plot_study_robustness(res, axes, label=name, color=f"C{i}", shade=False)
+    return fig

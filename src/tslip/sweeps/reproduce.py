@@ -1,0 +1,165 @@
+"""Run every thesis study, test every claim, write one HTML report.
+
+:func:`run_all` runs the studies of :mod:`tslip.sweeps.catalogue` (each
+cached under ``out_dir/studies/<name>/``, so a rerun is instant and an
+interrupted one resumes), computes the single-gait figures, evaluates
+:data:`tslip.sweeps.claims.CLAIMS`; :func:`tslip.plotting.report.reproduce`
+then writes ``out_dir/index.html``.
+
+Parallelism: most studies are one continuation line, so the studies
+themselves are the unit of work: they run in spawned worker processes (one
+study per process, serial inside), largest first, while this process
+computes the single-gait figures. With ``scheduler`` every study runs on
+that Dask cluster instead.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import multiprocessing as mp
+import os
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from ..gait import find_gait, floquet, robustness_report, stride_properties
+from ..model.parameters import preset
+from . import catalogue
+from .claims import ClaimResult, evaluate
+from .run import StudyResult, _init_worker, run_study
+from .spec import StudySpec
+
+__all__ = ["run_all", "run_catalogue", "single_figures", "table61"]
+
+#: ``progress(stage, name, seconds)`` after each study or figure.
+Progress = Callable[[str, str, float], None]
+
+
+def _run_one(spec: StudySpec, out: str) -> StudyResult:
+    return run_study(spec, out, workers=1)
+
+
+def run_catalogue(out_dir: str | Path, *, quick: bool = False, workers: int | None = None,
+                  scheduler: str | None = None, progress: Progress | None = None,
+                  names: list[str] | None = None,
+                  side_job: Callable[[], Any] | None = None) -> tuple[dict[str, StudyResult], Any]:
+    """Run (or load from cache) the catalogue's studies; optionally a side job meanwhile.
+
+    Returns the results by study name and the side job's return value.
+    """
+    specs = catalogue.studies(quick)
+    if names is not None:
+        specs = {n: specs[n] for n in names}
+    root = Path(out_dir) / "studies"
+    n_workers = workers if workers is not None else (os.cpu_count() or 1)
+    if n_workers < 1:
+        raise ValueError(f"workers must be >= 1, got {n_workers}")
+    results: dict[str, StudyResult] = {}
+    side = None
+
+    def done(name: str, res: StudyResult, t0: float) -> None:
+        results[name] = res
+        if progress:
+            progress("study", name, time.perf_counter() - t0)
+
+    order = sorted(specs, key=lambda n: -specs[n].n_points * (3 if "robustness" in
+                                                                   specs[n].analyses else 1))
+    if scheduler is not None or n_workers == 1:
+        if side_job is not None:
+            side = side_job()
+        for name in order:
+            t0 = time.perf_counter()
+            done(name, run_study(specs[name], root / name, workers=1, scheduler=scheduler), t0)
+        return results, side
+    _warm_up()
+    ctx = mp.get_context("spawn")
+    t0 = time.perf_counter()
+    with cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx,
+                                initializer=_init_worker) as pool:
+        futs = {pool.submit(_run_one, specs[n], str(root / n)): n for n in order}
+        if side_job is not None:
+            side = side_job()
+        try:
+            for fut in cf.as_completed(futs):
+                done(futs[fut], fut.result(), t0)
+        except BaseException:
+            for fut in futs:
+                fut.cancel()
+            raise
+    return results, side
+
+
+def _warm_up() -> None:
+    """Compile (or load) every kernel here once, so workers find them in numba's cache."""
+    g = find_gait(preset("table2.1"))
+    floquet(g)
+    stride_properties(g)
+    robustness_report(g, n_steps=2, check=False)
+
+
+def table61() -> dict[str, float]:
+    """Table 6.1 gait: multipliers, robustness (Section 6.1), stride (Table 6.2)."""
+    g = find_gait(preset("table6.1"))
+    fl = floquet(g)
+    rr = robustness_report(g, check=False)
+    sp = stride_properties(g)
+    return {"max_nontrivial": fl.max_nontrivial, "stability": fl.stability,
+            "step_down": rr.step_down, "push": rr.push, "pitch_rate": rr.pitch_rate,
+            "stance_time": sp.stance_time, "flight_time": sp.flight_time,
+            "duty_factor": sp.duty_factor, "step_frequency": sp.step_frequency,
+            "alphad_ref": g.params.controller.alphad_ref, "alpha_r": g.params.alpha_r}
+
+
+def single_figures(quick: bool = False, progress: Progress | None = None) -> dict[str, Any]:
+    """The single-gait analyses (Figures 4.1-4.7, 6.2, C.1) and Table 6.1's numbers."""
+    jobs: dict[str, Callable[[], Any]] = {
+        "4.1": catalogue.fig_impulse_linearisation,
+        "4.2": lambda: catalogue.fig_pitch_disturbance("table2.1"),
+        "4.3": lambda: catalogue.fig_pitch_disturbance("table2.1-global-pd"),
+        "6.2": lambda: catalogue.fig_pitch_disturbance("table6.1"),
+        "4.4": lambda: catalogue.fig_height_change(quick),
+        "4.5": catalogue.fig_step_down,
+        "4.7": catalogue.fig_velocity_angle,
+        "C.1": catalogue.fig_friction,
+        "table6.1": table61,
+    }
+    out = {}
+    for key, job in jobs.items():
+        t0 = time.perf_counter()
+        out[key] = job()
+        if progress:
+            progress("figure", key, time.perf_counter() - t0)
+    return out
+
+
+def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = None,
+            scheduler: str | None = None,
+            progress: Progress | None = None) -> tuple[dict[str, Any], list[ClaimResult], float]:
+    """Run every thesis study and figure; return the data, the claims and the seconds.
+
+    The report itself is written by :func:`tslip.plotting.report.reproduce`
+    (sweeps does not import plotting).
+
+    Parameters
+    ----------
+    out_dir : path
+        Report folder; studies are cached in ``out_dir/studies/<name>/``.
+    quick : bool
+        Coarse resolution (12 points a line, 6 x 6 grids) instead of the full
+        one (50 points, 40 x 40).
+    workers : int, optional
+        Worker processes (default all cores; 1 runs everything here).
+    scheduler : str, optional
+        Dask scheduler address for the studies.
+    progress : callable, optional
+        ``progress(stage, name, seconds)`` after each study and figure.
+    """
+    t0 = time.perf_counter()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    results, figures = run_catalogue(out, quick=quick, workers=workers, scheduler=scheduler,
+                                     progress=progress,
+                                     side_job=lambda: single_figures(quick, progress))
+    data: dict[str, Any] = {**results, **figures}
+    return data, evaluate(data), time.perf_counter() - t0
