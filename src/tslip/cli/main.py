@@ -519,6 +519,7 @@ def demo_cmd(
         console.print(f"done in {time.perf_counter() - t_start:.1f} s")
 
 
+from . import biped as _biped_commands  # noqa: E402, F401  (the biped group)
 from . import experiment as _experiment_commands  # noqa: E402, F401  (synth-video ... fit)
 from . import gait as _gait_commands  # noqa: E402, F401  (registers gait, continue)
 from . import studies as _study_commands  # noqa: E402, F401  (study, reproduce)

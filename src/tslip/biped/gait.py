@@ -1,0 +1,346 @@
+"""Biped stride map, periodic-gait search, Floquet multipliers, tracking, metacentre.
+
+The Poincare section is the state just after a right-foot touch-down (Section
+E.2.6). The controller is clocked by time (eqs E.25-E.27), so the section
+state is ``z = (q[1:], qd, rho_R)``: eq. E.35's state without ``x_b`` plus the
+right-leg phase at touch-down, which eq. E.36 leaves out. Without it a stride
+whose duration differs from ``T`` would count as periodic although the next
+stride starts at a different controller phase.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from . import _kernels as kn
+from . import _pack as pk
+from .dynamics import controller_references, leg_phase
+from .parameters import STATE_FIELDS, BipedParams, BipedState
+from .simulate import BipedOptions, BipedStatus, BipedTrajectory, simulate, stride
+
+__all__ = [
+    "SECTION_FIELDS",
+    "to_section",
+    "from_section",
+    "stride_map",
+    "FloquetResult",
+    "floquet",
+    "strides_until_fall",
+    "TrackingErrors",
+    "tracking_errors",
+    "GaitSearchResult",
+    "find_periodic_gait",
+    "metacentric_test",
+]
+
+SECTION_FIELDS: tuple[str, ...] = STATE_FIELDS[1:] + ("rho_R",)
+NZ = 18
+
+
+def _wrap(d: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Wrap the phase difference (last entry) to [-0.5, 0.5)."""
+    d = d.copy()
+    d[-1] = (d[-1] + 0.5) % 1.0 - 0.5
+    return d
+
+
+def to_section(params: BipedParams, y: NDArray[np.float64], t: float) -> NDArray[np.float64]:
+    """Section vector ``(q[1:], qd, rho_R)`` of a state ``y`` at time ``t``."""
+    return np.concatenate([np.asarray(y, dtype=np.float64)[1:], [leg_phase(params, t, 0)]])
+
+
+def from_section(params: BipedParams, z: NDArray[np.float64]) -> tuple[NDArray[np.float64],
+                                                                       float]:
+    """State ``y`` (with ``x_b = 0``) and start time ``t0`` of a section vector."""
+    z = np.asarray(z, dtype=np.float64)
+    if z.shape != (NZ,):
+        raise ValueError(f"section vector must have shape ({NZ},), got {z.shape}")
+    y = np.concatenate([[0.0], z[:17]])
+    t0 = ((z[17] - params.rho0) % 1.0) * params.T
+    return y, t0
+
+
+def stride_map(params: BipedParams, z: NDArray[np.float64],
+               options: BipedOptions | None = None) -> tuple[NDArray[np.float64], BipedStatus]:
+    """One stride from section vector ``z``: the next section vector and status."""
+    y, t0 = from_section(params, z)
+    res = stride(params, y, t0, options=options)
+    if res.status != BipedStatus.OK:
+        return np.full(NZ, np.nan), res.status
+    return to_section(params, res.state, res.t), res.status
+
+
+@dataclass(frozen=True)
+class FloquetResult:
+    """Multipliers of the linearised stride map at a section vector.
+
+    Attributes
+    ----------
+    multipliers : ndarray, shape (18,), complex
+        Sorted by decreasing magnitude.
+    jacobian : ndarray, shape (18, 18)
+    residual : float
+        ``|P(z) - z|`` (phase wrapped); near zero only at a periodic gait.
+    largest : float
+        Largest magnitude.
+    """
+
+    multipliers: NDArray[np.complex128]
+    jacobian: NDArray[np.float64]
+    residual: float
+    largest: float
+    z: NDArray[np.float64] = field(repr=False)
+
+
+def floquet(params: BipedParams, z: NDArray[np.float64], *, eps: float = 1e-6,
+            options: BipedOptions | None = None) -> FloquetResult:
+    """Floquet multipliers by central differences of :func:`stride_map`.
+
+    The touch-down section constrains ``z_b`` (the right foot is on the
+    ground), so one multiplier is near zero. A run that falls within a
+    perturbed stride gives NaN multipliers.
+    """
+    z = np.asarray(z, dtype=np.float64)
+    z1, st = stride_map(params, z, options)
+    Jm = np.empty((NZ, NZ))
+    for i in range(NZ):
+        dz = np.zeros(NZ)
+        dz[i] = eps
+        zp, _ = stride_map(params, z + dz, options)
+        zm, _ = stride_map(params, z - dz, options)
+        Jm[:, i] = _wrap(zp - zm) / (2 * eps)
+    if not np.all(np.isfinite(Jm)):
+        ev = np.full(NZ, np.nan + 0j)
+    else:
+        ev = np.linalg.eigvals(Jm)
+        ev = ev[np.argsort(-np.abs(ev))]
+    res = float(np.linalg.norm(_wrap(z1 - z))) if st == BipedStatus.OK else math.inf
+    return FloquetResult(ev, Jm, res, float(np.abs(ev[0])), z)
+
+
+def strides_until_fall(params: BipedParams, state: BipedState | NDArray[np.float64],
+                       t0: float = 0.0, max_strides: int = 50,
+                       options: BipedOptions | None = None) -> tuple[int, BipedTrajectory]:
+    """Completed strides before a fall (``max_strides`` if none), and the run."""
+    tr = simulate(params, state, max_strides, t0=t0, options=options)
+    return tr.n_strides, tr
+
+
+@dataclass(frozen=True)
+class TrackingErrors:
+    """RMS and max controller tracking errors over a run (Figure E.2)."""
+
+    thigh_rms: float
+    thigh_max: float
+    hip_rms: float
+    hip_max: float
+    shank_range: tuple[float, float]
+
+
+def tracking_errors(tr: BipedTrajectory, leg: int = 0, t_from: float = -math.inf,
+                    t_to: float = math.inf) -> TrackingErrors:
+    """Thigh-length and hip-angle tracking errors of a leg (eqs E.29, E.32)."""
+    m = (tr.time >= t_from) & (tr.time <= t_to)
+    t = tr.time[m]
+    side = "R" if leg == 0 else "L"
+    ref = controller_references(tr.params, leg_phase(tr.params, t, leg))
+    e_l = tr[f"l_t{side}"][m] - ref[:, 0]
+    e_h = tr[f"theta_h{side}"][m] - ref[:, 2]
+    ls = tr[f"l_s{side}"][m]
+    return TrackingErrors(float(np.sqrt(np.mean(e_l**2))), float(np.abs(e_l).max()),
+                          float(np.sqrt(np.mean(e_h**2))), float(np.abs(e_h).max()),
+                          (float(ls.min()), float(ls.max())))
+
+
+@dataclass(frozen=True)
+class GaitSearchResult:
+    """Outcome of :func:`find_periodic_gait` (never raised on non-convergence).
+
+    Attributes
+    ----------
+    converged : bool
+        Residual below ``tol``.
+    residual : float
+        Best ``|P(z) - z|`` reached.
+    z : ndarray, shape (18,)
+        Best section vector.
+    params : BipedParams
+        Parameters with the best free parameter values.
+    message : str
+    evaluations : int
+    history : list of float
+        Best residual after each stage.
+    """
+
+    converged: bool
+    residual: float
+    z: NDArray[np.float64]
+    params: BipedParams
+    message: str
+    evaluations: int
+    history: list[float] = field(default_factory=list)
+
+
+#: Free section entries of the thesis search (starred in Table E.2): pitch
+#: rate, right-leg rates and the whole left leg.
+THESIS_FREE_STATE: tuple[str, ...] = (
+    "theta_b_d", "l_tR_d", "l_sR_d", "theta_hR_d", "l_tL", "l_sL", "theta_hL", "l_tL_d",
+    "l_sL_d", "theta_hL_d",
+)
+
+
+def find_periodic_gait(
+    params: BipedParams,
+    z0: NDArray[np.float64],
+    *,
+    free_state: Sequence[str] = THESIS_FREE_STATE + ("rho_R",),
+    free_params: Sequence[str] = (),
+    bounds: dict[str, tuple[float, float]] | None = None,
+    cma_evals: int = 600,
+    sigma0: float = 0.05,
+    lsq_evals: int = 200,
+    tol: float = 1e-8,
+    seed: int = 1,
+    options: BipedOptions | None = None,
+    objective: Any = None,
+) -> GaitSearchResult:
+    """Search a periodic gait: CMA-ES (``cma``) then least squares on the stride map.
+
+    The residual is ``P(z) - z`` on the section (eq. E.36 plus the phase).
+    The right foot stays on the ground at the start: ``z_b`` follows from
+    the other coordinates. ``objective`` (optional) adds a scalar penalty to
+    the CMA-ES cost (used by the stable-gait search).
+
+    Returns
+    -------
+    GaitSearchResult
+        With ``converged=False`` and the best residual when the search stalls.
+    """
+    import cma
+    from scipy.optimize import least_squares
+
+    names = list(free_state) + list(free_params)
+    bad = [n for n in free_state if n not in SECTION_FIELDS]
+    bad += [n for n in free_params if not hasattr(params, n)]
+    if bad:
+        raise ValueError(f"unknown free variable(s) {bad}")
+    if not names:
+        raise ValueError("no free variables given")
+    idx = [SECTION_FIELDS.index(n) for n in free_state]
+    z0 = np.asarray(z0, dtype=np.float64)
+    x0 = np.concatenate([z0[idx], [float(getattr(params, n)) for n in free_params]])
+    bounds = bounds or {}
+    lo = np.array([bounds.get(n, (-np.inf, np.inf))[0] for n in names])
+    hi = np.array([bounds.get(n, (-np.inf, np.inf))[1] for n in names])
+    nev = [0]
+
+    def unpack(x: NDArray[np.float64]) -> tuple[BipedParams, NDArray[np.float64]]:
+        p = params.replace(**{n: float(v) for n, v in zip(free_params, x[len(idx):],
+                                                           strict=True)})
+        z = z0.copy()
+        z[idx] = x[: len(idx)]
+        z[17] %= 1.0
+        y, _ = from_section(p, z)
+        z[0] = _ground_height(p, y)
+        return p, z
+
+    def residual(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        nev[0] += 1
+        try:
+            p, z = unpack(x)
+        except ValueError:
+            return np.full(NZ, 10.0)
+        z1, st = stride_map(p, z, options)
+        if st != BipedStatus.OK:
+            return np.full(NZ, 10.0)
+        return _wrap(z1 - z)
+
+    def cost(x: NDArray[np.float64]) -> float:
+        r = residual(x)
+        c = float(r @ r)
+        if objective is not None and c < 1.0:
+            c += float(objective(*unpack(x)))
+        return c
+
+    history: list[float] = []
+    best_x = x0
+    best = float(np.linalg.norm(residual(x0)))
+    history.append(best)
+    if cma_evals > 0:
+        finite = np.isfinite(lo) & np.isfinite(hi)
+        opts = {"seed": seed, "maxfevals": cma_evals, "verbose": -9, "tolfun": 1e-14}
+        if finite.any():
+            opts["bounds"] = [np.where(finite, lo, -np.inf).tolist(),
+                              np.where(finite, hi, np.inf).tolist()]
+        es = cma.CMAEvolutionStrategy(x0, sigma0, opts)
+        es.optimize(cost)
+        xb = es.result.xbest
+        rb = float(np.linalg.norm(residual(xb)))
+        if rb < best:
+            best, best_x = rb, xb
+        history.append(best)
+    if lsq_evals > 0 and best < 10.0:
+        lb = np.where(np.isfinite(lo), lo, -np.inf)
+        ub = np.where(np.isfinite(hi), hi, np.inf)
+        xs = np.clip(best_x, lb + 1e-12, ub - 1e-12)
+        sol = least_squares(residual, xs, bounds=(lb, ub), max_nfev=lsq_evals, xtol=1e-15,
+                            ftol=1e-15, gtol=1e-15, diff_step=1e-7)
+        rb = float(np.linalg.norm(residual(sol.x)))
+        if rb < best:
+            best, best_x = rb, sol.x
+        history.append(best)
+    p, z = unpack(best_x)
+    ok = best < tol
+    msg = (f"periodic gait found, residual {best:.2e}" if ok else
+           f"no periodic gait to tolerance {tol:g}: best residual {best:.2e}")
+    return GaitSearchResult(ok, best, z, p, msg, nev[0], history)
+
+
+def _ground_height(p: BipedParams, y: NDArray[np.float64]) -> float:
+    """``z_b`` that puts the right foot at the ground (section constraint)."""
+    P = pk.pack_params(p)
+    _, zf, _, _ = kn.foot_state(P, y, 0)
+    return float(y[1] - zf)
+
+
+def metacentric_test(params: BipedParams, state: BipedState, t0: float = 0.0,
+                     pitches: Sequence[float] = (0.0, 0.5, -0.5),
+                     options: BipedOptions | None = None) -> list[dict[str, Any]]:
+    """Ground reaction forces and impulse of the first right stance for pitch changes.
+
+    The body pitch is changed by each ``dtheta`` about the body CoM with the
+    legs kept fixed in the world: both hip angles change by ``-dtheta``, and
+    the body is shifted so the hip stays where it was (Section E.3.3,
+    Figure E.4).
+
+    Returns
+    -------
+    list of dict
+        Per pitch change: ``dtheta``, times ``t``, forces ``Fx``, ``Fz``,
+        impulse ``(Ix, Iz)`` and the impulse's moment arm about the CoM.
+    """
+    out = []
+    for dth in pitches:
+        q = state.q.copy()
+        qd = state.qd.copy()
+        hip = q[:2] + params.r_1 * np.array([math.sin(q[2]), math.cos(q[2])])
+        q[2] += dth
+        q[5] -= dth
+        q[8] -= dth
+        q[:2] = hip - params.r_1 * np.array([math.sin(q[2]), math.cos(q[2])])
+        tr = simulate(params, BipedState(q, qd), 1, t0=t0, options=options)
+        lo = [e.t for e in tr.events if e.kind == "liftoff_R"]
+        t_lo = lo[0] if lo else tr.time[-1]
+        m = tr.time <= t_lo
+        t = tr.time[m]
+        fx, fz = tr["Fx_R"][m], tr["Fz_R"][m]
+        ix, iz = float(np.trapezoid(fx, t)), float(np.trapezoid(fz, t))
+        out.append({"dtheta": dth, "t": t, "Fx": fx, "Fz": fz, "impulse": (ix, iz),
+                    "status": tr.status.name})
+    return out

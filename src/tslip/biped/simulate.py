@@ -1,0 +1,356 @@
+"""Public biped simulation API: runs, the stride map, typed results.
+
+Validates inputs, calls :func:`._kernels.run`, and maps its flat arrays and
+status to a :class:`BipedTrajectory`. A stride is right-foot touch-down to
+the next right-foot touch-down (Section E.2.5).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from . import _kernels as kn
+from . import _pack as pk
+from .parameters import STATE_FIELDS, BipedParams, BipedState
+
+__all__ = [
+    "BipedOptions",
+    "BipedStatus",
+    "BipedEvent",
+    "BipedTrajectory",
+    "StrideResult",
+    "simulate",
+    "stride",
+    "RECORD_COLUMNS",
+]
+
+#: Columns of :attr:`BipedTrajectory.data`.
+RECORD_COLUMNS: tuple[str, ...] = (
+    ("t",) + STATE_FIELDS + ("contact_R", "contact_L", "Fx_R", "Fz_R", "Fx_L", "Fz_L",
+                              "tau_R", "tau_L", "F_tR", "F_tL", "F_sR", "F_sL")
+)
+
+
+class BipedStatus(enum.IntEnum):
+    """Outcome of a biped run."""
+
+    OK = pk.ST_OK
+    T_END = pk.ST_TEND
+    FALL_HIP = pk.ST_FALL_HIP
+    FALL_BACKWARD = pk.ST_FALL_BACKWARD
+    FALL_PITCH = pk.ST_FALL_PITCH
+    FALL_LEG = pk.ST_FALL_LEG
+    FALL_NO_TOUCHDOWN = pk.ST_FALL_NO_TD
+    ERR_MAX_STEPS = pk.ST_ERR_MAX_STEPS
+    ERR_STEP_UNDERFLOW = pk.ST_ERR_UNDERFLOW
+    ERR_NONFINITE = pk.ST_ERR_NONFINITE
+
+    @property
+    def fell(self) -> bool:
+        """True for a fall (not an integrator failure)."""
+        return 10 <= int(self) < 20
+
+    @property
+    def is_error(self) -> bool:
+        """True for an integrator failure."""
+        return int(self) >= 20
+
+    @property
+    def reason(self) -> str:
+        """One-line description."""
+        return _REASONS[self]
+
+
+_REASONS = {
+    BipedStatus.OK: "completed the requested strides",
+    BipedStatus.T_END: "reached the end time",
+    BipedStatus.FALL_HIP: "fall: a hip reached the ground",
+    BipedStatus.FALL_BACKWARD: "fall: the body moved backward (xd_b < 0)",
+    BipedStatus.FALL_PITCH: "fall: body pitch beyond +-pi/2",
+    BipedStatus.FALL_LEG: "fall: a thigh or shank length reached zero",
+    BipedStatus.FALL_NO_TOUCHDOWN: "fall: no right touch-down within the stride time limit",
+    BipedStatus.ERR_MAX_STEPS: "integrator: maximum number of steps",
+    BipedStatus.ERR_STEP_UNDERFLOW: "integrator: step size underflow",
+    BipedStatus.ERR_NONFINITE: "integrator: non-finite state",
+}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BipedOptions:
+    """Integrator options of the biped simulator.
+
+    Parameters
+    ----------
+    rtol, atol : float
+        DOPRI5 tolerances (thesis: 1e-8, Section E.2.5).
+    h0, h_max, h_min : float
+        First, largest and smallest step [g^-1/2 L^1/2] (``h0 = 0``: 1e-3).
+    max_steps : int
+        Step limit per run (accepted + rejected).
+    stride_time_max : float
+        A right touch-down must follow the previous one within this time
+        [g^-1/2 L^1/2], otherwise the run is a fall.
+    check_falls : bool
+        Stop at falls (off for the free-flight conservation tests).
+    max_records : int
+        Rows of the recorded trajectory (one per accepted step).
+    """
+
+    rtol: float = 1e-8
+    atol: float = 1e-8
+    h0: float = 0.0
+    h_max: float = 0.05
+    h_min: float = 1e-12
+    max_steps: int = 5_000_000
+    stride_time_max: float = 5.0
+    check_falls: bool = True
+    max_records: int = 400_000
+
+    def __post_init__(self) -> None:
+        for name in ("rtol", "atol", "h_max", "h_min", "stride_time_max"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be a positive number, got {v!r}")
+        if not (isinstance(self.h0, (int, float)) and math.isfinite(self.h0) and self.h0 >= 0):
+            raise ValueError(f"h0 must be >= 0, got {self.h0!r}")
+        for name in ("max_steps", "max_records"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, np.integer)) or v < 1:
+                raise ValueError(f"{name} must be an integer >= 1, got {v!r}")
+
+    def pack(self, t_end: float = math.inf) -> NDArray[np.float64]:
+        """Options vector for the kernels."""
+        O = np.zeros(pk.NO)
+        O[pk.O_RTOL] = self.rtol
+        O[pk.O_ATOL] = self.atol
+        O[pk.O_H0] = self.h0
+        O[pk.O_HMAX] = self.h_max
+        O[pk.O_HMIN] = self.h_min
+        O[pk.O_MAXSTEPS] = self.max_steps
+        O[pk.O_TSTRIDE] = self.stride_time_max
+        O[pk.O_TEND] = t_end
+        O[pk.O_FALLS] = 1.0 if self.check_falls else 0.0
+        return O
+
+
+_EVENT_NAMES = {pk.EV_TD_R: "touchdown_R", pk.EV_TD_L: "touchdown_L", pk.EV_LO_R: "liftoff_R",
+                pk.EV_LO_L: "liftoff_L", pk.EV_FALL: "fall"}
+
+
+@dataclass(frozen=True, slots=True)
+class BipedEvent:
+    """A contact event: time, kind and foot position (touch-down anchor)."""
+
+    t: float
+    kind: str
+    foot_x: float
+    foot_z: float
+
+
+@dataclass(frozen=True)
+class BipedTrajectory:
+    """A biped run, recorded at every accepted integrator step.
+
+    Attributes
+    ----------
+    data : ndarray, shape (n, 31)
+        Columns :data:`RECORD_COLUMNS`.
+    events : list of BipedEvent
+    strides : ndarray, shape (n_strides, 25)
+        Time, state (18) and contact state (6) just after each right touch-down.
+    status : BipedStatus
+    params : BipedParams
+    final_state : ndarray, shape (18,)
+    final_contact : ndarray, shape (6,)
+    stats : dict
+        Accepted and rejected steps, right-hand-side calls.
+    """
+
+    data: NDArray[np.float64]
+    events: list[BipedEvent]
+    strides: NDArray[np.float64]
+    status: BipedStatus
+    params: BipedParams
+    final_state: NDArray[np.float64]
+    final_contact: NDArray[np.float64]
+    stats: dict[str, Any] = field(default_factory=dict)
+
+    def __getitem__(self, name: str) -> NDArray[np.float64]:
+        return self.data[:, RECORD_COLUMNS.index(name)]
+
+    @property
+    def time(self) -> NDArray[np.float64]:
+        """Sample times [g^-1/2 L^1/2]."""
+        return self.data[:, 0]
+
+    @property
+    def fell(self) -> bool:
+        """True if the run ended in a fall."""
+        return self.status.fell
+
+    @property
+    def n_strides(self) -> int:
+        """Completed strides (right touch-downs after the start)."""
+        return int(self.strides.shape[0])
+
+    def to_dataframe(self) -> Any:
+        """The recorded time series as a ``pandas.DataFrame``."""
+        import pandas as pd
+
+        return pd.DataFrame(self.data, columns=list(RECORD_COLUMNS))
+
+
+def _check(params: Any, state: Any) -> tuple[BipedParams, NDArray[np.float64]]:
+    if not isinstance(params, BipedParams):
+        raise ValueError(f"params must be BipedParams, got {type(params).__name__}")
+    if isinstance(state, BipedState):
+        return params, state.to_array()
+    return params, BipedState.from_array(state).to_array()
+
+
+def simulate(
+    params: BipedParams,
+    state: BipedState | NDArray[np.float64],
+    n_strides: int,
+    *,
+    t0: float = 0.0,
+    t_end: float = math.inf,
+    contact: NDArray[np.float64] | None = None,
+    options: BipedOptions | None = None,
+) -> BipedTrajectory:
+    """Simulate up to ``n_strides`` strides of the biped from ``state`` at ``t0``.
+
+    Parameters
+    ----------
+    params : BipedParams
+    state : BipedState or array_like, shape (18,)
+        ``(q, qd)`` at time ``t0`` (eq. E.9).
+    n_strides : int
+        Number of right touch-downs to run through (>= 1).
+    t0 : float
+        Start time; sets the controller phase (eq. E.25).
+    t_end : float
+        Stop at this time if reached first.
+    contact : array_like, shape (6,), optional
+        Contact flags and touch-down anchors ``(on_R, on_L, x_R, z_R, x_L,
+        z_L)``. Default: a foot at or below the ground that pushes is in
+        contact, anchored where it is.
+    options : BipedOptions, optional
+
+    Returns
+    -------
+    BipedTrajectory
+        Ends early at a fall (status says which) or integrator failure.
+
+    Raises
+    ------
+    ValueError
+        For invalid parameters, state, stride count or times.
+
+    References
+    ----------
+    Thesis Appendix E, eqs E.22-E.34, Section E.2.5.
+    """
+    params, y0 = _check(params, state)
+    if not isinstance(n_strides, (int, np.integer)) or n_strides < 1:
+        raise ValueError(f"n_strides must be an integer >= 1, got {n_strides!r}")
+    if not math.isfinite(t0):
+        raise ValueError(f"t0 [g^-1/2 L^1/2] must be finite, got {t0!r}")
+    if not t_end > t0:
+        raise ValueError(f"t_end [g^-1/2 L^1/2] must be after t0 = {t0}, got {t_end!r}")
+    options = options or BipedOptions()
+    P = pk.pack_params(params)
+    cs = np.zeros(pk.NCS)
+    if contact is None:
+        kn.init_contact(P, y0, cs)
+    else:
+        cs[:] = np.asarray(contact, dtype=np.float64)
+    rec = np.empty((options.max_records, pk.NREC))
+    ev = np.empty((8 * int(n_strides) + 16, pk.NEV))
+    strides = np.empty((int(n_strides), pk.NSTRIDE))
+    yend = np.empty(18)
+    csend = np.empty(pk.NCS)
+    stats = np.zeros(pk.NSTATS)
+    st = kn.run(P, options.pack(t_end), float(t0), y0, cs, int(n_strides), rec, ev, strides,
+                yend, csend, stats)
+    n_ev = int(stats[pk.S_NEV])
+    events = [
+        BipedEvent(float(e[0]), _EVENT_NAMES[int(e[1])], float(e[2]), float(e[3]))
+        for e in ev[:n_ev]
+    ]
+    return BipedTrajectory(
+        data=rec[: int(stats[pk.S_NREC])].copy(),
+        events=events,
+        strides=strides[: min(int(stats[pk.S_NSTRIDE]), int(n_strides))].copy(),
+        status=BipedStatus(int(st)),
+        params=params,
+        final_state=yend,
+        final_contact=csend,
+        stats={"accepted": int(stats[pk.S_NACC]), "rejected": int(stats[pk.S_NREJ]),
+               "rhs_calls": int(stats[pk.S_NFEV]), "t_end": float(stats[pk.S_TEND]),
+               "records_full": bool(stats[pk.S_RECFULL])},
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class StrideResult:
+    """One stride of the stride map (right touch-down to the next).
+
+    Attributes
+    ----------
+    status : BipedStatus
+    t : float
+        Time of the next right touch-down [g^-1/2 L^1/2].
+    state : ndarray, shape (18,)
+        State just after it (NaN if the stride failed).
+    contact : ndarray, shape (6,)
+    accepted : int
+        Integrator steps taken.
+    """
+
+    status: BipedStatus
+    t: float
+    state: NDArray[np.float64]
+    contact: NDArray[np.float64]
+    accepted: int
+
+
+_NO_REC = np.empty((0, pk.NREC))
+
+
+def stride(
+    params: BipedParams,
+    state: NDArray[np.float64],
+    t0: float,
+    *,
+    contact: NDArray[np.float64] | None = None,
+    options: BipedOptions | None = None,
+    _P: NDArray[np.float64] | None = None,
+) -> StrideResult:
+    """One stride from ``(t0, state)`` without recording (the stride map)."""
+    options = options or BipedOptions()
+    P = pk.pack_params(params) if _P is None else _P
+    y0 = np.asarray(state, dtype=np.float64)
+    cs = np.zeros(pk.NCS)
+    if contact is None:
+        kn.init_contact(P, y0, cs)
+    else:
+        cs[:] = contact
+    ev = np.empty((16, pk.NEV))
+    strides = np.empty((1, pk.NSTRIDE))
+    yend = np.empty(18)
+    csend = np.empty(pk.NCS)
+    stats = np.zeros(pk.NSTATS)
+    st = BipedStatus(int(kn.run(P, options.pack(), float(t0), y0, cs, 1, _NO_REC, ev, strides,
+                                yend, csend, stats)))
+    if st != BipedStatus.OK:
+        return StrideResult(st, float(stats[pk.S_TEND]), np.full(18, np.nan), csend,
+                            int(stats[pk.S_NACC]))
+    return StrideResult(st, float(strides[0, 0]), strides[0, 1:19].copy(),
+                        strides[0, 19:25].copy(), int(stats[pk.S_NACC]))

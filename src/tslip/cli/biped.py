@@ -1,0 +1,185 @@
+"""``tslip biped ...``: simulate, search, animate and report the two-legged model.
+
+Registered on the main app as the ``biped`` command group when this module is
+imported (``from . import biped`` in :mod:`tslip.cli.main`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import typer
+
+from ..biped import BipedOptions, BipedParams, BipedState, simulate
+from ..biped.gait import (
+    find_periodic_gait,
+    floquet,
+    from_section,
+    metacentric_test,
+    to_section,
+    tracking_errors,
+)
+from .main import _console, _errors, app
+
+__all__ = ["biped_app"]
+
+biped_app = typer.Typer(help="Two-legged running model with massed legs (thesis App. E).",
+                        no_args_is_help=True)
+app.add_typer(biped_app, name="biped")
+
+SetOpt = Annotated[list[str] | None, typer.Option(
+    "--set", "-s", metavar="KEY=VALUE", help="Override a biped parameter, e.g. Kp_h=0.8.")]
+GaitOpt = Annotated[Path | None, typer.Option(
+    "--gait", metavar="FILE.json", help="Start from a gait written by `tslip biped search`.")]
+StridesOpt = Annotated[int, typer.Option("--strides", "-n", help="Number of strides.")]
+TolOpt = Annotated[float, typer.Option("--tol", help="Integrator rtol = atol.")]
+
+
+def _params(sets: list[str] | None, base: BipedParams | None = None) -> BipedParams:
+    changes: dict[str, Any] = {}
+    for item in sets or []:
+        key, sep, value = item.partition("=")
+        if not sep:
+            raise ValueError(f"--set expects key=value, got {item!r}")
+        key = key.strip()
+        if value.strip().lower() in ("true", "false"):
+            changes[key] = value.strip().lower() == "true"
+            continue
+        try:
+            changes[key] = float(value)
+        except ValueError:
+            raise ValueError(f"{key} must be a number, got {value!r}") from None
+    return BipedParams.from_dict(changes, base)
+
+
+def _start(sets: list[str] | None, gait: Path | None) -> tuple[BipedParams, np.ndarray, float]:
+    """Parameters, start state and start time: Table E.2 or a saved gait."""
+    if gait is None:
+        p = _params(sets)
+        return p, BipedState.thesis().to_array(), 0.0
+    try:
+        data = json.loads(Path(gait).read_text())
+    except FileNotFoundError:
+        raise ValueError(f"gait file {str(gait)!r} does not exist") from None
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"gait file {str(gait)!r} is not valid JSON: {exc}") from None
+    p = _params(sets, BipedParams.from_dict(data["params"]))
+    y, t0 = from_section(p, np.asarray(data["z"], dtype=float))
+    return p, y, t0
+
+
+def _write_json(path: Path, data: dict[str, Any]) -> None:
+    Path(path).write_text(json.dumps(data, indent=2, default=float))
+
+
+@biped_app.command("simulate")
+def simulate_cmd(
+    sets: SetOpt = None,
+    gait: GaitOpt = None,
+    strides: StridesOpt = 20,
+    tol: TolOpt = 1e-8,
+    out: Annotated[Path | None, typer.Option("--out", help="CSV of the run.")] = None,
+) -> None:
+    """Run the biped from Table E.2 (or a gait) and report strides and tracking."""
+    with _errors():
+        p, y, t0 = _start(sets, gait)
+        if strides < 1:
+            raise ValueError(f"--strides must be >= 1, got {strides}")
+        tr = simulate(p, y, strides, t0=t0, options=BipedOptions(rtol=tol, atol=tol))
+        c = _console()
+        c.print(f"{tr.n_strides} strides, {tr.status.reason} (t = {tr.stats['t_end']:.3f})")
+        if tr.n_strides:
+            for leg, name in ((0, "right"), (1, "left")):
+                te = tracking_errors(tr, leg, t0, tr.strides[0, 0])
+                c.print(f"{name} leg, stride 1: thigh RMS error {te.thigh_rms:.2e} L, "
+                        f"hip RMS error {te.hip_rms:.3f} rad")
+        if out is not None:
+            tr.to_dataframe().to_csv(out, index=False)
+            c.print(f"wrote {out}")
+
+
+@biped_app.command("search")
+def search_cmd(
+    out: Annotated[Path, typer.Option("--out", help="JSON of the best gait.")],
+    sets: SetOpt = None,
+    gait: GaitOpt = None,
+    free_param: Annotated[list[str] | None, typer.Option(
+        "--free-param", help="Also free this parameter (repeatable).")] = None,
+    cma_evals: Annotated[int, typer.Option("--cma-evals")] = 600,
+    lsq_evals: Annotated[int, typer.Option("--lsq-evals")] = 200,
+    sigma0: Annotated[float, typer.Option("--sigma0")] = 0.05,
+    seed: Annotated[int, typer.Option("--seed")] = 1,
+    multipliers: Annotated[bool, typer.Option("--multipliers/--no-multipliers")] = True,
+) -> None:
+    """CMA-ES then least squares for a periodic gait (eqs E.35-E.36)."""
+    with _errors():
+        p, y, t0 = _start(sets, gait)
+        z0 = to_section(p, y, t0)
+        free = list(free_param or ["rho0"])
+        bounds = {"rho0": (0.0, 0.999)}
+        res = find_periodic_gait(p, z0, free_params=free, bounds=bounds, cma_evals=cma_evals,
+                                 lsq_evals=lsq_evals, sigma0=sigma0, seed=seed)
+        c = _console()
+        c.print(res.message + f" ({res.evaluations} strides simulated)")
+        data: dict[str, Any] = {"converged": res.converged, "residual": res.residual,
+                                "z": res.z.tolist(), "params": res.params.to_dict(),
+                                "history": res.history}
+        if multipliers and math.isfinite(res.residual) and res.residual < 1.0:
+            fr = floquet(res.params, res.z)
+            data["multipliers"] = [[float(m.real), float(m.imag)] for m in fr.multipliers]
+            c.print(f"largest multiplier magnitude {fr.largest:.3f}")
+        _write_json(out, data)
+        c.print(f"wrote {out}")
+
+
+@biped_app.command("animate")
+def animate_cmd(
+    out: Annotated[Path, typer.Option("--out", help="GIF or MP4 file.")],
+    sets: SetOpt = None,
+    gait: GaitOpt = None,
+    strides: StridesOpt = 5,
+    fps: Annotated[int, typer.Option("--fps")] = 25,
+) -> None:
+    """Animate the runner with both legs."""
+    from ..plotting.biped import animate_biped
+
+    with _errors():
+        if out.suffix.lower() not in (".gif", ".mp4"):
+            raise ValueError(f"--out must end in .gif or .mp4, got {str(out)!r}")
+        p, y, t0 = _start(sets, gait)
+        tr = simulate(p, y, strides, t0=t0)
+        animate_biped(tr, out, fps=fps)
+        _console().print(f"{tr.n_strides} strides, {tr.status.reason}; wrote {out}")
+
+
+@biped_app.command("report")
+def report_cmd(
+    out_dir: Annotated[Path, typer.Option("--out-dir", help="Directory for figures/tables.")],
+    sets: SetOpt = None,
+    gait: GaitOpt = None,
+    strides: StridesOpt = 50,
+) -> None:
+    """Write Figures E.2-E.4 and the multiplier table."""
+    from ..plotting.biped import plot_foot_path, plot_metacentric, plot_tracking
+
+    with _errors():
+        p, y, t0 = _start(sets, gait)
+        out_dir.mkdir(parents=True, exist_ok=True)
+        tr = simulate(p, y, strides, t0=t0)
+        c = _console()
+        c.print(f"strides until fall: {tr.n_strides} ({tr.status.reason})")
+        plot_tracking(tr).savefig(out_dir / "fig_e2_tracking.png", dpi=120)
+        plot_foot_path(tr).savefig(out_dir / "fig_e3_foot_path.png", dpi=120)
+        meta = metacentric_test(p, BipedState.from_array(y), t0)
+        plot_metacentric(meta).savefig(out_dir / "fig_e4_metacentric.png", dpi=120)
+        fr = floquet(p, to_section(p, y, t0))
+        rows = ["index,real,imag,abs"] + [
+            f"{i},{m.real:.6g},{m.imag:.6g},{abs(m):.6g}" for i, m in enumerate(fr.multipliers)
+        ]
+        (out_dir / "multipliers.csv").write_text("\n".join(rows) + "\n")
+        c.print(f"largest multiplier {fr.largest:.3f} (periodicity residual {fr.residual:.2e})")
+        c.print(f"wrote figures and multipliers.csv to {out_dir}")

@@ -1,0 +1,143 @@
+"""Figures of the two-legged model: tracking (E.2), foot path (E.3), metacentre (E.4), frames.
+
+Functions take results and an optional axes, return the Figure, never show.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..biped.dynamics import controller_references, foot_position, hip_position, leg_phase
+
+if TYPE_CHECKING:
+    from ..biped.simulate import BipedTrajectory
+
+__all__ = ["plot_tracking", "plot_foot_path", "plot_metacentric", "draw_biped", "animate_biped"]
+
+
+def _window(tr: BipedTrajectory, stride: int) -> np.ndarray:
+    t_s = np.r_[tr.time[0], tr.strides[:, 0]]
+    if stride + 1 >= t_s.size:
+        return np.ones(tr.time.size, dtype=bool)
+    return (tr.time >= t_s[stride]) & (tr.time <= t_s[stride + 1])
+
+
+def plot_tracking(tr: BipedTrajectory, stride: int = 0, leg: int = 0) -> Figure:
+    """Reference vs actual thigh length, shank length and hip angle (Figure E.2)."""
+    m = _window(tr, stride)
+    t = tr.time[m]
+    side = "R" if leg == 0 else "L"
+    ref = controller_references(tr.params, leg_phase(tr.params, t, leg))
+    fig = Figure(figsize=(7, 7), layout="constrained")
+    axs = fig.subplots(3, 1, sharex=True)
+    rows = [(f"l_t{side}", ref[:, 0], "thigh length l_t [L]"),
+            (f"l_s{side}", np.full(t.size, tr.params.l_s0), "shank length l_s [L]"),
+            (f"theta_h{side}", ref[:, 2], "hip angle theta_h [rad]")]
+    for ax, (col, r, label) in zip(axs, rows, strict=True):
+        ax.plot(t, r, "k--", lw=1, label="reference" if col != f"l_s{side}" else "rest length")
+        ax.plot(t, tr[col][m], "C0", lw=1.5, label="simulation")
+        ax.set_ylabel(label)
+        ax.legend(loc="best", fontsize=8)
+    axs[-1].set_xlabel("time [g^-1/2 L^1/2]")
+    fig.suptitle(f"controller tracking, {'right' if leg == 0 else 'left'} leg, stride {stride}")
+    return fig
+
+
+def plot_foot_path(tr: BipedTrajectory, leg: int = 0, ax: Any = None) -> Figure:
+    """Reference and actual foot path relative to the hip (Figure E.3)."""
+    p = tr.params
+    if ax is None:
+        fig = Figure(figsize=(6, 5), layout="constrained")
+        ax = fig.subplots()
+    else:
+        fig = ax.figure
+    q = tr.data[:, 1:10]
+    rel = foot_position(p, q, leg) - hip_position(p, q)
+    rho = np.linspace(0, 1, 400)
+    ref = controller_references(p, rho)
+    gam = ref[:, 2]  # reference hip angle at zero pitch
+    s = ref[:, 0] + p.l_s0
+    ax.plot(-s * np.sin(gam), -s * np.cos(gam), "k--", lw=1, label="reference (theta_b = 0)")
+    ax.plot(rel[:, 0], rel[:, 1], "C0", lw=1, label="simulation")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x - x_hip [L]")
+    ax.set_ylabel("z - z_hip [L]")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def plot_metacentric(results: list[dict[str, Any]], ax: Any = None) -> Figure:
+    """Ground reaction forces and resultant impulse for pitch changes (Figure E.4)."""
+    if ax is None:
+        fig = Figure(figsize=(8, 4), layout="constrained")
+        ax, ax2 = fig.subplots(1, 2)
+    else:
+        fig = ax.figure
+        ax2 = None
+    for i, r in enumerate(results):
+        lab = f"dtheta_b = {r['dtheta']:+.1f}"
+        ax.plot(r["t"] - r["t"][0], r["Fz"], f"C{i}", label=lab + " F_z")
+        ax.plot(r["t"] - r["t"][0], r["Fx"], f"C{i}--", label=lab + " F_x")
+        if ax2 is not None:
+            ix, iz = r["impulse"]
+            ax2.annotate("", xy=(ix, iz), xytext=(0, 0),
+                         arrowprops={"arrowstyle": "->", "color": f"C{i}"})
+            ax2.plot([ix], [iz], "o", color=f"C{i}", label=lab)
+    ax.set_xlabel("time since start [g^-1/2 L^1/2]")
+    ax.set_ylabel("GRF [M g]")
+    ax.legend(fontsize=7)
+    if ax2 is not None:
+        ax2.set_xlabel("impulse I_x [M g^1/2 L^1/2]")
+        ax2.set_ylabel("impulse I_z")
+        ax2.axhline(0, color="0.7", lw=0.5)
+        ax2.axvline(0, color="0.7", lw=0.5)
+        ax2.legend(fontsize=7)
+    return fig
+
+
+def draw_biped(ax: Any, params: Any, y: np.ndarray) -> None:
+    """Draw trunk, both legs (thigh, shank, foot) of a state onto ``ax``."""
+    q = np.asarray(y)[:9]
+    hip = hip_position(params, q)
+    com = q[:2]
+    ax.plot([com[0] - (hip[0] - com[0]), hip[0]], [com[1] - (hip[1] - com[1]), hip[1]],
+            "k-", lw=5, solid_capstyle="round")
+    ax.plot(com[0], com[1], "ko", ms=8)
+    for leg, color in ((0, "C3"), (1, "C0")):
+        b = 3 + 3 * leg
+        gam = q[2] + q[b + 2]
+        u = np.array([np.sin(gam), np.cos(gam)])
+        knee = hip - q[b] * u
+        foot = hip - (q[b] + q[b + 1]) * u
+        ax.plot([hip[0], knee[0]], [hip[1], knee[1]], "-", color=color, lw=3)
+        ax.plot([knee[0], foot[0]], [knee[1], foot[1]], ":", color=color, lw=2)
+        ax.plot(foot[0], foot[1], "o", color=color, ms=4)
+
+
+def animate_biped(tr: BipedTrajectory, path: str | Path, fps: int = 30,
+                  speed: float = 0.5) -> Path:
+    """Write a GIF or MP4 of the run with both legs drawn (right red, left blue)."""
+    from matplotlib.animation import FFMpegWriter, PillowWriter
+
+    path = Path(path)
+    t_frames = np.arange(tr.time[0], tr.time[-1], speed / fps)
+    idx = np.searchsorted(tr.time, t_frames).clip(0, tr.time.size - 1)
+    fig = Figure(figsize=(6, 3), layout="constrained")
+    ax = fig.subplots()
+    writer = PillowWriter(fps=fps) if path.suffix.lower() == ".gif" else FFMpegWriter(fps=fps)
+    with writer.saving(fig, str(path), dpi=80):
+        for i in idx:
+            ax.clear()
+            y = tr.data[i, 1:19]
+            ax.axhline(0.0, color="0.4", lw=1)
+            draw_biped(ax, tr.params, y)
+            ax.set_xlim(y[0] - 1.5, y[0] + 1.5)
+            ax.set_ylim(-0.1, 1.4)
+            ax.set_aspect("equal")
+            ax.set_title(f"t = {tr.time[i]:.2f}")
+            writer.grab_frame()
+    return path
