@@ -72,35 +72,64 @@ def _num(x: Any) -> float:
 
 
 def _seeded_gaits(spec: StudySpec, assignment: dict[str, float], values: np.ndarray,
-                  seeds: dict[float, list[float]], tol: float) -> list[Gait | None]:
-    """Gaits along a line from the neighbouring line's solutions (2-D continuation).
+                  seeds: dict[float, list[float]], tol: float,
+                  known: list[Gait | None] | None = None) -> list[Gait | None]:
+    """Gaits along a line, grown from seeds (2-D continuation).
 
-    Each point starts once from its neighbour's unknowns in the previous line,
-    else from the nearest solved point of this line; no automatic guesses, so a
-    point without a gait costs one short least-squares run.
+    First every point with a seed (its neighbour's unknowns in the previous
+    line) starts once from it; then the solved points grow outward along the
+    line, each unsolved neighbour starting once from an adjacent solution. No
+    automatic guesses: a point without a gait costs one short least-squares run
+    per attempt.
     """
     inner = spec.axes[-1].param
-    gaits: list[Gait | None] = [None] * len(values)
-    base = get_param(spec.base, inner)
-    order = np.argsort(np.abs(values - base), kind="stable")
-    for i in order:
-        p = spec.params_at({**assignment, inner: float(values[i])})
-        names = GaitProblem.from_params(p).names
-        starts = []
-        if float(values[i]) in seeds:
-            starts.append(seeds[float(values[i])])
-        solved = [j for j in range(len(values)) if gaits[j] is not None]
-        if solved:
-            j = min(solved, key=lambda j: abs(values[j] - values[i]))
-            g = gaits[j]
-            starts.append(_unknowns(g, names))
-        for z in starts:
-            if len(z) != len(names) or not np.all(np.isfinite(z)):
+    n = len(values)
+    gaits: list[Gait | None] = list(known) if known is not None else [None] * n
+    problems = {}
+
+    def attempt(i: int, z: list[float] | np.ndarray) -> bool:
+        if i not in problems:
+            p = spec.params_at({**assignment, inner: float(values[i])})
+            problems[i] = (p, GaitProblem.from_params(p).names)
+        p, names = problems[i]
+        if len(z) != len(names) or not np.all(np.isfinite(z)):
+            return False
+        g = find_gait(p, guess=np.asarray(z, dtype=float), tol=tol)
+        if g.converged:
+            gaits[i] = g
+        return g.converged
+
+    for i in range(n):
+        if gaits[i] is None and float(values[i]) in seeds:
+            attempt(i, seeds[float(values[i])])
+    tried: set[tuple[int, int]] = set()
+    grown = True
+    while grown:
+        grown = False
+        for i in range(n):
+            if gaits[i] is None:
                 continue
-            g = find_gait(p, guess=np.asarray(z), tol=tol)
-            if g.converged:
-                gaits[i] = g
-                break
+            for j in (i - 1, i + 1):
+                if 0 <= j < n and gaits[j] is None and (i, j) not in tried:
+                    tried.add((i, j))
+                    names = problems[j][1] if j in problems else GaitProblem.from_params(
+                        spec.params_at({**assignment, inner: float(values[j])})).names
+                    grown |= attempt(j, _unknowns(gaits[i], names))
+    return gaits
+
+
+def _scan_line(spec: StudySpec, assignment: dict[str, float], values: np.ndarray,
+               tol: float, n_probe: int = 10) -> list[Gait | None]:
+    """Cold searches at ``n_probe`` evenly spread values, then grow from any found."""
+    inner = spec.axes[-1].param
+    gaits: list[Gait | None] = [None] * len(values)
+    for i in np.unique(np.linspace(0, len(values) - 1, min(n_probe, len(values))).round()):
+        i = int(i)
+        g = find_gait(spec.params_at({**assignment, inner: float(values[i])}), tol=tol)
+        if g.converged:
+            gaits[i] = g
+    if any(g is not None for g in gaits):
+        gaits = _seeded_gaits(spec, assignment, values, {}, tol, known=gaits)
     return gaits
 
 
@@ -139,19 +168,25 @@ def solve_line(spec: StudySpec, assignment: dict[str, float], values: list[float
     t0 = time.perf_counter()
     tol = float(spec.meta.get("tol", 1e-10))  # global PD has no exact fixed point
     vals = np.sort(np.asarray(values, dtype=float))
-    if seeds is None:
+    if seeds is None:  # a 1-D study or the root line of a grid: cold start
         branch = continue_gait(params, inner, vals, tol=tol, max_failures=3, multipliers=False)
         gaits = list(branch.gaits)
         residual = list(branch.residual)
         messages = list(branch.messages)
-    else:
+        if len(spec.axes) == 2 and not any(g is not None for g in gaits):
+            # the base value may lie outside the gait's band: probe along the line
+            gaits = _scan_line(spec, assignment, vals, tol)
+            residual = [g.residual if g is not None else math.nan for g in gaits]
+            messages = ["found by probing the line" if g is not None else
+                        "no periodic gait found along this line" for g in gaits]
+    else:  # seeded from the neighbouring line (empty seeds: it had no gait)
         names = GaitProblem.from_params(params).names
         full = {v: [z[("delta", "phi", "phid", "alpha_r", "alphad_ref", "tau_c").index(n)]
                     for n in names] for v, z in seeds.items()}
         gaits = _seeded_gaits(spec, assignment, vals, full, tol)
         residual = [g.residual if g is not None else math.nan for g in gaits]
-        messages = ["seeded from the neighbouring line" if g is not None else
-                    "no periodic gait from the neighbouring line's solutions" for g in gaits]
+        messages = ["continued from the neighbouring line" if g is not None else
+                    "no periodic gait continuing from the neighbouring line" for g in gaits]
     neutral_tol = float(spec.meta.get("neutral_tol", 1e-6))
     records = []
     for i, v in enumerate(vals):
