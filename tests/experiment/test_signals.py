@@ -17,7 +17,8 @@ def test_perfect_fit_gives_one_and_hundred_percent() -> None:
 
 def test_constant_offset_keeps_correlation_lowers_vaf() -> None:
     y = np.array([1.0, 2.0, 3.0, 4.0])
-    # var(y) = 1.25; y - (y + 1) = -1 has zero variance -> VAF stays 100 (eq. 5.2 uses var)
+    # var(y) = 1.25; y - (y + 1) = -1 has zero variance -> VAF stays 100 (eq. 5.2 uses var);
+    # the uncentred form that an offset lowers is tested below
     assert correlation(y, y + 1.0) == pytest.approx(1.0, abs=1e-12)
     assert vaf(y, y + 1.0) == pytest.approx(100.0, abs=1e-9)  # eq. 5.2 as printed
     # a scaled copy: corr 1, VAF = (1 - var(-0.5 y) / var(y)) * 100 = 75 %
@@ -27,6 +28,31 @@ def test_constant_offset_keeps_correlation_lowers_vaf() -> None:
     yh = y + np.array([0.0, 0.0, 0.0, 1.0])
     assert vaf(y, yh) == pytest.approx((1 - np.var([0, 0, 0, 1.0]) / 1.25) * 100, abs=1e-9)
     assert vaf(y, yh) < 100.0
+
+
+def test_uncentred_vaf_lowers_for_constant_offset() -> None:
+    y = np.array([1.0, 2.0, 3.0, 4.0])   # mean 2.5, var(y) = 5 / 4 = 1.25
+    # perfect fit: 100 % in both forms
+    assert vaf(y, y, centred=False) == pytest.approx(100.0, abs=1e-12)
+    # offset +1: mean((-1)^2) = 1 -> (1 - 1 / 1.25) * 100 = 20 %; eq. 5.2 gives 100 %
+    assert vaf(y, y + 1.0, centred=False) == pytest.approx(20.0, abs=1e-9)
+    assert vaf(y, y + 1.0, centred=True) == pytest.approx(100.0, abs=1e-9)
+    assert correlation(y, y + 1.0) == pytest.approx(1.0, abs=1e-12)
+    # offset 0.5: (1 - 0.25 / 1.25) * 100 = 80 %
+    assert vaf(y, y - 0.5, centred=False) == pytest.approx(80.0, abs=1e-9)
+    # scaled copy 1.5 y: residual -0.5 y = (-0.5, -1, -1.5, -2), mean square 7.5 / 4 = 1.875
+    # -> (1 - 1.875 / 1.25) * 100 = -50 %; the centred form gives 75 %
+    assert vaf(y, 1.5 * y, centred=False) == pytest.approx(-50.0, abs=1e-9)
+    assert vaf(y, 1.5 * y, centred=True) == pytest.approx(75.0, abs=1e-9)
+    # zero-mean residual (0, 1, -1, 0): both forms (1 - 0.5 / 1.25) * 100 = 60 %
+    yh = y + np.array([0.0, 1.0, -1.0, 0.0])
+    assert vaf(y, yh, centred=False) == pytest.approx(60.0, abs=1e-9)
+    assert vaf(y, yh, centred=True) == pytest.approx(60.0, abs=1e-9)
+    # anti-correlated, y = (1, 2, 3): residual 2 y, mean square 56 / 3, var(y) = 2 / 3
+    y3 = np.array([1.0, 2.0, 3.0])
+    assert vaf(y3, -y3, centred=False) == pytest.approx((1 - 28.0) * 100, abs=1e-9)
+    # constant measurement: undefined
+    assert np.isnan(vaf(np.ones(3), np.zeros(3), centred=False))
 
 
 def test_anticorrelated_gives_minus_one() -> None:

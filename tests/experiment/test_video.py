@@ -13,7 +13,9 @@ from tslip.experiment.video import (
     Calibration,
     TrackerOptions,
     VideoError,
+    _merge_boxes,
     measure_calibration,
+    open_video,
     track_frames,
     track_video,
 )
@@ -109,3 +111,24 @@ def test_truncated_video_keeps_tracks(run, tmp_path: Path) -> None:  # noqa: ANN
         return
     assert res.fatal
     assert "truncated" in res.problems[-1] or "no frames" in res.problems[-1]
+
+
+def test_reused_decode_buffer_gives_same_frames(run, tmp_path: Path) -> None:  # noqa: ANN001
+    from dataclasses import replace
+
+    short = replace(run, truth=run.truth.iloc[:12].reset_index(drop=True))
+    path = write_video(short, tmp_path / "s.mp4")
+    plain, _, _ = open_video(path)
+    fresh = [f.copy() for f in plain]
+    reused, _, _ = open_video(path, reuse_buffer=True)
+    ids = set()
+    for k, f in enumerate(reused):
+        ids.add(id(f))
+        assert np.array_equal(f, fresh[k])
+    assert len(fresh) == 12 and len(ids) <= 2     # one array after the first read
+
+
+def test_merge_boxes() -> None:
+    boxes = [[0, 0, 10, 10], [20, 0, 30, 10], [8, 8, 22, 12], [50, 50, 60, 60]]
+    assert sorted(_merge_boxes(boxes)) == [[0, 0, 30, 12], [50, 50, 60, 60]]
+    assert _merge_boxes([[0, 0, 5, 5], [5, 0, 9, 5]]) == [[0, 0, 5, 5], [5, 0, 9, 5]]

@@ -51,21 +51,54 @@ def correlation(y: np.ndarray, yhat: np.ndarray) -> float:
     return float(np.mean((y - y.mean()) * (yhat - yhat.mean())) / (sy * sh))
 
 
-def vaf(y: np.ndarray, yhat: np.ndarray) -> float:
+def vaf(y: np.ndarray, yhat: np.ndarray, *, centred: bool = True) -> float:
     """Variance accounted for (eq. 5.2) [%].
 
-    ``VAF = (1 - var(y - yhat) / var(y)) * 100``.
+    ``centred=True`` (default) is eq. 5.2 as printed in the thesis and used
+    for Table 6.3::
+
+        VAF = (1 - var(y - yhat) / var(y)) * 100
+
+    The variance of the residual removes its mean, so a model that is off by
+    a constant offset still scores 100 % (and correlation 1): this VAF
+    measures the shape of the signal only.
+
+    ``centred=False`` replaces the residual variance by its mean square::
+
+        VAF = (1 - mean((y - yhat)^2) / var(y)) * 100
+
+    so a constant offset ``d`` lowers it by ``100 d^2 / var(y)`` percentage
+    points; this is the variant in which "a constant offset leaves correlation
+    at 1 and lowers VAF". The two agree when the residual has zero mean.
+
+    Parameters
+    ----------
+    y, yhat : ndarray, shape (n,)
+        Measurement and model.
+    centred : bool
+        Use the residual's variance (eq. 5.2) or its mean square.
+
+    Returns
+    -------
+    float
+        VAF [%]; 100 for a perfect fit, NaN if ``y`` is constant; unbounded
+        below.
 
     Examples
     --------
-    >>> vaf(np.array([1.0, 2.0, 3.0]), np.array([1.0, 2.0, 3.0]))
+    >>> y = np.array([1.0, 2.0, 3.0, 4.0])
+    >>> vaf(y, y + 1.0)
     100.0
+    >>> round(vaf(y, y + 1.0, centred=False), 6)    # 1 - 1 / 1.25
+    20.0
     """
     y, yhat = np.asarray(y, float), np.asarray(yhat, float)
     v = np.var(y)
     if v == 0:
         return math.nan
-    return float((1.0 - np.var(y - yhat) / v) * 100.0)
+    r = y - yhat
+    err = np.var(r) if centred else np.mean(r * r)
+    return float((1.0 - err / v) * 100.0)
 
 
 # -- filters ----------------------------------------------------------------------------------

@@ -5,7 +5,10 @@ edges and a Hough circle transform tuned to the disc size; each circle is
 refined to sub-pixel accuracy by a least-squares circle through its Canny
 edge pixels, and the two discs give position and pitch. Feet: a MOG2
 background subtractor masks the static scene, an HSV range keeps the foot
-colour, ellipses are fitted to the blobs and the two largest are the feet.
+colour, ellipses are fitted to the blobs and the two largest are the feet
+(coarse to fine: the moving foot-coloured blobs are found in a down-sampled
+frame, the HSV mask and ellipse fits run at full resolution in crops around
+them).
 Each new point joins the series whose last known point is nearest; gaps stay
 gaps. Frames are processed as a stream, so memory does not grow with length.
 
@@ -78,7 +81,8 @@ class TrackerOptions:
     foot_radius : float
         Foot marker radius [px] (for the expected blob area).
     roi_margin : float
-        Margin of the body region of interest around the discs [px].
+        Margin of the body region of interest around the predicted discs
+        [px]; it grows by this much per frame while the discs are lost.
     canny_low, canny_high : float
         Canny hysteresis thresholds [grey levels].
     hough_votes : float
@@ -86,7 +90,8 @@ class TrackerOptions:
     foot_hsv_low, foot_hsv_high : tuple of int
         HSV range of the foot colour (OpenCV ranges: H 0-179).
     bg_scale : int
-        Down-sampling of the background subtractor's input [-].
+        Down-sampling of the background subtractor's input and of the first,
+        coarse foot-colour search [-].
     bg_history : int
         MOG2 history [frames].
     bg_ratio : float
@@ -118,11 +123,19 @@ class TrackerOptions:
     def for_scale(cls, px_per_m: float, *, marker_radius: float = 0.025,
                   marker_spacing: float = 0.18, foot_radius: float = 0.016,
                   **kw: Any) -> TrackerOptions:
-        """Options from marker sizes in metres [m] and an image scale [px/m]."""
+        """Options from marker sizes in metres [m] and an image scale [px/m].
+
+        The body search margin is 15 mm (at least 12 px) beyond the predicted
+        discs, and the background model's down-sampling keeps about three
+        samples per foot-marker radius (``bg_scale = foot radius / 3``, 1-8),
+        unless given in ``kw``.
+        """
+        foot_px = foot_radius * px_per_m
+        kw.setdefault("roi_margin", max(0.015 * px_per_m, 12.0))
+        kw.setdefault("bg_scale", int(min(max(foot_px // 3, 1), 8)))
         return cls(marker_radius=marker_radius * px_per_m,
                    marker_spacing=marker_spacing * px_per_m,
-                   foot_radius=foot_radius * px_per_m,
-                   roi_margin=max(0.035 * px_per_m, 12.0), **kw)
+                   foot_radius=foot_px, **kw)
 
 
 @dataclass(frozen=True)
@@ -163,8 +176,16 @@ class TrackResult:
 # -- video input ----------------------------------------------------------------------------
 
 
-def open_video(path: str | Path) -> tuple[Iterator[np.ndarray], float, int]:
+def open_video(path: str | Path, *,
+               reuse_buffer: bool = False) -> tuple[Iterator[np.ndarray], float, int]:
     """Open an ``.mp4``/``.avi`` file or a folder of PNG/JPEG frames.
+
+    Parameters
+    ----------
+    path : str or Path
+    reuse_buffer : bool
+        Decode every frame of a video file into the same array (faster; each
+        yielded frame is overwritten by the next, so do not keep references).
 
     Returns
     -------
@@ -206,10 +227,13 @@ def open_video(path: str | Path) -> tuple[Iterator[np.ndarray], float, int]:
 
     def gen_cap() -> Iterator[np.ndarray]:
         try:
+            buf = None
             while True:
-                ok, img = cap.read()
+                ok, img = cap.read(buf) if buf is not None else cap.read()
                 if not ok:
                     return
+                if reuse_buffer:
+                    buf = img
                 yield img
         finally:
             cap.release()
@@ -298,7 +322,7 @@ def track_video(path: str | Path, calibration: Calibration, options: TrackerOpti
     VideoError
         If the video is missing or cannot be opened at all.
     """
-    frames, file_fps, n = open_video(path)
+    frames, file_fps, n = open_video(path, reuse_buffer=True)
     rate = fps if fps is not None else file_fps
     if not (rate is not None and math.isfinite(rate) and rate > 0):
         raise VideoError(f"frame rate unknown for {str(path)!r}; give --fps")
@@ -395,7 +419,15 @@ def _gap_report(df: pd.DataFrame) -> list[str]:
 
 
 class _Tracker:
-    """State carried from frame to frame (last points, background model)."""
+    """State carried from frame to frame (last points, background model).
+
+    Per-frame work is kept to small regions: the body Hough search runs in the
+    bounding box of the predicted disc positions (whole frame only when lost),
+    the background model and a first colour mask run on a ``bg_scale``
+    down-sampled frame, and the full-resolution HSV mask, morphology and
+    ellipse fits run only in crops around the foot-coloured moving blobs found
+    there.
+    """
 
     def __init__(self, opt: TrackerOptions) -> None:
         import cv2
@@ -403,6 +435,7 @@ class _Tracker:
         self.cv2 = cv2
         self.opt = opt
         self.body: np.ndarray | None = None      # last (front, rear) [px], shape (2, 2)
+        self.vel = np.zeros((2, 2))              # last frame-to-frame body motion [px]
         self.lost = 0
         self.feet: list[np.ndarray | None] = [None, None]
         self.bg = cv2.createBackgroundSubtractorMOG2(history=opt.bg_history,
@@ -414,15 +447,23 @@ class _Tracker:
         self.lo = np.array(opt.foot_hsv_low, dtype=np.uint8)
         self.hi = np.array(opt.foot_hsv_high, dtype=np.uint8)
         self.kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5))
+        self.kernel3 = np.ones((3, 3), np.uint8)
+        self.area_full = math.pi * opt.foot_radius ** 2
 
     def step(self, frame: np.ndarray) -> tuple[float, ...]:
         body = self._body(frame)
         if body is None:
             self.lost += 1
+            self.vel[:] = 0.0
             b = (math.nan,) * 4 + (QUALITY["missing"],)
         else:
+            if self.body is not None and self.lost == 0:
+                self.vel = body - self.body
+            else:
+                self.vel[:] = 0.0
             self.body, self.lost = body, 0
-            b = (*body[0], *body[1], QUALITY["ok"])
+            b = (float(body[0, 0]), float(body[0, 1]), float(body[1, 0]), float(body[1, 1]),
+                 QUALITY["ok"])
         f = self._feet(frame)
         return b + f
 
@@ -432,17 +473,17 @@ class _Tracker:
         H, W = frame.shape[:2]
         R = o.marker_radius
         if self.body is not None and self.lost < 20:
-            c = self.body.mean(axis=0)
-            half = 0.5 * o.marker_spacing + R + o.roi_margin * (1 + self.lost)
-            x0, x1 = max(int(c[0] - half), 0), min(int(c[0] + half) + 1, W)
-            y0, y1 = max(int(c[1] - half), 0), min(int(c[1] + half) + 1, H)
+            # bounding box of the predicted discs, grown while the markers stay lost
+            pred = self.body + self.vel
+            m = R + o.roi_margin * (1 + self.lost) + float(np.abs(self.vel).max())
+            x0, x1 = max(int(pred[:, 0].min() - m), 0), min(int(pred[:, 0].max() + m) + 1, W)
+            y0, y1 = max(int(pred[:, 1].min() - m), 0), min(int(pred[:, 1].max() + m) + 1, H)
         else:
             x0, y0, x1, y1 = 0, 0, W, H
         if x1 - x0 < 2 * R or y1 - y0 < 2 * R:
             return None
         grey = cv2.cvtColor(frame[y0:y1, x0:x1], cv2.COLOR_BGR2GRAY)
         grey = cv2.GaussianBlur(grey, (5, 5), 1.0)
-        edges = cv2.Canny(grey, o.canny_low, o.canny_high)
         circles = cv2.HoughCircles(grey, cv2.HOUGH_GRADIENT, dp=1,
                                    minDist=max(0.5 * o.marker_spacing, R),
                                    param1=o.canny_high, param2=o.hough_votes,
@@ -467,50 +508,79 @@ class _Tracker:
                     best = (score, pair)
         if best is None:
             return None
-        pair = best[1]
-        out = np.array([_refine_circle(edges, p, R) for p in pair])
+        out = np.array([_refine_circle(grey, p, R, o.canny_low, o.canny_high, cv2)
+                        for p in best[1]])
         return out + (x0, y0)
 
     # feet: background subtraction, HSV mask, ellipses (Figure D.4)
     def _feet(self, frame: np.ndarray) -> tuple[float, ...]:
         cv2, o = self.cv2, self.opt
         H, W = frame.shape[:2]
-        s = o.bg_scale
-        small = np.ascontiguousarray(frame[s // 2::s, s // 2::s])   # point sampling: fast
+        s = max(int(o.bg_scale), 1)
+        hs, ws = H // s, W // s
+        # point sampling at pixel (s*i, s*j): cheap, and the full-resolution pass
+        # below decides the blob outline
+        small = cv2.resize(frame[: hs * s, : ws * s], (ws, hs), interpolation=cv2.INTER_NEAREST)
         fg_small = self.bg.apply(small)
-        if self.body is not None:
-            y0 = max(int(self.body[:, 1].min() - o.marker_spacing * 0.5), 0)
-        else:
-            y0 = 0
-        y0 -= y0 % s
-        roi = frame[y0:]
-        hsv = cv2.cvtColor(roi, cv2.COLOR_BGR2HSV)
-        col = cv2.inRange(hsv, self.lo, self.hi)
         self.n += 1
-        if self.n > o.bg_warmup:
-            fg = np.repeat(np.repeat(fg_small[y0 // s:], s, axis=0), s, axis=1)
-            fg = np.ascontiguousarray(fg[: roi.shape[0], :W])
-            if fg.shape != col.shape:
-                fg = cv2.resize(fg_small[y0 // s:], (W, roi.shape[0]),
-                                interpolation=cv2.INTER_NEAREST)
-            fg = cv2.dilate(fg, self.kernel)
-            mask = cv2.bitwise_and(col, fg)
+        use_fg = self.n > o.bg_warmup
+        y0 = 0
+        if self.body is not None:
+            y0 = min(max(int(self.body[:, 1].min() - o.marker_spacing * 0.5), 0), H - 1)
+        ys0 = y0 // s
+        col_small = cv2.inRange(cv2.cvtColor(small[ys0:], cv2.COLOR_BGR2HSV), self.lo, self.hi)
+        gate = None
+        if use_fg:
+            # moving pixels, grown by one sample so the gate covers the blob edges
+            gate = cv2.dilate(fg_small[ys0:], self.kernel3)
+            cand = cv2.bitwise_and(col_small, gate)
         else:
-            mask = col
-        mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, self.kernel)
-        contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
-        area_full = math.pi * o.foot_radius ** 2
-        blobs = []
-        for c in contours:
-            a = cv2.contourArea(c)
-            if a < 0.15 * area_full:
+            cand = col_small
+        cand = cv2.dilate(cand, self.kernel3)
+        n_lab, _, stats, _ = cv2.connectedComponentsWithStats(cand, connectivity=8)
+        # expected full-size area in samples (dilated): keep anything that could
+        # hold a blob of at least 0.15 of the foot area
+        min_samples = max(0.15 * self.area_full / (s * s), 1.0)
+        pad = 2 * s + 4
+        boxes = []
+        for lab in range(1, n_lab):
+            bx, by, bw, bh, area = (int(v) for v in stats[lab])
+            if area < min_samples:
                 continue
-            if len(c) >= 5:
-                (cx, cy), _, _ = cv2.fitEllipse(c)
-            else:
-                m = cv2.moments(c)
-                cx, cy = m["m10"] / m["m00"], m["m01"] / m["m00"]
-            blobs.append((a, np.array([cx, cy + y0])))
+            boxes.append([max(bx * s - pad, 0), max((by + ys0) * s - pad, y0),
+                          min((bx + bw) * s + pad, W), min((by + bh + ys0) * s + pad, H)])
+        boxes = _merge_boxes(boxes)
+        blobs = []
+        for bx0, by0, bx1, by1 in boxes:
+            hsv = cv2.cvtColor(frame[by0:by1, bx0:bx1], cv2.COLOR_BGR2HSV)
+            mask = cv2.inRange(hsv, self.lo, self.hi)
+            if gate is not None:
+                # sample (i, j) covers full-resolution pixels [s*i - s/2, s*i + s/2)
+                gy0, gx0 = (by0 + s // 2) // s - ys0, (bx0 + s // 2) // s
+                gy1, gx1 = (by1 - 1 + s // 2) // s - ys0 + 1, (bx1 - 1 + s // 2) // s + 1
+                g = gate[gy0:gy1, gx0:gx1]
+                g = cv2.resize(g, (g.shape[1] * s, g.shape[0] * s),
+                               interpolation=cv2.INTER_NEAREST)
+                oy, ox = by0 - (gy0 + ys0) * s + s // 2, bx0 - gx0 * s + s // 2
+                g = g[oy: oy + by1 - by0, ox: ox + bx1 - bx0]
+                if g.shape != mask.shape:    # frame edge: pad the gate with "moving"
+                    gg = np.full_like(mask, 255)
+                    gg[: g.shape[0], : g.shape[1]] = g
+                    g = gg
+                mask = cv2.bitwise_and(mask, g)
+            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, self.kernel)
+            contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE,
+                                           offset=(bx0, by0))
+            for c in contours:
+                a = cv2.contourArea(c)
+                if a < 0.15 * self.area_full:
+                    continue
+                if len(c) >= 5:
+                    (cx, cy), _, _ = cv2.fitEllipse(c)
+                else:
+                    mo = cv2.moments(c)
+                    cx, cy = mo["m10"] / mo["m00"], mo["m01"] / mo["m00"]
+                blobs.append((a, np.array([cx, cy])))
         blobs.sort(key=lambda b: -b[0])
         blobs = blobs[:2]
         assign = self._assign([b[1] for b in blobs])
@@ -522,7 +592,7 @@ class _Tracker:
                 continue
             a, p = blobs[k]
             self.feet[series] = p
-            if a < o.partial_area * area_full:
+            if a < o.partial_area * self.area_full:
                 out += [math.nan, math.nan, QUALITY["partial"]]
             else:
                 out += [float(p[0]), float(p[1]), QUALITY["ok"]]
@@ -553,24 +623,61 @@ class _Tracker:
         return {0: 0, 1: 1} if straight <= crossed else {0: 1, 1: 0}
 
 
-def _refine_circle(edges: np.ndarray, c: np.ndarray, R: float) -> np.ndarray:
-    """Least-squares (Kasa) circle through the Canny edge pixels near a Hough circle."""
-    x0, y0 = int(c[0] - R - 4), int(c[1] - R - 4)
-    x0, y0 = max(x0, 0), max(y0, 0)
-    sub = edges[y0:int(c[1] + R + 5), x0:int(c[0] + R + 5)]
-    ys, xs = np.nonzero(sub)
+def _merge_boxes(boxes: list[list[int]]) -> list[list[int]]:
+    """Union of overlapping (x0, y0, x1, y1) boxes until none overlap."""
+    merged = True
+    while merged and len(boxes) > 1:
+        merged = False
+        for i in range(len(boxes)):
+            for j in range(i + 1, len(boxes)):
+                a, b = boxes[i], boxes[j]
+                if a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]:
+                    boxes[i] = [min(a[0], b[0]), min(a[1], b[1]), max(a[2], b[2]),
+                                max(a[3], b[3])]
+                    del boxes[j]
+                    merged = True
+                    break
+            if merged:
+                break
+    return boxes
+
+
+def _refine_circle(grey: np.ndarray, c: np.ndarray, R: float, canny_low: float,
+                   canny_high: float, cv2: Any) -> np.ndarray:
+    """Least-squares (Kasa) circle through the Canny edge pixels near a Hough circle.
+
+    ``grey`` is the blurred grey region; the Canny edges are computed only in
+    a window of the circle (plus a border so the window edge adds no edges).
+    """
+    h, w = grey.shape
+    x0, y0 = max(int(c[0] - R - 8), 0), max(int(c[1] - R - 8), 0)
+    x1, y1 = min(int(c[0] + R + 9), w), min(int(c[1] + R + 9), h)
+    if x1 - x0 < 8 or y1 - y0 < 8:
+        return c
+    edges = cv2.Canny(grey[y0:y1, x0:x1], canny_low, canny_high)
+    ys, xs = np.nonzero(edges)
     if len(xs) < 12:
         return c
     xs = xs + float(x0)
     ys = ys + float(y0)
     for _ in range(2):
-        d = np.hypot(xs - c[0], ys - c[1])
-        keep = np.abs(d - R) < 3.0
-        if keep.sum() < 12:
+        keep = np.abs(np.hypot(xs - c[0], ys - c[1]) - R) < 3.0
+        n = int(keep.sum())
+        if n < 12:
             return c
         x, y = xs[keep], ys[keep]
-        A = np.stack([x, y, np.ones_like(x)], axis=1)
-        sol, *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
-        c = np.array([sol[0] / 2, sol[1] / 2])
-        R = math.sqrt(max(sol[2] + c[0] ** 2 + c[1] ** 2, 1.0))
+        mx, my = x.mean(), y.mean()
+        u, v = x - mx, y - my
+        z = u * u + v * v
+        # normal equations of min sum (z - a u - b v - e)^2 with centred u, v
+        suu, svv, suv = float(u @ u), float(v @ v), float(u @ v)
+        suz, svz = float(u @ z), float(v @ z)
+        det = suu * svv - suv * suv
+        if det <= 0:
+            return c
+        a = (suz * svv - svz * suv) / det
+        b = (svz * suu - suz * suv) / det
+        e = float(z.mean())
+        c = np.array([mx + a / 2, my + b / 2])
+        R = math.sqrt(max(e + (a / 2) ** 2 + (b / 2) ** 2, 1.0))
     return c
