@@ -55,13 +55,13 @@ def synth_video_cmd(
     = Path("synthetic.mp4"),
     preset_name: PresetOpt = "table6.1",
     sets: SetOpt = None,
-    duration: Annotated[float, typer.Option("--duration", help="Length [s].")] = 1.0,
-    fps: Annotated[float, typer.Option("--fps", help="Frame rate [Hz].")] = 1000.0,
-    width: Annotated[int, typer.Option("--width", help="Frame width [px].")] = 1024,
-    height: Annotated[int, typer.Option("--height", help="Frame height [px].")] = 816,
+    duration: Annotated[float, typer.Option("--duration", help="Length \\[s].")] = 1.0,
+    fps: Annotated[float, typer.Option("--fps", help="Frame rate \\[Hz].")] = 1000.0,
+    width: Annotated[int, typer.Option("--width", help="Frame width \\[px].")] = 1024,
+    height: Annotated[int, typer.Option("--height", help="Frame height \\[px].")] = 816,
     field_width: Annotated[float, typer.Option("--field-width",
-                                               help="Scene width in the frame [m].")] = 0.88,
-    noise: Annotated[float, typer.Option("--noise", help="Sensor noise [grey levels].")] = 3.0,
+                                               help="Scene width in the frame \\[m].")] = 0.88,
+    noise: Annotated[float, typer.Option("--noise", help="Sensor noise \\[grey levels].")] = 3.0,
     seed: Annotated[int, typer.Option("--seed", help="Noise seed.")] = 0,
 ) -> None:
     """Render a simulated run as a treadmill video with a ground-truth CSV."""
@@ -141,11 +141,11 @@ def track_cmd(
     video: Annotated[Path, typer.Argument(help="Video (.mp4) or folder of frames.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Tracks table (.csv/.parquet).")]
     = Path("tracks.csv"),
-    fps: Annotated[float | None, typer.Option("--fps", help="Frame rate [Hz] (default: "
+    fps: Annotated[float | None, typer.Option("--fps", help="Frame rate \\[Hz] (default: "
                                               "from the file).")] = None,
-    scale: Annotated[float | None, typer.Option("--scale", help="Image scale [px/m] (default: "
+    scale: Annotated[float | None, typer.Option("--scale", help="Image scale \\[px/m] (default: "
                                                 "measured from the disc spacing).")] = None,
-    ground: Annotated[float | None, typer.Option("--ground", help="Ground row [px].")] = None,
+    ground: Annotated[float | None, typer.Option("--ground", help="Ground row \\[px].")] = None,
     max_frames: Annotated[int | None, typer.Option("--max-frames")] = None,
 ) -> None:
     """Track body discs and feet in a video; write per-frame positions."""
@@ -239,9 +239,9 @@ def fit_cmd(
 def experiment_cmd(
     video: Annotated[Path, typer.Argument(help="Video (.mp4) or folder of frames.")],
     out_dir: Annotated[Path, typer.Option("--out-dir", "-o")] = Path("experiment"),
-    fps: Annotated[float | None, typer.Option("--fps", help="Frame rate [Hz].")] = None,
-    scale: Annotated[float | None, typer.Option("--scale", help="[px/m]")] = None,
-    ground: Annotated[float | None, typer.Option("--ground", help="Ground row [px].")] = None,
+    fps: Annotated[float | None, typer.Option("--fps", help="Frame rate \\[Hz].")] = None,
+    scale: Annotated[float | None, typer.Option("--scale", help="\\[px/m]")] = None,
+    ground: Annotated[float | None, typer.Option("--ground", help="Ground row \\[px].")] = None,
 ) -> None:
     """Run track -> process -> fit and write everything into one folder."""
     with _errors():

@@ -25,7 +25,7 @@ __all__ = ["study_cmd", "reproduce_cmd"]
 WorkersOpt = Annotated[int | None, typer.Option("--workers", min=1,
                                                 help="Worker processes (default: all cores).")]
 SchedulerOpt = Annotated[str | None, typer.Option(
-    "--scheduler", help="Dask scheduler address (needs tslip[dask]).")]
+    "--scheduler", help="Dask scheduler address (needs tslip\\[dask]).")]
 
 
 class _Rate(TextColumn):
