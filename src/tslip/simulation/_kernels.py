@@ -220,18 +220,23 @@ def dopri_step(P, y, h, K, ytmp, ynew):
 
 @njit(**_JIT)
 def error_norm(err, y, ynew, rtol, atol):
-    """Hairer's RMS error norm, in units of the tolerance (accept if <= 1)."""
+    """Hairer's RMS error norm, in units of the tolerance (accept if <= 1).
+
+    Generic in the state size, like :func:`dense_coeffs` and :func:`dense_eval`
+    (the biped's integrator uses them too).
+    """
+    n = y.shape[0]
     s = 0.0
-    for i in range(NSTATE):
+    for i in range(n):
         sk = atol + rtol * max(abs(y[i]), abs(ynew[i]))
         s += (err[i] / sk) ** 2
-    return math.sqrt(s / NSTATE)
+    return math.sqrt(s / n)
 
 
 @njit(**_JIT)
 def dense_coeffs(y, ynew, h, K, R):
     """Coefficients of the 4th-order continuous extension (dopri5 ``contd5``)."""
-    for i in range(NSTATE):
+    for i in range(y.shape[0]):
         ydiff = ynew[i] - y[i]
         bspl = h * K[0, i] - ydiff
         R[0, i] = y[i]
@@ -248,7 +253,7 @@ def dense_coeffs(y, ynew, h, K, R):
 def dense_eval(R, theta, out):
     """Evaluate the continuous extension at ``theta`` in [0, 1] of the step."""
     t1 = 1.0 - theta
-    for i in range(NSTATE):
+    for i in range(out.shape[0]):
         out[i] = R[0, i] + theta * (R[1, i] + t1 * (R[2, i] + theta * (R[3, i] + t1 * R[4, i])))
 
 
