@@ -39,18 +39,15 @@ from ..simulation._kernels import (
     B4,
     B5,
     B6,
-    D1,
-    D3,
-    D4,
-    D5,
-    D6,
-    D7,
     E1,
     E3,
     E4,
     E5,
     E6,
     E7,
+    dense_coeffs,
+    dense_eval,
+    error_norm,
 )
 from ._pack import (
     CS_ON_L,
@@ -459,40 +456,6 @@ def dopri_step(P, t, y, h, K, ytmp, ynew, cs, ws, aux, t_end_eval):
             E1 * K[0, i] + E3 * K[2, i] + E4 * K[3, i] + E5 * K[4, i] + E6 * K[5, i]
             + E7 * K[6, i]
         )
-
-
-@njit(**_JIT)
-def error_norm(err, y, ynew, rtol, atol):
-    """Hairer's RMS error norm in tolerance units (accept if <= 1)."""
-    s = 0.0
-    for i in range(N):
-        sk = atol + rtol * max(abs(y[i]), abs(ynew[i]))
-        s += (err[i] / sk) ** 2
-    return math.sqrt(s / N)
-
-
-@njit(**_JIT)
-def dense_coeffs(y, ynew, h, K, R):
-    """Coefficients of the 4th-order continuous extension (dopri5 ``contd5``)."""
-    for i in range(N):
-        ydiff = ynew[i] - y[i]
-        bspl = h * K[0, i] - ydiff
-        R[0, i] = y[i]
-        R[1, i] = ydiff
-        R[2, i] = bspl
-        R[3, i] = ydiff - h * K[6, i] - bspl
-        R[4, i] = h * (
-            D1 * K[0, i] + D3 * K[2, i] + D4 * K[3, i] + D5 * K[4, i] + D6 * K[5, i]
-            + D7 * K[6, i]
-        )
-
-
-@njit(**_JIT)
-def dense_eval(R, theta, out):
-    """Evaluate the continuous extension at ``theta`` in [0, 1]."""
-    t1 = 1.0 - theta
-    for i in range(N):
-        out[i] = R[0, i] + theta * (R[1, i] + t1 * (R[2, i] + theta * (R[3, i] + t1 * R[4, i])))
 
 
 @njit(**_JIT)

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from . import _kernels as kn
 from . import _pack as pk
 from .dynamics import controller_references, leg_phase
-from .parameters import STATE_FIELDS, BipedParams, BipedState
+from .parameters import BIPED_PARAMETER_TABLE, STATE_FIELDS, BipedParams, BipedState
 from .simulate import BipedOptions, BipedStatus, BipedTrajectory, simulate, stride
 
 __all__ = [
@@ -37,6 +37,12 @@ __all__ = [
     "GaitSearchResult",
     "find_periodic_gait",
     "metacentric_test",
+    "refine_periodic_gait",
+    "section_multipliers",
+    "REFINE_OPTIONS",
+    "DISTURBANCES",
+    "survives_disturbance",
+    "disturbance_limit",
 ]
 
 SECTION_FIELDS: tuple[str, ...] = STATE_FIELDS[1:] + ("rho_R",)
@@ -185,6 +191,7 @@ class GaitSearchResult:
     message: str
     evaluations: int
     history: list[float] = field(default_factory=list)
+    multipliers: NDArray[np.complex128] | None = field(default=None, repr=False)
 
 
 #: Free section entries of the thesis search (starred in Table E.2): pitch
@@ -344,3 +351,225 @@ def metacentric_test(params: BipedParams, state: BipedState, t0: float = 0.0,
         out.append({"dtheta": dth, "t": t, "Fx": fx, "Fz": fz, "impulse": (ix, iz),
                     "status": tr.status.name})
     return out
+
+
+#: Integrator options of the Newton refinement: tighter than the thesis's 1e-8
+#: so that the stride map is smooth well below the 1e-8 residual target.
+REFINE_OPTIONS = BipedOptions(rtol=1e-11, atol=1e-11, max_steps=200_000, stride_time_max=3.0)
+
+
+def refine_periodic_gait(
+    params: BipedParams,
+    z0: NDArray[np.float64],
+    *,
+    free_params: Sequence[str] = ("T", "theta_f", "theta_s", "Kp_h", "Kd_h"),
+    tol: float = 1e-8,
+    max_iter: int = 30,
+    fd_step: float = 1e-6,
+    options: BipedOptions | None = None,
+    multipliers: bool = True,
+) -> GaitSearchResult:
+    """Drive ``|P(z) - z|`` below ``tol`` by Levenberg-Marquardt shooting.
+
+    Well-posed section: every section entry except ``z_b`` is free (``z_b``
+    follows from the right foot being on the ground, and its residual from
+    the others), i.e. 17 unknowns for the 17 independent equations of
+    ``P(z) = z`` including the controller phase ``rho_R`` (which forces the
+    stride to last exactly ``T``). ``free_params`` adds parameters (as the
+    thesis frees starred parameters); the system is then underdetermined and
+    the step starts Levenberg-Marquardt damped (``mu = 1e-6``, scaled by
+    ``diag(J^T J)``) and becomes the minimum-norm Gauss-Newton step as ``mu``
+    falls; the damping picks the gait found (see the report). The Jacobian is
+    a forward difference with step ``fd_step * max(1, |x|)`` at
+    :data:`REFINE_OPTIONS` tolerances. Never raises on non-convergence.
+
+    With ``multipliers`` the Floquet multipliers of the reduced 17-dimensional
+    map (section without ``z_b``) are computed at the result by forward
+    differences (17 extra strides); the 18-dimensional map adds a zero.
+    """
+    options = options or REFINE_OPTIONS
+    free_params = tuple(free_params)
+    bad = [n for n in free_params if n not in {r.name for r in BIPED_PARAMETER_TABLE}]
+    if bad:
+        raise ValueError(f"unknown free parameter(s) {bad}")
+    z0 = np.asarray(z0, dtype=np.float64)
+    if z0.shape != (NZ,):
+        raise ValueError(f"section vector must have shape ({NZ},), got {z0.shape}")
+    x = np.concatenate([z0[1:], [float(getattr(params, n)) for n in free_params]])
+    nev = [0]
+
+    def unpack(x: NDArray[np.float64]) -> tuple[BipedParams, NDArray[np.float64]]:
+        p = params.replace(**{n: float(v) for n, v in zip(free_params, x[NZ - 1:],
+                                                           strict=True)})
+        z = np.concatenate([[0.0], x[: NZ - 1]])
+        z[17] %= 1.0
+        y, _ = from_section(p, z)
+        z[0] = _ground_height(p, y)
+        return p, z
+
+    def res(x: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        nev[0] += 1
+        try:
+            p, z = unpack(x)
+        except ValueError:
+            return None
+        z1, st = stride_map(p, z, options)
+        return None if st != BipedStatus.OK else _wrap(z1 - z)
+
+    def jac(x: NDArray[np.float64], r: NDArray[np.float64], cols: int) -> NDArray[np.float64]:
+        J = np.empty((NZ, cols))
+        for j in range(cols):
+            h = fd_step * max(1.0, abs(x[j]))
+            xp = x.copy()
+            xp[j] += h
+            rp = res(xp)
+            if rp is None:
+                xp[j] -= 2 * h
+                h = -h
+                rp = res(xp)
+            J[:, j] = np.nan if rp is None else (rp - r) / h
+        return J
+
+    r = res(x)
+    if r is None:
+        return GaitSearchResult(False, math.inf, z0, params,
+                                "no periodic gait: the start state falls within a stride",
+                                nev[0], [math.inf])
+    n = float(np.linalg.norm(r))
+    history = [n]
+    mu = 1e-6
+    for _ in range(max_iter):
+        if n <= tol:
+            break
+        J = jac(x, r, x.size)
+        if not np.all(np.isfinite(J)):
+            break
+        improved = False
+        for _ in range(10):
+            if mu <= 1e-9:
+                dx = np.linalg.lstsq(J, -r, rcond=None)[0]
+            else:
+                A = J.T @ J
+                dx = np.linalg.solve(A + mu * np.diag(np.diag(A) + 1e-12), -J.T @ r)
+            rn = res(x + dx)
+            if rn is not None and float(np.linalg.norm(rn)) < n:
+                x, r, n = x + dx, rn, float(np.linalg.norm(rn))
+                mu = max(mu / 10.0, 1e-10)
+                improved = True
+                break
+            mu = max(10.0 * mu, 1e-4)
+        history.append(n)
+        if not improved:
+            break
+    p, z = unpack(x)
+    ev = None
+    if multipliers and math.isfinite(n):
+        ev = section_multipliers(p, z, fd_step=fd_step, options=options)
+    ok = n <= tol
+    msg = (f"periodic gait found, residual {n:.2e}" if ok else
+           f"no periodic gait to tolerance {tol:g}: best residual {n:.2e}")
+    return GaitSearchResult(ok, n, z, p, msg, nev[0], history, ev)
+
+
+def section_multipliers(params: BipedParams, z: NDArray[np.float64], *,
+                        fd_step: float = 1e-6,
+                        options: BipedOptions | None = None) -> NDArray[np.complex128]:
+    """Multipliers of the reduced stride map ``w -> P(z(w))[1:]``, ``w = z[1:]``.
+
+    ``z_b`` is eliminated by the section constraint (right foot on the
+    ground), so these are the 17 non-trivial multipliers; sorted by
+    decreasing magnitude. Forward differences at ``options`` (default
+    :data:`REFINE_OPTIONS`); NaN if a perturbed stride falls.
+    """
+    options = options or REFINE_OPTIONS
+    z = np.asarray(z, dtype=np.float64)
+
+    def fix(zz: NDArray[np.float64]) -> NDArray[np.float64]:
+        zz = zz.copy()
+        zz[17] %= 1.0
+        zz[0] = _ground_height(params, from_section(params, zz)[0])
+        return zz
+
+    z = fix(z)
+    z1, st = stride_map(params, z, options)
+    A = np.empty((NZ - 1, NZ - 1))
+    for j in range(1, NZ):
+        h = fd_step * max(1.0, abs(z[j]))
+        zp = z.copy()
+        zp[j] += h
+        zp1, _ = stride_map(params, fix(zp), options)
+        A[:, j - 1] = _wrap(zp1 - z1)[1:] / h
+    if not np.all(np.isfinite(A)):
+        return np.full(NZ - 1, np.nan + 0j)
+    ev = np.linalg.eigvals(A)
+    return ev[np.argsort(-np.abs(ev))]
+
+
+#: Disturbances of the robustness search (CONVENTIONS.md, "Disturbances for
+#: robustness", adapted to the biped): magnitudes are signed by ``sign``.
+DISTURBANCES: tuple[str, ...] = ("step_down", "push", "pitch_rate")
+
+
+def survives_disturbance(params: BipedParams, z: NDArray[np.float64], kind: str,
+                         value: float, n_strides: int = 25,
+                         options: BipedOptions | None = None) -> tuple[bool, str]:
+    """Run ``n_strides`` from the gait ``z`` with one disturbance; (survived, status).
+
+    ``step_down``: the ground is shifted by ``value`` [L] (negative: down)
+    for every touch-down after the first right stance (the body is shifted by
+    ``-value`` in the middle of the first flight phase after a lift-off).
+    ``push``: ``value`` added to ``xd_b`` of the section state.
+    ``pitch_rate``: ``value`` added to the body pitch rate with the leg
+    (absolute) angular rates kept, i.e. subtracted from both hip-angle rates.
+    """
+    if kind not in DISTURBANCES:
+        raise ValueError(f"unknown disturbance {kind!r}; known: {list(DISTURBANCES)}")
+    y, t0 = from_section(params, z)
+    if kind == "push":
+        y[9] += value
+    elif kind == "pitch_rate":
+        y[11] += value
+        y[14] -= value
+        y[17] -= value
+    if kind != "step_down":
+        tr = simulate(params, y, n_strides, t0=t0, options=options)
+        return tr.n_strides >= n_strides, tr.status.name
+    # first right stance on the original ground; cut in the middle of the first
+    # interval after a lift-off in which both feet are in the air
+    first = simulate(params, y, 1, t0=t0, options=options)
+    t_cut = math.inf
+    evs = first.events
+    for i, e in enumerate(evs[:-1]):
+        if e.kind.startswith("liftoff"):
+            tm = 0.5 * (e.t + evs[i + 1].t)
+            row = min(int(first.time.searchsorted(tm)), first.data.shape[0] - 1)
+            if first["contact_R"][row] == 0.0 and first["contact_L"][row] == 0.0:
+                t_cut = tm
+                break
+    if not math.isfinite(t_cut):
+        return False, "NO_FLIGHT"
+    part = simulate(params, y, 1, t0=t0, t_end=t_cut, options=options)
+    if part.status.name != "T_END":
+        return False, part.status.name
+    y1 = part.final_state.copy()
+    y1[1] -= value
+    tr = simulate(params, y1, n_strides, t0=float(part.stats["t_end"]),
+                  contact=part.final_contact, options=options)
+    return tr.n_strides >= n_strides, tr.status.name
+
+
+def disturbance_limit(params: BipedParams, z: NDArray[np.float64], kind: str, *,
+                      sign: float = -1.0, n_strides: int = 25, tol: float = 1e-3,
+                      options: BipedOptions | None = None) -> Any:
+    """Largest survivable magnitude of a disturbance (``tslip.gait.robustness.limit_search``).
+
+    Returns the :class:`~tslip.gait.robustness.LimitSearch`; the signed
+    limit is ``sign * result.lo``.
+    """
+    from ..gait.robustness import limit_search
+
+    def survives(m: NDArray[np.float64]) -> NDArray[np.bool_]:
+        return np.array([survives_disturbance(params, z, kind, sign * float(v), n_strides,
+                                              options)[0] for v in np.ravel(m)])
+
+    return limit_search(survives, start=0.01, tol=tol, ladder=8, k=1, max_magnitude=10.0)
