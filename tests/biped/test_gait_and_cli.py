@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 
 import numpy as np
 import pytest
@@ -57,11 +58,33 @@ def test_cli_simulate_search_report(tmp_path):
     assert r.exit_code == 0, r.output
     assert "2 strides" in r.output and (tmp_path / "a.csv").exists()
     r = runner.invoke(app, ["biped", "search", "--out", str(tmp_path / "g.json"),
-                            "--cma-evals", "0", "--lsq-evals", "2", "--no-multipliers"])
+                            "--max-iter", "1", "--no-multipliers", "-n", "3"])
     assert r.exit_code == 0, r.output
+    assert "best residual" in r.output and "strides until fall" in r.output
     data = json.loads((tmp_path / "g.json").read_text())
     assert data["converged"] is False and len(data["z"]) == 18
     r = runner.invoke(app, ["biped", "simulate", "-n", "1", "--gait", str(tmp_path / "g.json")])
     assert r.exit_code == 0, r.output
     r = runner.invoke(app, ["biped", "simulate", "--set", "m_b=-1"])
     assert r.exit_code == 2 and "m_b" in r.output
+
+
+def test_cli_search_from_the_stored_gait_reports_multipliers(tmp_path):
+    gait = os.path.join(os.path.dirname(__file__), "stable_gait.json")
+    r = CliRunner().invoke(app, ["biped", "search", "--gait", gait, "--out",
+                                 str(tmp_path / "g.json"), "-n", "10"])
+    assert r.exit_code == 0, r.output
+    assert "periodic gait found" in r.output and "stable" in r.output
+    data = json.loads((tmp_path / "g.json").read_text())
+    assert data["converged"] and data["residual"] < 1e-8
+    assert 0.78 < data["largest_multiplier"] < 0.80 and len(data["multipliers"]) == 17
+    assert data["strides_until_fall"] == 10
+
+
+def test_cli_report_loads_a_gait_file(tmp_path):
+    gait = os.path.join(os.path.dirname(__file__), "optimised_gait.json")
+    r = CliRunner().invoke(app, ["biped", "report", "--gait", gait, "--out-dir",
+                                 str(tmp_path), "-n", "3"])
+    assert r.exit_code == 0, r.output
+    assert "strides until fall: 3" in r.output and "largest multiplier 0.428" in r.output
+    assert (tmp_path / "multipliers.csv").exists() and (tmp_path / "fig_e2_tracking.png").exists()

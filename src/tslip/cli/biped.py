@@ -102,36 +102,76 @@ def simulate_cmd(
             c.print(f"wrote {out}")
 
 
+def _gait_summary(p: BipedParams, z: np.ndarray, ev: np.ndarray | None,
+                  strides: int) -> tuple[dict[str, Any], list[str]]:
+    """Multipliers and strides until fall of a gait: JSON entries and printed lines."""
+    data: dict[str, Any] = {}
+    lines: list[str] = []
+    if ev is not None and np.all(np.isfinite(ev)):
+        data["multipliers"] = [[float(m.real), float(m.imag)] for m in ev]
+        data["largest_multiplier"] = float(np.abs(ev[0]))
+        top = ", ".join(f"{abs(m):.4f}" for m in ev[:4])
+        lines.append(f"largest multiplier magnitude {abs(ev[0]):.4f} "
+                     f"({'stable' if abs(ev[0]) < 1 else 'unstable'}; leading: {top})")
+    elif ev is not None:
+        lines.append("multipliers: a perturbed stride falls (NaN)")
+    y, t0 = from_section(p, z)
+    tr = simulate(p, y, strides, t0=t0)
+    data["strides_until_fall"] = tr.n_strides
+    data["fall_reason"] = tr.status.reason
+    lines.append(f"strides until fall: {tr.n_strides} of {strides} ({tr.status.reason})")
+    return data, lines
+
+
 @biped_app.command("search")
 def search_cmd(
     out: Annotated[Path, typer.Option("--out", help="JSON of the best gait.")],
     sets: SetOpt = None,
     gait: GaitOpt = None,
     free_param: Annotated[list[str] | None, typer.Option(
-        "--free-param", help="Also free this parameter (repeatable).")] = None,
-    cma_evals: Annotated[int, typer.Option("--cma-evals")] = 600,
-    lsq_evals: Annotated[int, typer.Option("--lsq-evals")] = 200,
+        "--free-param", help="Parameter freed in the refinement (repeatable; default "
+        "T, theta_f, theta_s, Kp_h, Kd_h).")] = None,
+    cma_evals: Annotated[int, typer.Option(
+        "--cma-evals", help="CMA-ES strides before the refinement (0: refine only).")] = 0,
     sigma0: Annotated[float, typer.Option("--sigma0")] = 0.05,
     seed: Annotated[int, typer.Option("--seed")] = 1,
+    max_iter: Annotated[int, typer.Option(
+        "--max-iter", help="Levenberg-Marquardt iterations of the refinement.")] = 30,
+    tol: Annotated[float, typer.Option("--tol", help="Periodicity residual target.")] = 1e-8,
     multipliers: Annotated[bool, typer.Option("--multipliers/--no-multipliers")] = True,
+    strides: Annotated[int, typer.Option(
+        "--strides", "-n", help="Strides run from the result (strides until fall).")] = 50,
 ) -> None:
-    """CMA-ES then least squares for a periodic gait (eqs E.35-E.36)."""
+    """Periodic gait: optional CMA-ES (eqs E.35-E.36), then shooting refinement."""
+    from ..biped.gait import refine_periodic_gait
+
     with _errors():
         p, y, t0 = _start(sets, gait)
         z0 = to_section(p, y, t0)
-        free = list(free_param or ["rho0"])
-        bounds = {"rho0": (0.0, 0.999)}
-        res = find_periodic_gait(p, z0, free_params=free, bounds=bounds, cma_evals=cma_evals,
-                                 lsq_evals=lsq_evals, sigma0=sigma0, seed=seed)
+        free = tuple(free_param) if free_param else ("T", "theta_f", "theta_s", "Kp_h", "Kd_h")
         c = _console()
-        c.print(res.message + f" ({res.evaluations} strides simulated)")
+        history: list[float] = []
+        evals = 0
+        if cma_evals > 0:
+            cm = find_periodic_gait(p, z0, free_params=("rho0",), bounds={"rho0": (0.0, 0.999)},
+                                    cma_evals=cma_evals, lsq_evals=0, sigma0=sigma0, seed=seed)
+            c.print(f"CMA-ES: best residual {cm.residual:.2e} ({cm.evaluations} strides)")
+            history += cm.history
+            evals += cm.evaluations
+            p, z0 = cm.params, cm.z
+        res = refine_periodic_gait(p, z0, free_params=free, tol=tol, max_iter=max_iter,
+                                   multipliers=multipliers)
+        history += res.history
+        evals += res.evaluations
+        c.print(res.message + f" ({evals} strides simulated)")
         data: dict[str, Any] = {"converged": res.converged, "residual": res.residual,
                                 "z": res.z.tolist(), "params": res.params.to_dict(),
-                                "history": res.history}
-        if multipliers and math.isfinite(res.residual) and res.residual < 1.0:
-            fr = floquet(res.params, res.z)
-            data["multipliers"] = [[float(m.real), float(m.imag)] for m in fr.multipliers]
-            c.print(f"largest multiplier magnitude {fr.largest:.3f}")
+                                "free_params": list(free), "history": history}
+        if math.isfinite(res.residual):
+            extra, lines = _gait_summary(res.params, res.z, res.multipliers, strides)
+            data.update(extra)
+            for line in lines:
+                c.print(line)
         _write_json(out, data)
         c.print(f"wrote {out}")
 
@@ -162,8 +202,11 @@ def report_cmd(
     sets: SetOpt = None,
     gait: GaitOpt = None,
     strides: StridesOpt = 50,
+    robustness: Annotated[bool, typer.Option(
+        "--robustness/--no-robustness",
+        help="Also find the step-down, push and pitch-rate limits (25 strides).")] = False,
 ) -> None:
-    """Write Figures E.2-E.4 and the multiplier table."""
+    """Write Figures E.2-E.4 and the multiplier table (and robustness limits)."""
     from ..plotting.biped import plot_foot_path, plot_metacentric, plot_tracking
 
     with _errors():
@@ -182,4 +225,55 @@ def report_cmd(
         ]
         (out_dir / "multipliers.csv").write_text("\n".join(rows) + "\n")
         c.print(f"largest multiplier {fr.largest:.3f} (periodicity residual {fr.residual:.2e})")
+        if robustness:
+            from ..biped.gait import DISTURBANCES, disturbance_limit
+
+            z = fr.z
+            lim = {k: -float(disturbance_limit(p, z, k, sign=-1.0).lo) for k in DISTURBANCES}
+            c.print("robustness (25 strides): " + ", ".join(
+                f"{k} {v:.4f}" for k, v in lim.items()) + "  (TSLIP Table 6.1: step_down "
+                "-0.119, push -0.725, pitch_rate -0.733)")
+            _write_json(out_dir / "robustness.json", lim)
         c.print(f"wrote figures and multipliers.csv to {out_dir}")
+
+
+@biped_app.command("optimise")
+def optimise_cmd(
+    out: Annotated[Path, typer.Option("--out", help="JSON of the most stable gait found.")],
+    gait: Annotated[Path, typer.Option(
+        "--gait", metavar="FILE.json", help="Converged gait to start from (warm start).")],
+    budget: Annotated[float, typer.Option("--budget", help="Wall-clock seconds.")] = 600.0,
+    max_evals: Annotated[int, typer.Option("--max-evals")] = 400,
+    popsize: Annotated[int, typer.Option("--popsize")] = 8,
+    sigma0: Annotated[float, typer.Option("--sigma0", help="CMA-ES step (bounds scaled "
+                                          "to [0, 1]).")] = 0.08,
+    seed: Annotated[int, typer.Option("--seed")] = 3,
+    processes: Annotated[int, typer.Option("--processes", "-j")] = 1,
+) -> None:
+    """Beyond the thesis: minimise the largest multiplier over gains, sweep, duty, masses."""
+    from ..biped.design import DESIGN_BOUNDS, stable_gait_search
+    from ..biped.gait import section_multipliers
+
+    with _errors():
+        p, y, t0 = _start(None, gait)
+        z0 = to_section(p, y, t0)
+        c = _console()
+        r = stable_gait_search(p, z0, budget_s=budget, max_evals=max_evals, popsize=popsize,
+                               sigma0=sigma0, seed=seed, processes=processes, log=c.print)
+        b = r["best"]
+        data: dict[str, Any] = {"design": b.get("design"), "bounds": DESIGN_BOUNDS,
+                                "evaluations": r["evaluations"], "seconds": r["seconds"],
+                                "history": r["history"], "residual": b["residual"],
+                                "converged": b["score"] < 10.0}
+        if "z" in b:
+            bp = BipedParams.from_dict(b["params"])
+            data.update(params=b["params"], z=b["z"])
+            ev = section_multipliers(bp, np.asarray(b["z"]))
+            extra, lines = _gait_summary(bp, np.asarray(b["z"]), ev, 50)
+            data.update(extra)
+            for line in lines:
+                c.print(line)
+        c.print(f"best score {b['score']:.4f} after {r['evaluations']} designs "
+                f"({r['seconds']:.0f} s)")
+        _write_json(out, data)
+        c.print(f"wrote {out}")

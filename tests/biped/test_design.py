@@ -1,0 +1,55 @@
+"""Stable-gait design search (beyond the thesis) and the optimised gait it found."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+from tslip.biped import BipedParams
+from tslip.biped.design import DESIGN_BOUNDS, apply_design, design_objective
+
+HERE = os.path.dirname(__file__)
+
+
+def _load(name):
+    with open(os.path.join(HERE, name)) as fh:
+        data = json.load(fh)
+    return data, BipedParams.from_dict(data["params"]), np.array(data["z"])
+
+
+def test_apply_design_keeps_unit_mass_and_scales_inertias():
+    p = apply_design(BipedParams(), {"m_t": 0.05, "m_s": 0.02, "m_f": 0.01, "Kp_h": 1.0})
+    assert p.total_mass == pytest.approx(1.0)
+    assert p.m_b == pytest.approx(0.84)
+    assert p.J_b == pytest.approx(0.125 * 0.84) and p.J_t == pytest.approx(0.125 * 0.05)
+    assert p.J_s == pytest.approx(0.5 * 0.02) and p.Kp_h == 1.0
+    assert apply_design(BipedParams(), {}).J_b == pytest.approx(0.1)  # Table E.1 unchanged
+    # the heaviest legs within the bounds leave m_b = 0.54 >= 0.5
+    assert apply_design(BipedParams(), {"m_t": 0.15, "m_s": 0.05, "m_f": 0.03}).m_b == \
+        pytest.approx(0.54)
+    with pytest.raises(ValueError, match="Kp_t must be in"):
+        apply_design(BipedParams(), {"Kp_t": DESIGN_BOUNDS["Kp_t"][1] + 1})
+    with pytest.raises(ValueError, match="unknown design"):
+        apply_design(BipedParams(), {"k": 9.0})
+
+
+def test_design_objective_penalises_infeasible_designs():
+    _, p, z = _load("stable_gait.json")
+    out = design_objective(p, z, {"d": 0.9})
+    assert out["score"] == 20.0 and "d must be in" in out["message"]
+
+
+def test_optimised_gait_is_periodic_and_uses_a_feasible_design():
+    """The gait of `tslip biped optimise` (see the report; multipliers checked by the
+    report CLI test, 0.428)."""
+    from tslip.biped.gait import REFINE_OPTIONS, _wrap, stride_map
+
+    data, p, z = _load("optimised_gait.json")
+    z1, st = stride_map(p, z, REFINE_OPTIONS)
+    assert st.name == "OK" and np.linalg.norm(_wrap(z1 - z)) < 1e-8
+    assert apply_design(BipedParams(), data["design"]).replace(
+        T=p.T, theta_f=p.theta_f) == p
+    assert data["largest_multiplier"] < 0.45 and data["strides_until_fall"] == 50
