@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import os
 import tempfile
+import tomllib
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["atomic_write", "write_table"]
+__all__ = ["atomic_write", "git_hash", "read_toml", "write_table"]
 
 
 def atomic_write(path: str | Path, write: Callable[[str], None]) -> Path:
@@ -41,3 +42,29 @@ def write_table(df, path: str | Path) -> Path:  # noqa: ANN001 - pandas.DataFram
     if suffix == ".parquet":
         return atomic_write(path, lambda tmp: df.to_parquet(tmp, index=False))
     raise ValueError(f"output file must end in .csv or .parquet, got {str(path)!r}")
+
+
+def read_toml(path: str | Path, what: str) -> dict:
+    """Parse a TOML file; a missing or malformed file is a one-line ``ValueError``.
+
+    ``what`` names the file in the message, e.g. ``"parameter file"``.
+    """
+    try:
+        with open(path, "rb") as fh:
+            return tomllib.load(fh)
+    except FileNotFoundError:
+        raise ValueError(f"{what} {str(path)!r} does not exist") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{what} {str(path)!r} is not valid TOML: {exc}") from None
+
+
+def git_hash() -> str | None:
+    """The source checkout's commit, if the package runs from one."""
+    import subprocess
+
+    try:
+        out = subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent,
+                             capture_output=True, text=True, timeout=5)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() or None if out.returncode == 0 else None

@@ -13,11 +13,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, NamedTuple
 
+from .._io import read_toml
 from .controllers import (
     ConstantTorque,
     Controller,
@@ -238,13 +238,7 @@ class Params:
     @classmethod
     def from_toml(cls, path: str | Path, base: Params | None = None) -> Params:
         """Read parameters from a TOML file (see :meth:`from_dict`)."""
-        try:
-            with open(path, "rb") as fh:
-                data = tomllib.load(fh)
-        except FileNotFoundError:
-            raise ValueError(f"parameter file {str(path)!r} does not exist") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise ValueError(f"parameter file {str(path)!r} is not valid TOML: {exc}") from None
+        data = read_toml(path, "parameter file")
         return cls.from_dict(data.get("params", data), base=base)
 
 

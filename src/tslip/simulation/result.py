@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._io import atomic_write, write_table
+from .._io import atomic_write, git_hash, write_table
 from ..model import _pack as pk
 from ..model.parameters import Params
 from ..model.state import TouchdownState
@@ -263,21 +263,10 @@ step-down from a :class:`Disturbance`). ``steps`` holds the :class:`StepResult` 
             "reason": self.status.reason,
             "n_steps": len(self.steps),
             "terrain": {"breakpoints": self.terrain.breakpoints, "heights": self.terrain.heights},
-            "git": _git_hash(),
+            "git": git_hash(),
             **self.meta,
         }
         atomic_write(path.with_suffix(".json"),
                      lambda tmp: Path(tmp).write_text(json.dumps(meta, indent=2, default=str)))
         return path
 
-
-def _git_hash() -> str | None:
-    """The source checkout's commit, if the package runs from one."""
-    import subprocess
-
-    try:
-        out = subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent,
-                             capture_output=True, text=True, timeout=5)
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return out.stdout.strip() or None if out.returncode == 0 else None

@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
-from .._io import atomic_write, write_table
+from .._io import atomic_write, git_hash, write_table
 from ..gait.continuation import continue_gait, get_param
 from ..gait.fixed_point import Gait, GaitProblem, find_gait
 from ..gait.robustness import KINDS, robustness_report
@@ -264,12 +264,6 @@ def _init_worker() -> None:  # pragma: no cover - runs in worker processes
     numba.set_num_threads(1)  # one process per core; no nested threads
 
 
-def _git_hash() -> str | None:
-    from ..simulation.result import _git_hash as gh
-
-    return gh()
-
-
 def run_study(
     spec: StudySpec,
     out_dir: str | Path | None = None,
@@ -376,7 +370,7 @@ def run_study(
     rows = [records[keys[tuple(pt)]] for pt in _points(spec)]
     frame = pd.DataFrame(rows)
     meta = {
-        "tslip_version": __version__, "git": _git_hash(), "study": spec.to_dict(),
+        "tslip_version": __version__, "git": git_hash(), "study": spec.to_dict(),
         "points": n_total, "computed": n_total - n_cached, "cached": n_cached,
         "seconds": time.perf_counter() - t_start, "workers": n_workers,
         "scheduler": scheduler, "tol": float(spec.meta.get("tol", 1e-10)),

@@ -23,7 +23,6 @@ the last axis per value of the first). Specs come from code or from TOML::
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -31,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from .._io import read_toml
 from ..gait.continuation import get_param, set_param
 from ..model.parameters import Params, preset
 
@@ -215,12 +215,6 @@ class StudySpec:
     @classmethod
     def from_toml(cls, path: str | Path) -> StudySpec:
         """Read a study from a TOML file."""
-        try:
-            with open(path, "rb") as fh:
-                data = tomllib.load(fh)
-        except FileNotFoundError:
-            raise ValueError(f"study file {str(path)!r} does not exist") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise ValueError(f"study file {str(path)!r} is not valid TOML: {exc}") from None
+        data = read_toml(path, "study file")
         data.setdefault("name", Path(path).stem)
         return cls.from_dict(data)
