@@ -520,12 +520,18 @@ def fall_check(P, y):
 
 @njit(**_JIT)
 def init_contact(P, y, cs):
-    """Contact flags at the start: a foot at or below ground that is pushing."""
+    """Contact flags at the start: a foot at or below ground that is pushing.
+
+    The anchor is at the ground, or at the foot if it is above (by at most
+    1e-9 L, e.g. a section state placed at the ground up to rounding): an
+    anchor below the foot would zero the force at the first instant (the
+    ground pushes only a foot at or below its anchor).
+    """
     for leg in range(2):
         x, z, xd, zd = foot_state(P, y, leg)
         cs[CS_ON_R + leg] = 0.0
         cs[CS_XR + 2 * leg] = x
-        cs[CS_ZR + 2 * leg] = 0.0
+        cs[CS_ZR + 2 * leg] = max(z, 0.0)
         if P[P_CONTACT] != 0.0 and z <= 1e-9 and -P[P_KZ] * z - P[P_CZ] * zd > 0.0:
             cs[CS_ON_R + leg] = 1.0
 

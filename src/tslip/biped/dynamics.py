@@ -32,6 +32,7 @@ __all__ = [
     "accelerations",
     "energy",
     "body_positions",
+    "momentum",
     "foot_position",
     "hip_position",
     "controller_references",
@@ -123,6 +124,37 @@ def body_positions(params: BipedParams, q: NDArray[np.float64] | BipedState,
     q, qd = _q(q)
     _, ws = _terms(params, q, qd)
     return ws[0].copy()
+
+
+def momentum(params: BipedParams, state: BipedState | NDArray[np.float64],
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+    """Centre of mass, linear momentum and angular momentum about the CoM.
+
+    ``L = sum_i m_i (p_i - c) x v_i + J_i omega_i`` over the seven bodies of
+    eq. E.13, with ``v_i = J_i qd`` (eq. E.11). Moments are counter-clockwise
+    positive (x forward, z up); segment angles are clockwise positive (eq.
+    E.2: ``b_z = (sin theta_b, cos theta_b)``), so ``omega_i = -dangle_i/dt``.
+    Only the ground forces change ``L``: gravity acts at the body CoMs and the
+    actuators are internal.
+
+    Returns
+    -------
+    com : ndarray, shape (2,)
+        Whole-body CoM ``(x, z)`` [L].
+    p : ndarray, shape (2,)
+        Linear momentum [M g^1/2 L^1/2].
+    L : float
+        Angular momentum about ``com`` [M g^1/2 L^3/2].
+    """
+    q, qd = _q(state)
+    _, ws = _terms(params, q, qd)
+    pos, Jp, Ja, _, mass, inertia = ws[:6]
+    v = Jp @ qd
+    m_tot = float(mass.sum())
+    com = mass @ pos / m_tot
+    r = pos - com
+    L = float(np.sum(mass * (r[:, 0] * v[:, 1] - r[:, 1] * v[:, 0])) - inertia @ (Ja @ qd))
+    return com, mass @ v, L
 
 
 def hip_position(params: BipedParams, q: NDArray[np.float64]) -> NDArray[np.float64]:

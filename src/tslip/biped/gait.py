@@ -1,4 +1,4 @@
-"""Biped stride map, periodic-gait search, Floquet multipliers, tracking, metacentre.
+"""Biped stride map, periodic-gait search, Floquet multipliers, tracking, robustness.
 
 The Poincare section is the state just after a right-foot touch-down (Section
 E.2.6). The controller is clocked by time (eqs E.25-E.27), so the section
@@ -36,7 +36,6 @@ __all__ = [
     "tracking_errors",
     "GaitSearchResult",
     "find_periodic_gait",
-    "metacentric_test",
     "refine_periodic_gait",
     "section_multipliers",
     "REFINE_OPTIONS",
@@ -356,43 +355,6 @@ def _ground_height(p: BipedParams, y: NDArray[np.float64]) -> float:
     P = pk.pack_params(p)
     _, zf, _, _ = kn.foot_state(P, y, 0)
     return float(y[1] - zf)
-
-
-def metacentric_test(params: BipedParams, state: BipedState, t0: float = 0.0,
-                     pitches: Sequence[float] = (0.0, 0.5, -0.5),
-                     options: BipedOptions | None = None) -> list[dict[str, Any]]:
-    """Ground reaction forces and impulse of the first right stance for pitch changes.
-
-    The body pitch is changed by each ``dtheta`` about the body CoM with the
-    legs kept fixed in the world: both hip angles change by ``-dtheta``, and
-    the body is shifted so the hip stays where it was (Section E.3.3,
-    Figure E.4).
-
-    Returns
-    -------
-    list of dict
-        Per pitch change: ``dtheta``, times ``t``, forces ``Fx``, ``Fz``,
-        impulse ``(Ix, Iz)`` and the impulse's moment arm about the CoM.
-    """
-    out = []
-    for dth in pitches:
-        q = state.q.copy()
-        qd = state.qd.copy()
-        hip = q[:2] + params.r_1 * np.array([math.sin(q[2]), math.cos(q[2])])
-        q[2] += dth
-        q[5] -= dth
-        q[8] -= dth
-        q[:2] = hip - params.r_1 * np.array([math.sin(q[2]), math.cos(q[2])])
-        tr = simulate(params, BipedState(q, qd), 1, t0=t0, options=options)
-        lo = [e.t for e in tr.events if e.kind == "liftoff_R"]
-        t_lo = lo[0] if lo else tr.time[-1]
-        m = tr.time <= t_lo
-        t = tr.time[m]
-        fx, fz = tr["Fx_R"][m], tr["Fz_R"][m]
-        ix, iz = float(np.trapezoid(fx, t)), float(np.trapezoid(fz, t))
-        out.append({"dtheta": dth, "t": t, "Fx": fx, "Fz": fz, "impulse": (ix, iz),
-                    "status": tr.status.name})
-    return out
 
 
 #: Integrator options of the Newton refinement: tighter than the thesis's 1e-8

@@ -240,7 +240,7 @@ def simulate(
     contact : array_like, shape (6,), optional
         Contact flags and touch-down anchors ``(on_R, on_L, x_R, z_R, x_L,
         z_L)``. Default: a foot at or below the ground that pushes is in
-        contact, anchored where it is.
+        contact, anchored at the ground (see :func:`._kernels.init_contact`).
     options : BipedOptions, optional
 
     Returns

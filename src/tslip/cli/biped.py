@@ -19,10 +19,10 @@ from ..biped.gait import (
     find_periodic_gait,
     floquet,
     from_section,
-    metacentric_test,
     to_section,
     tracking_errors,
 )
+from ..biped.metacentre import metacentric_table, metacentric_test
 from .main import _console, _errors, app
 
 __all__ = ["biped_app"]
@@ -206,7 +206,10 @@ def report_cmd(
         "--robustness/--no-robustness",
         help="Also find the step-down, push and pitch-rate limits (25 strides).")] = False,
 ) -> None:
-    """Write Figures E.2-E.4 and the multiplier table (and robustness limits)."""
+    """Write Figures E.2-E.4, the multiplier and metacentric tables (and robustness limits)."""
+    import pandas as pd
+
+    from .._io import write_table
     from ..plotting.biped import plot_foot_path, plot_metacentric, plot_tracking
 
     with _errors():
@@ -219,6 +222,12 @@ def report_cmd(
         plot_foot_path(tr).savefig(out_dir / "fig_e3_foot_path.png", dpi=120)
         meta = metacentric_test(p, BipedState.from_array(y), t0)
         plot_metacentric(meta).savefig(out_dir / "fig_e4_metacentric.png", dpi=120)
+        table = pd.DataFrame(metacentric_table(meta))
+        write_table(table, out_dir / "metacentric.csv")
+        c.print("metacentric test (right stance, legs fixed in the world): " + "; ".join(
+            f"dtheta {r.dtheta:+.1f}: |I| {r.magnitude_change:+.1%}, lean {r.lean_change_deg:+.1f}"
+            f" deg, dtorque {r.dtorque:+.4f} ({'restoring' if r.restoring else 'not restoring'})"
+            for r in table.itertuples() if r.dtheta != 0.0))
         fr = floquet(p, to_section(p, y, t0))
         rows = ["index,real,imag,abs"] + [
             f"{i},{m.real:.6g},{m.imag:.6g},{abs(m):.6g}" for i, m in enumerate(fr.multipliers)
@@ -234,7 +243,7 @@ def report_cmd(
                 f"{k} {v:.4f}" for k, v in lim.items()) + "  (TSLIP Table 6.1: step_down "
                 "-0.119, push -0.725, pitch_rate -0.733)")
             _write_json(out_dir / "robustness.json", lim)
-        c.print(f"wrote figures and multipliers.csv to {out_dir}")
+        c.print(f"wrote figures, multipliers.csv and metacentric.csv to {out_dir}")
 
 
 @biped_app.command("optimise")

@@ -37,6 +37,7 @@ import dataclasses
 import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.integrate import simpson
@@ -55,6 +56,7 @@ __all__ = [
     "stance_impulse",
     "impulse_linearisation",
     "pitch_disturbance_response",
+    "summarise_pitch_response",
     "Y_P_SINGULAR_ANGLE",
 ]
 
@@ -104,9 +106,9 @@ class Impulse:
     time, F_x, F_y, x, y, hip_x, hip_y : ndarray, shape (n,)
         Stance samples: time since touch-down, ground reaction force, foot
         and hip positions relative to the CoM.
-    state : TouchdownState
-        Touch-down state of the stance.
-    params : Params
+    state : TouchdownState or BipedState
+        State at the start of the stance.
+    params : Params or BipedParams
     """
 
     I_x: float
@@ -127,8 +129,8 @@ class Impulse:
     y: np.ndarray
     hip_x: np.ndarray
     hip_y: np.ndarray
-    state: TouchdownState
-    params: Params
+    state: TouchdownState | Any
+    params: Params | Any
 
     @property
     def magnitude(self) -> float:
@@ -400,8 +402,10 @@ class PitchResponse:
         hip: 1 when the point of application moves with the hip, 0 when it
         stays under the CoM; NaN for ``dphi = 0``.
     restoring : tuple of bool or None
-        ``sign(torque) == -sign(dphi)``: the moment about the CoM opposes the
-        disturbance; ``None`` for ``dphi = 0``.
+        ``sign(torque - nominal.torque) == -sign(dphi)`` (in the pitch
+        direction): the change of the moment about the CoM opposes the
+        disturbance; ``None`` for ``dphi = 0``. At a TSLIP gait the nominal
+        moment is zero (the pitch rate is periodic and constant in flight).
     """
 
     dphis: tuple[float, ...]
@@ -463,15 +467,52 @@ def pitch_disturbance_response(
     nominal = next((i for d, i in zip(dphis, imps, strict=True) if d == 0.0), None)
     if nominal is None:
         nominal = stance_impulse(gait.params, gait.state, dt=dt, options=options)
-    r = gait.params.r
+    return summarise_pitch_response(dphis, imps, nominal, gait.params.r)
+
+
+def summarise_pitch_response(
+    dphis: Sequence[float],
+    impulses: Sequence[Impulse],
+    nominal: Impulse,
+    offset: float,
+    *,
+    pitch_sign: float = 1.0,
+) -> PitchResponse:
+    """Metacentric summary of stance impulses after pitch disturbances.
+
+    Shared by the TSLIP (:func:`pitch_disturbance_response`) and the biped
+    (:func:`tslip.biped.metacentre.metacentric_test`).
+
+    Parameters
+    ----------
+    dphis : sequence of float
+        Pitch disturbances [rad], aligned with ``impulses``.
+    impulses : sequence of Impulse
+    nominal : Impulse
+        The undisturbed stance.
+    offset : float
+        Hip-to-CoM distance [L] that scales ``hip_distance`` (``r`` of the
+        TSLIP, ``r_1`` of the biped).
+    pitch_sign : float
+        +1 if positive pitch is counter-clockwise (TSLIP), -1 if clockwise
+        (biped, eq. E.2). The moment in the pitch direction is
+        ``pitch_sign * torque``.
+
+    Returns
+    -------
+    PitchResponse
+    """
+    dphis = tuple(float(d) for d in dphis)
+    imps = tuple(impulses)
     hx0 = nominal.hip_mean[0]
     dist, ddir, follow, restoring = [], [], [], []
     for d, imp in zip(dphis, imps, strict=True):
-        dist.append(abs(imp.line_distance(*imp.hip_mean)) / r if r > 0 else math.nan)
+        dist.append(abs(imp.line_distance(*imp.hip_mean)) / offset if offset > 0 else math.nan)
         ddir.append(imp.direction - nominal.direction)
         dhx = imp.hip_mean[0] - hx0
         follow.append((imp.x_p - nominal.x_p) / dhx if d != 0.0 and dhx != 0.0 else math.nan)
-        restoring.append(None if d == 0.0 else bool(np.sign(imp.torque) == -np.sign(d)))
+        dtau = pitch_sign * (imp.torque - nominal.torque)
+        restoring.append(None if d == 0.0 else bool(np.sign(dtau) == -np.sign(d)))
     return PitchResponse(
         dphis=dphis, impulses=imps, nominal=nominal, hip_distance=tuple(dist),
         direction_change=tuple(ddir), x_p_follows_hip=tuple(follow), restoring=tuple(restoring),

@@ -12,9 +12,11 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..biped.dynamics import controller_references, foot_position, hip_position, leg_phase
+from .gait import plot_pitch_impulse
 
 if TYPE_CHECKING:
     from ..biped.simulate import BipedTrajectory
+    from ..gait.impulse import PitchResponse
 
 __all__ = ["plot_tracking", "plot_foot_path", "plot_metacentric", "draw_biped", "animate_biped"]
 
@@ -70,32 +72,42 @@ def plot_foot_path(tr: BipedTrajectory, leg: int = 0, ax: Any = None) -> Figure:
     return fig
 
 
-def plot_metacentric(results: list[dict[str, Any]], ax: Any = None) -> Figure:
-    """Ground reaction forces and resultant impulse for pitch changes (Figure E.4)."""
-    if ax is None:
-        fig = Figure(figsize=(8, 4), layout="constrained")
-        ax, ax2 = fig.subplots(1, 2)
-    else:
-        fig = ax.figure
-        ax2 = None
-    for i, r in enumerate(results):
-        lab = f"dtheta_b = {r['dtheta']:+.1f}"
-        ax.plot(r["t"] - r["t"][0], r["Fz"], f"C{i}", label=lab + " F_z")
-        ax.plot(r["t"] - r["t"][0], r["Fx"], f"C{i}--", label=lab + " F_x")
-        if ax2 is not None:
-            ix, iz = r["impulse"]
-            ax2.annotate("", xy=(ix, iz), xytext=(0, 0),
-                         arrowprops={"arrowstyle": "->", "color": f"C{i}"})
-            ax2.plot([ix], [iz], "o", color=f"C{i}", label=lab)
-    ax.set_xlabel("time since start [g^-1/2 L^1/2]")
-    ax.set_ylabel("GRF [M g]")
+def plot_metacentric(response: PitchResponse) -> Figure:
+    """Ground reaction forces and resultant impulse for pitch changes (Figure E.4).
+
+    Left: total ground reaction force over the right stance for each pitch
+    change. Right: the forces at the centre of pressure, the impulse's line
+    of action, the whole-body CoM (origin) and the mean hip, drawn by
+    :func:`tslip.plotting.gait.plot_pitch_impulse` as for the TSLIP.
+
+    Parameters
+    ----------
+    response : PitchResponse
+        From :func:`tslip.biped.metacentre.metacentric_test`.
+    """
+    fig = Figure(figsize=(10, 4.2), layout="constrained")
+    ax, ax2 = fig.subplots(1, 2, width_ratios=(1.0, 1.2))
+    labels = [rf"$\Delta\theta_b$ = {d:+.1f} rad" for d in response.dphis]
+    for i, (imp, lab) in enumerate(zip(response, labels, strict=True)):
+        ax.plot(imp.time, imp.F_y, f"C{i}", label=lab + ": $F_z$")
+        ax.plot(imp.time, imp.F_x, f"C{i}--", label=lab + ": $F_x$")
+    ax.set_xlabel("time since touch-down [g$^{-1/2}$ L$^{1/2}$]")
+    ax.set_ylabel("ground reaction force [M g]")
+    # the ground damper (Table E.3) gives short touch-down and lift-off spikes;
+    # scale the axis to the rest of the stance and say how far the spikes go
+    f_all = np.concatenate([np.r_[i.F_x, i.F_y] for i in response])
+    lo, hi = np.percentile(f_all, [1.0, 99.0])
+    if f_all.max() > 1.5 * hi or f_all.min() < lo - 0.5 * (hi - lo):
+        ax.set_ylim(min(lo, 0.0) - 0.2 * (hi - lo), 1.3 * hi)
+        ax.set_title(f"spikes clipped: range {f_all.min():.1f} to {f_all.max():.1f} M g",
+                     fontsize="small")
+    ax.axhline(0.0, color="0.7", lw=0.5)
     ax.legend(fontsize=7)
-    if ax2 is not None:
-        ax2.set_xlabel("impulse I_x [M g^1/2 L^1/2]")
-        ax2.set_ylabel("impulse I_z")
-        ax2.axhline(0, color="0.7", lw=0.5)
-        ax2.axvline(0, color="0.7", lw=0.5)
-        ax2.legend(fontsize=7)
+    plot_pitch_impulse(response, ax=ax2, labels=labels)
+    ax2.set_xlabel(r"$x - x_{CoM}$ [L]")
+    ax2.set_ylabel(r"$z - z_{CoM}$ [L]")
+    fig.suptitle("metacentric test: right stance after a body-pitch change, legs fixed in the "
+                 "world (CoM at origin, hip: open circle)", fontsize="medium")
     return fig
 
 

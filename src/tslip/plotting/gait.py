@@ -79,10 +79,10 @@ def plot_pitch_impulse(
         Default: ``"dphi = ..."`` for a :class:`PitchResponse`, the
         touch-down pitch otherwise.
     n_arrows : int
-        Force arrows per stance.
+        Force arrows per stance, at interior instants evenly spaced in time.
     force_scale : float, optional
         Arrow length per unit force [L / Mg]; default draws the largest
-        force 0.35 L long.
+        arrow 0.35 L long.
 
     Returns
     -------
@@ -99,12 +99,14 @@ def plot_pitch_impulse(
             labels = [rf"$\phi_{{TD}}$ = {i.state.phi:+.2f} rad" for i in imps]
     fig, axes = _axes_list(ax, len(imps), (4.0 * len(imps), 4.2), sharex=True, sharey=True)
     overlay = len(set(map(id, axes))) == 1
-    f_max = max(float(np.max(np.hypot(i.F_x, i.F_y))) for i in imps)
+    # arrows at interior instants evenly spaced in time (the samples need not be)
+    sels = [np.unique(np.searchsorted(i.time, np.linspace(0.0, i.time[-1], n_arrows + 2)[1:-1]))
+            for i in imps]
+    f_max = max(float(np.max(np.hypot(i.F_x[s], i.F_y[s]))) for i, s in zip(imps, sels))
     scale = force_scale if force_scale is not None else 0.35 / f_max
     i_max = max(i.magnitude for i in imps)
-    for k, (imp, a, label) in enumerate(zip(imps, axes, labels, strict=True)):
+    for k, (imp, a, label, sel) in enumerate(zip(imps, axes, labels, sels, strict=True)):
         color = f"C{k}" if overlay else "C0"
-        sel = np.unique(np.linspace(0, len(imp.time) - 1, n_arrows).round().astype(int))
         a.plot(imp.x, imp.y, color="0.5", lw=0.8)
         a.quiver(imp.x[sel], imp.y[sel], imp.F_x[sel] * scale, imp.F_y[sel] * scale,
                  angles="xy", scale_units="xy", scale=1.0, color=color, alpha=0.45, width=0.006)
