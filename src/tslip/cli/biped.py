@@ -14,6 +14,7 @@ from typing import Annotated, Any
 import numpy as np
 import typer
 
+from .._io import atomic_write
 from ..biped import BipedOptions, BipedParams, BipedState, simulate
 from ..biped.gait import (
     find_periodic_gait,
@@ -35,6 +36,10 @@ SetOpt = Annotated[list[str] | None, typer.Option(
     "--set", "-s", metavar="KEY=VALUE", help="Override a biped parameter, e.g. Kp_h=0.8.")]
 GaitOpt = Annotated[Path | None, typer.Option(
     "--gait", metavar="FILE.json", help="Start from a gait written by `tslip biped search`.")]
+TslipOpt = Annotated[str | None, typer.Option(
+    "--from-tslip", metavar="PRESET",
+    help="Start from this TSLIP preset's periodic gait (Table E.2's '+' entries; the rest "
+         "from Table E.2), e.g. table6.1.")]
 StridesOpt = Annotated[int, typer.Option("--strides", "-n", help="Number of strides.")]
 TolOpt = Annotated[float, typer.Option("--tol", help="Integrator rtol = atol.")]
 
@@ -56,11 +61,24 @@ def _params(sets: list[str] | None, base: BipedParams | None = None) -> BipedPar
     return BipedParams.from_dict(changes, base)
 
 
-def _start(sets: list[str] | None, gait: Path | None) -> tuple[BipedParams, np.ndarray, float]:
-    """Parameters, start state and start time: Table E.2 or a saved gait."""
+def _start(sets: list[str] | None, gait: Path | None,
+           from_tslip: str | None = None) -> tuple[BipedParams, np.ndarray, float]:
+    """Parameters, start state and start time: Table E.2, a TSLIP gait or a saved gait."""
+    if gait is not None and from_tslip is not None:
+        raise ValueError("give at most one of --gait and --from-tslip")
     if gait is None:
         p = _params(sets)
-        return p, BipedState.thesis().to_array(), 0.0
+        if from_tslip is None:
+            return p, BipedState.thesis().to_array(), 0.0
+        from ..biped.anchor import tslip_start
+        from ..gait.fixed_point import find_gait
+        from ..model.parameters import preset
+
+        g = find_gait(preset(from_tslip))
+        if not g.converged:
+            raise ValueError(f"TSLIP preset {from_tslip!r} has no converged gait "
+                             f"(residual {g.residual:.1e})")
+        return p, tslip_start(g.state, p).to_array(), 0.0
     try:
         data = json.loads(Path(gait).read_text())
     except FileNotFoundError:
@@ -73,20 +91,22 @@ def _start(sets: list[str] | None, gait: Path | None) -> tuple[BipedParams, np.n
 
 
 def _write_json(path: Path, data: dict[str, Any]) -> None:
-    Path(path).write_text(json.dumps(data, indent=2, default=float))
+    text = json.dumps(data, indent=2, default=float)
+    atomic_write(path, lambda tmp: Path(tmp).write_text(text))
 
 
 @biped_app.command("simulate")
 def simulate_cmd(
     sets: SetOpt = None,
     gait: GaitOpt = None,
+    from_tslip: TslipOpt = None,
     strides: StridesOpt = 20,
     tol: TolOpt = 1e-8,
     out: Annotated[Path | None, typer.Option("--out", help="CSV of the run.")] = None,
 ) -> None:
     """Run the biped from Table E.2 (or a gait) and report strides and tracking."""
     with _errors():
-        p, y, t0 = _start(sets, gait)
+        p, y, t0 = _start(sets, gait, from_tslip)
         if strides < 1:
             raise ValueError(f"--strides must be >= 1, got {strides}")
         tr = simulate(p, y, strides, t0=t0, options=BipedOptions(rtol=tol, atol=tol))
@@ -128,6 +148,7 @@ def search_cmd(
     out: Annotated[Path, typer.Option("--out", help="JSON of the best gait.")],
     sets: SetOpt = None,
     gait: GaitOpt = None,
+    from_tslip: TslipOpt = None,
     free_param: Annotated[list[str] | None, typer.Option(
         "--free-param", help="Parameter freed in the refinement (repeatable; default "
         "T, theta_f, theta_s, Kp_h, Kd_h).")] = None,
@@ -146,7 +167,7 @@ def search_cmd(
     from ..biped.gait import refine_periodic_gait
 
     with _errors():
-        p, y, t0 = _start(sets, gait)
+        p, y, t0 = _start(sets, gait, from_tslip)
         z0 = to_section(p, y, t0)
         free = tuple(free_param) if free_param else ("T", "theta_f", "theta_s", "Kp_h", "Kd_h")
         c = _console()
@@ -181,6 +202,7 @@ def animate_cmd(
     out: Annotated[Path, typer.Option("--out", help="GIF or MP4 file.")],
     sets: SetOpt = None,
     gait: GaitOpt = None,
+    from_tslip: TslipOpt = None,
     strides: StridesOpt = 5,
     fps: Annotated[int, typer.Option("--fps")] = 25,
 ) -> None:
@@ -190,7 +212,7 @@ def animate_cmd(
     with _errors():
         if out.suffix.lower() not in (".gif", ".mp4"):
             raise ValueError(f"--out must end in .gif or .mp4, got {str(out)!r}")
-        p, y, t0 = _start(sets, gait)
+        p, y, t0 = _start(sets, gait, from_tslip)
         tr = simulate(p, y, strides, t0=t0)
         animate_biped(tr, out, fps=fps)
         _console().print(f"{tr.n_strides} strides, {tr.status.reason}; wrote {out}")
@@ -201,6 +223,7 @@ def report_cmd(
     out_dir: Annotated[Path, typer.Option("--out-dir", help="Directory for figures/tables.")],
     sets: SetOpt = None,
     gait: GaitOpt = None,
+    from_tslip: TslipOpt = None,
     strides: StridesOpt = 50,
     robustness: Annotated[bool, typer.Option(
         "--robustness/--no-robustness",
@@ -213,7 +236,7 @@ def report_cmd(
     from ..plotting.biped import plot_foot_path, plot_metacentric, plot_tracking
 
     with _errors():
-        p, y, t0 = _start(sets, gait)
+        p, y, t0 = _start(sets, gait, from_tslip)
         out_dir.mkdir(parents=True, exist_ok=True)
         tr = simulate(p, y, strides, t0=t0)
         c = _console()
