@@ -53,3 +53,33 @@ def test_optimised_gait_is_periodic_and_uses_a_feasible_design():
     assert apply_design(BipedParams(), data["design"]).replace(
         T=p.T, theta_f=p.theta_f) == p
     assert data["largest_multiplier"] < 0.45 and data["strides_until_fall"] == 50
+
+
+def test_search_interrupt_keeps_the_best_and_checkpoints_it(monkeypatch):
+    """Ctrl-C (here raised from the progress log after the third generation) ends
+    the search with the best design so far instead of losing it. The gait solve
+    is replaced by a cheap bowl so that only the search loop is under test."""
+    import tslip.biped.design as design
+
+    def bowl(base, z_warm, values, **kw):
+        score = (values["Kp_h"] - 1.0) ** 2 + (values["Kd_h"] - 0.5) ** 2
+        return {"score": score, "residual": 0.0, "z": list(z_warm), "params": {}}
+
+    monkeypatch.setattr(design, "design_objective", bowl)
+    _, p, z = _load("optimised_gait.json")
+    calls, saved = [], []
+
+    def log(msg):
+        calls.append(msg)
+        if len(calls) == 4:
+            raise KeyboardInterrupt
+
+    r = design.stable_gait_search(p, z, names=("Kp_h", "Kd_h"), popsize=4, sigma0=0.3,
+                                  seed=1, log=log, on_improve=saved.append)
+    assert r["interrupted"] and r["evaluations"] == 1 + 3 * 4
+    assert "interrupted" in calls[-1] and len(r["history"]) == 4
+    start = (p.Kp_h - 1.0) ** 2 + (p.Kd_h - 0.5) ** 2
+    assert r["best"]["score"] == min(r["history"]) and r["best"]["score"] <= start
+    assert saved and [b["score"] for b in saved] == sorted((b["score"] for b in saved),
+                                                           reverse=True)
+    assert saved[-1]["score"] == r["best"]["score"] and saved[-1]["evaluations"] <= 13

@@ -119,18 +119,24 @@ def stable_gait_search(base: BipedParams, z0: NDArray[np.float64], *,
                        names: tuple[str, ...] = tuple(DESIGN_BOUNDS),
                        budget_s: float = 600.0, max_evals: int = 400, popsize: int = 8,
                        sigma0: float = 0.08, seed: int = 3, processes: int = 1,
-                       log: Callable[[str], None] | None = None) -> dict[str, Any]:
+                       log: Callable[[str], None] | None = None,
+                       on_improve: Callable[[dict[str, Any]], None] | None = None,
+                       ) -> dict[str, Any]:
     """CMA-ES over the design variables ``names`` for the smallest ``max |lambda|``.
 
     ``base`` and ``z0`` are a converged gait (the warm start). Stops after
-    ``budget_s`` seconds (checked per generation) or ``max_evals`` designs.
-    ``processes > 1`` scores a generation in a process pool.
+    ``budget_s`` seconds (checked per generation), ``max_evals`` designs, or
+    an interrupt (Ctrl-C), returning the best design so far in each case.
+    ``processes > 1`` scores a generation in a process pool. ``on_improve``
+    is called with each new best (e.g. to checkpoint it; a run resumes by
+    warm-starting from that gait).
 
     Returns
     -------
     dict
         ``best`` (the best :func:`design_objective` result plus ``design``),
-        ``evaluations``, ``history`` (best score per generation), ``seconds``.
+        ``evaluations``, ``history`` (best score per generation), ``seconds``,
+        ``interrupted``.
     """
     import cma
 
@@ -158,6 +164,7 @@ def stable_gait_search(base: BipedParams, z0: NDArray[np.float64], *,
         import multiprocessing as mp
 
         pool = mp.get_context("fork").Pool(processes)
+    interrupted = False
     try:
         while (time.perf_counter() - t_start < budget_s and n_ev + popsize <= max_evals
                and not es.stop()):
@@ -170,14 +177,20 @@ def stable_gait_search(base: BipedParams, z0: NDArray[np.float64], *,
             if outs[k]["score"] < best["score"]:
                 best = {**outs[k], "design": jobs[k][2]}
                 z_warm = np.asarray(best["z"], dtype=np.float64)
+                if on_improve:
+                    on_improve({**best, "evaluations": n_ev})
             history.append(best["score"])
             if log:
                 ok = sum(o["score"] < 10 for o in outs)
                 log(f"{n_ev} designs, {time.perf_counter() - t_start:.0f} s: generation best "
                     f"{outs[k]['score']:.4f} ({ok}/{len(outs)} periodic), best {best['score']:.4f}")
+    except KeyboardInterrupt:
+        interrupted = True
+        if log:
+            log(f"interrupted after {n_ev} designs; keeping the best so far")
     finally:
         if pool is not None:
-            pool.close()
+            pool.terminate() if interrupted else pool.close()
             pool.join()
     return {"best": best, "evaluations": n_ev, "history": history,
-            "seconds": time.perf_counter() - t_start}
+            "seconds": time.perf_counter() - t_start, "interrupted": interrupted}

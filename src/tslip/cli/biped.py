@@ -282,7 +282,11 @@ def optimise_cmd(
     seed: Annotated[int, typer.Option("--seed")] = 3,
     processes: Annotated[int, typer.Option("--processes", "-j")] = 1,
 ) -> None:
-    """Beyond the thesis: minimise the largest multiplier over gains, sweep, duty, masses."""
+    """Beyond the thesis: minimise the largest multiplier over gains, sweep, duty, masses.
+
+    The best gait is written to --out at every improvement; Ctrl-C stops
+    with the best so far, and --gait OUT continues from it.
+    """
     from ..biped.design import DESIGN_BOUNDS, stable_gait_search
     from ..biped.gait import section_multipliers
 
@@ -290,13 +294,21 @@ def optimise_cmd(
         p, y, t0 = _start(None, gait)
         z0 = to_section(p, y, t0)
         c = _console()
+
+        def checkpoint(b: dict[str, Any]) -> None:  # a usable --gait file at every new best
+            _write_json(out, {"design": b["design"], "bounds": DESIGN_BOUNDS,
+                              "evaluations": b["evaluations"], "residual": b["residual"],
+                              "largest_multiplier": b["score"], "converged": True,
+                              "params": b["params"], "z": b["z"], "checkpoint": True})
+
         r = stable_gait_search(p, z0, budget_s=budget, max_evals=max_evals, popsize=popsize,
-                               sigma0=sigma0, seed=seed, processes=processes, log=c.print)
+                               sigma0=sigma0, seed=seed, processes=processes, log=c.print,
+                               on_improve=checkpoint)
         b = r["best"]
         data: dict[str, Any] = {"design": b.get("design"), "bounds": DESIGN_BOUNDS,
                                 "evaluations": r["evaluations"], "seconds": r["seconds"],
                                 "history": r["history"], "residual": b["residual"],
-                                "converged": b["score"] < 10.0}
+                                "converged": b["score"] < 10.0, "interrupted": r["interrupted"]}
         if "z" in b:
             bp = BipedParams.from_dict(b["params"])
             data.update(params=b["params"], z=b["z"])
