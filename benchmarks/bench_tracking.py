@@ -29,7 +29,8 @@ def main() -> None:
 
     cv2.setNumThreads(1)
     import tslip
-    from tslip.experiment.synth import Camera, render_frames, synthesize, write_video
+    from tslip.experiment.render import render_frames, write_video
+    from tslip.experiment.synth import Camera, synthesize
     from tslip.experiment.video import Calibration, TrackerOptions, track_frames, track_video
 
     cam = Camera()

@@ -12,7 +12,7 @@ ALLOWED = {
     "simulation": {"model"},
     "gait": {"model", "simulation"},
     "sweeps": {"model", "simulation", "gait"},
-    "experiment": {"model", "simulation", "gait"},
+    "experiment": {"model", "simulation", "gait", "biped"},
     "biped": {"model", "simulation", "gait"},
     "plotting": {"model", "simulation", "gait", "sweeps", "experiment", "biped"},
 }

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import tslip
-from tslip.experiment.synth import Camera, render_frames, synthesize, write_video
+from tslip.experiment.render import render_frames, write_video
+from tslip.experiment.synth import Camera, synthesize
 from tslip.experiment.video import (
     Calibration,
     TrackerOptions,

@@ -63,26 +63,45 @@ def synth_video_cmd(
                                                help="Scene width in the frame \\[m].")] = 0.88,
     noise: Annotated[float, typer.Option("--noise", help="Sensor noise \\[grey levels].")] = 3.0,
     seed: Annotated[int, typer.Option("--seed", help="Noise seed.")] = 0,
+    biped_gait: Annotated[Path | None, typer.Option(
+        "--biped-gait", metavar="FILE.json",
+        help="Render the two-legged model (Appendix E) from this gait, as written by `tslip "
+             "biped search`, instead of the preset's TSLIP gait.")] = None,
 ) -> None:
-    """Render a simulated run as a treadmill video with a ground-truth CSV."""
+    """Render a simulated run as a treadmill video with a ground-truth CSV.
+
+    The run is the preset's TSLIP gait, or with --biped-gait the two-legged
+    model of Appendix E (--preset is then unused).
+    """
     with _errors():
-        from ..experiment.synth import Camera, RenderOptions, synthesize, write_video
+        from ..experiment.render import write_video
+        from ..experiment.synth import Camera, RenderOptions, synthesize, synthesize_biped
         from ..gait import find_gait
 
         cam = Camera(width=width, height=height, fps=fps, field_width=field_width)
-        params = _build_params(preset_name, sets, None)
-        gait = find_gait(params)
-        if not gait.converged:
-            _fail(f"no periodic gait for the preset: {gait.message}", 1)
-        run = synthesize(gait.params, gait.state, duration, camera=cam,
-                         options=RenderOptions(noise=noise, seed=seed))
+        render = RenderOptions(noise=noise, seed=seed)
+        if biped_gait is not None:
+            if sets:
+                raise ValueError("--set changes the TSLIP preset; it cannot be combined with "
+                                 "--biped-gait")
+            bp, y, t0, z = _load_biped_gait(biped_gait)
+            run = synthesize_biped(bp, y, duration, t0=t0, camera=cam, options=render)
+            model: dict[str, Any] = {"model": "biped", "gait_file": str(biped_gait),
+                                     "params": bp.to_dict(), "z": z, "t0": t0}
+        else:
+            params = _build_params(preset_name, sets, None)
+            gait = find_gait(params)
+            if not gait.converged:
+                _fail(f"no periodic gait for the preset: {gait.message}", 1)
+            run = synthesize(gait.params, gait.state, duration, camera=cam, options=render)
+            model = {"params": gait.params.to_dict()}
         with _bar("rendering") as bar:
             task = bar.add_task("frames", total=run.n_frames)
             write_video(run, out, progress=lambda d, n: bar.update(task, completed=d))
         truth = out.with_name(out.stem + ".truth.csv") if out.suffix else out / "truth.csv"
         write_table(run.truth, truth)
         _write_json(truth.with_suffix(".json"), {
-            "params": gait.params.to_dict(), "fps": fps, "px_per_m": cam.px_per_m,
+            **model, "fps": fps, "px_per_m": cam.px_per_m,
             "ground_y_px": cam.ground_px, "belt_speed_m_s": run.belt_speed,
             "stance_time": run.stance_time, "flight_time": run.flight_time,
             "geometry": {"r": run.geometry.r, "a": run.geometry.a, "b": run.geometry.b,
@@ -91,6 +110,32 @@ def synth_video_cmd(
         c = _console()
         c.print(f"wrote {out} ({run.n_frames} frames, {width}x{height} px at {fps:g} Hz)")
         c.print(f"wrote {truth}")
+
+
+def _load_biped_gait(path: Path) -> tuple[Any, np.ndarray, float, list[float]]:
+    """Parameters, start state, start time and section vector of a biped gait JSON."""
+    from ..biped.gait import from_section
+    from ..biped.parameters import BipedParams
+
+    name = str(path)
+    try:
+        data = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise ValueError(f"biped gait file {name!r} does not exist") from None
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"biped gait file {name!r} is not valid JSON: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"cannot read biped gait file {name!r}: {exc}") from None
+    if not (isinstance(data, dict) and isinstance(data.get("params"), dict) and "z" in data):
+        raise ValueError(f"biped gait file {name!r} needs a 'params' object and a section "
+                         f"vector 'z' (as written by `tslip biped search`)")
+    try:
+        p = BipedParams.from_dict(data["params"])
+        z = np.asarray(data["z"], dtype=float)
+        y, t0 = from_section(p, z)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"biped gait file {name!r}: {exc}") from None
+    return p, y, t0, z.tolist()
 
 
 def _track(video: Path, out: Path, fps: float | None, scale: float | None,

@@ -1,27 +1,35 @@
 """Synthetic high-speed treadmill video of a two-legged runner with known truth.
 
-A simulated TSLIP run (thesis Chapter 2, in the robot's SI scale of Table 5.1)
-is drawn as the side view of Section 5.4: a light uneven background, a moving
-treadmill belt, the body plate with two circular disc markers (position and
-pitch), and two legs whose feet carry a distinct colour. The model has one
-leg that is reset at lift-off; the recording alternates a near and a hind
-leg: each follows the simulated stance when it is on the ground and a smooth
-half-elliptical swing (relative to the hip, like the mechanism of Figure D.2)
-from its lift-off to its next touch-down. The hind leg is drawn behind the
-body, so its foot is occluded when it passes behind it.
+A simulated run, in the robot's SI scale of Table 5.1, is drawn as the side
+view of Section 5.4: a light uneven background, a moving treadmill belt, the
+body plate with two circular disc markers (position and pitch), and two legs
+whose feet carry a distinct colour. The hind leg is drawn behind the body, so
+its foot is occluded when it passes behind it. Two models can be recorded:
 
-Drawing is plain NumPy (no OpenCV: :mod:`tslip.experiment.video` is the only
-module that imports it); each shape is rasterised with an anti-aliased edge
-inside its bounding box, and moving markers are swept over the exposure
-(motion blur). Image coordinates: x to the right (running direction), y down.
+* :func:`synthesize`: TSLIP (thesis Chapter 2). The model has one leg that is
+  reset at lift-off; the recording alternates a near and a hind leg: each
+  follows the simulated stance when it is on the ground and a smooth
+  half-elliptical swing (relative to the hip, like the mechanism of Figure
+  D.2) from its lift-off to its next touch-down.
+* :func:`synthesize_biped`: the two-legged model with massed legs (Appendix
+  E). Both legs, their feet and contacts come from the simulation: the right
+  leg is the near one, the left leg the hind one; the plate follows the trunk.
+
+Each model only supplies world-frame functions of time (hip, pitch, CoM, both
+feet and their stance flags) plus its touch-downs and mean speed; one shared
+layout turns them into the camera frame, the markers and the truth table, so
+the renderer and the tracking pipeline treat both recordings alike.
+
+:mod:`tslip.experiment.render` draws the frames. Image coordinates: x to the
+right (running direction), y down.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -30,17 +38,13 @@ from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..model.units import ROBOT_SCALING, Scaling
 
+if TYPE_CHECKING:
+    from ..biped.parameters import BipedParams, BipedState
+    from ..biped.simulate import BipedOptions
+
 __all__ = [
-    "Camera", "BodyGeometry", "RenderOptions", "SyntheticRun", "synthesize", "render_frames",
-    "write_video", "FOOT_BGR",
+    "Camera", "BodyGeometry", "RenderOptions", "SyntheticRun", "synthesize", "synthesize_biped",
 ]
-
-#: Foot marker colour (B, G, R): a saturated magenta found nowhere else in the scene.
-FOOT_BGR = (200, 40, 230)
-_DISC = 245.0          # marker disc grey level
-_BODY = (70.0, 75.0, 85.0)
-_LEG = (40.0, 40.0, 45.0)
-
 
 @dataclass(frozen=True, slots=True)
 class Camera:
@@ -157,7 +161,8 @@ class RenderOptions:
         Relative amplitude of the brightness flicker [-].
     swing_lift : float
         Height of the swing ellipse above the straight line between lift-off
-        and touch-down foot positions [m].
+        and touch-down foot positions [m] (TSLIP only: the biped's swing is
+        simulated).
     seed : int
         Seed of the noise.
     """
@@ -181,11 +186,13 @@ class SyntheticRun:
         and ``<m>_x_m, <m>_y_m`` [m] (x in the camera frame, y up from the
         ground), ``hind_visible`` (visible fraction of the hind foot),
         ``near_stance``, ``hind_stance``, and the model states ``com_x_m``,
-        ``com_y_m``, ``phi``, ``hip_x_m``, ``hip_y_m``.
-    params : Params
+        ``com_y_m``, ``phi``, ``hip_x_m``, ``hip_y_m``. For the biped the
+        CoM is the trunk's and the near/hind feet are the right/left feet.
+    params : Params or BipedParams
         Model that generated the run (dimensionless, Table 3.1).
-    state : TouchdownState
-        Touch-down state of its periodic gait.
+    state : TouchdownState or BipedState
+        Touch-down state of the TSLIP gait, or the biped's start state at
+        ``t0``.
     scaling : Scaling
         Units (Table 5.1 by default).
     camera, geometry, options
@@ -193,14 +200,19 @@ class SyntheticRun:
     belt_speed : float
         Treadmill speed [m/s] (the mean forward speed of the runner).
     stance_time, flight_time : float
-        Model stride times [g^-1/2 L^1/2].
+        Model stride times [g^-1/2 L^1/2]: TSLIP's first stance and flight;
+        for the biped the right foot's first stance in the recording and the
+        time from its lift-off to the next left touch-down.
     touchdowns : pandas.DataFrame
         ``t`` [s], ``leg`` ("near"/"hind"), ``liftoff_t`` [s] of each stance.
+    t0 : float
+        Start time of the simulation [g^-1/2 L^1/2] (the biped controller's
+        clock; 0 for TSLIP).
     """
 
     truth: pd.DataFrame
-    params: Params
-    state: TouchdownState
+    params: Params | BipedParams
+    state: TouchdownState | BipedState
     scaling: Scaling
     camera: Camera
     geometry: BodyGeometry
@@ -209,6 +221,7 @@ class SyntheticRun:
     stance_time: float
     flight_time: float
     touchdowns: pd.DataFrame
+    t0: float = 0.0
     _poses: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
 
     @property
@@ -221,7 +234,12 @@ def synthesize(params: Params, state: TouchdownState, duration: float, *,
                camera: Camera | None = None, geometry: BodyGeometry | None = None,
                options: RenderOptions | None = None,
                scaling: Scaling = ROBOT_SCALING) -> SyntheticRun:
-    """Simulate a gait and lay it out as a two-legged recording.
+    """Simulate a TSLIP gait and lay it out as a two-legged recording.
+
+    The one TSLIP leg alternates between the near and the hind leg of the
+    drawing; between its stances each leg follows a half-elliptical swing
+    (:attr:`RenderOptions.swing_lift`). The recording starts at the third
+    touch-down, a near one.
 
     Parameters
     ----------
@@ -233,7 +251,8 @@ def synthesize(params: Params, state: TouchdownState, duration: float, *,
     duration : float
         Length of the recording [s].
     camera, geometry, options
-        Frame size and rate, marker layout, image effects.
+        Frame size and rate, marker layout (default ``r = params.r * L``),
+        image effects.
     scaling : Scaling
         Dimensionless -> SI units (Table 5.1 robot by default).
 
@@ -246,17 +265,117 @@ def synthesize(params: Params, state: TouchdownState, duration: float, *,
     ValueError
         If the duration is not positive or the simulated run falls.
     """
-    from ..simulation import simulate
-
     camera = camera or Camera()
     geometry = geometry or BodyGeometry(r=params.r * scaling.L)
     options = options or RenderOptions()
+    _check_duration(duration)
+    motion = _tslip_motion(params, state, duration, camera, options, scaling)
+    return _layout(motion, duration, camera, geometry, options, scaling)
+
+
+def synthesize_biped(params: BipedParams, state: BipedState | np.ndarray, duration: float, *,
+                     t0: float = 0.0, camera: Camera | None = None,
+                     geometry: BodyGeometry | None = None, options: RenderOptions | None = None,
+                     scaling: Scaling = ROBOT_SCALING,
+                     biped_options: BipedOptions | None = None) -> SyntheticRun:
+    """Simulate the two-legged model and lay it out as a recording.
+
+    Both legs and feet come from :func:`tslip.biped.simulate` (thesis
+    Appendix E): the right leg is drawn as the near leg, the left one as the
+    hind leg; stance flags are the simulator's contact flags. The body plate
+    follows the trunk: its CoM is the trunk CoM ``(x_b, z_b)`` and its pitch
+    ``phi = -theta_b`` (the biped's pitch is clockwise positive, eq. E.2;
+    the plate's counter-clockwise, eq. A.3). The recorded rows (one per
+    accepted integrator step) are interpolated linearly onto the frame times;
+    the recording starts at the first right touch-down after ``t0``.
+
+    Parameters
+    ----------
+    params : BipedParams
+        Model (dimensionless, Table 3.1 units).
+    state : BipedState or array_like, shape (18,)
+        ``(q, qd)`` at ``t0``, e.g. from :func:`tslip.biped.gait.from_section`.
+    duration : float
+        Length of the recording [s].
+    t0 : float
+        Start time of the simulation [g^-1/2 L^1/2]; sets the controller phase
+        (eq. E.25).
+    camera, geometry, options
+        Frame size and rate, marker layout (default ``r = params.r_1 * L``),
+        image effects (``swing_lift`` is not used).
+    scaling : Scaling
+        Dimensionless -> SI units (Table 5.1 robot by default).
+    biped_options : BipedOptions, optional
+        Integrator options; by default those of the simulator with recorded
+        rows at most a quarter frame interval apart.
+
+    Returns
+    -------
+    SyntheticRun
+        ``stance_time`` is the right foot's first stance in the recording and
+        ``flight_time`` the time from its lift-off to the next left
+        touch-down (negative: double support), both in model units.
+
+    Raises
+    ------
+    ValueError
+        If the duration or ``t0`` is invalid, the state has the wrong shape,
+        or the simulated run falls or ends before the recording.
+
+    References
+    ----------
+    Thesis Appendix E, eqs E.5 and E.8 (hip and foot positions).
+    """
+    camera = camera or Camera()
+    geometry = geometry or BodyGeometry(r=params.r_1 * scaling.L)
+    options = options or RenderOptions()
+    _check_duration(duration)
+    if not math.isfinite(t0):
+        raise ValueError(f"t0 [g^-1/2 L^1/2] must be finite, got {t0!r}")
+    motion = _biped_motion(params, state, duration, t0, camera, scaling, biped_options)
+    return _layout(motion, duration, camera, geometry, options, scaling)
+
+
+# -- model-specific motion ------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Motion:
+    """A simulated run as world-frame functions of time, in SI units.
+
+    ``pose(t)`` maps times ``t`` [s], shape (n,), to ``hip``, ``com``,
+    ``near``, ``hind`` [m], shape (n, 2) (x forward, y up from the ground),
+    ``phi`` [rad] (counter-clockwise, eq. A.3) and the boolean
+    ``near_stance``, ``hind_stance``. ``touchdowns`` has ``t``, ``leg``,
+    ``liftoff_t`` [s] of every stance; ``speed`` is the mean forward speed
+    [m/s]; frames start at ``t_start`` [s] and ``pose`` is valid up to
+    ``t_last`` [s].
+    """
+
+    params: Any
+    state: Any
+    t0: float
+    pose: Callable[[np.ndarray], dict[str, np.ndarray]]
+    touchdowns: pd.DataFrame
+    speed: float
+    t_start: float
+    t_last: float
+    stance_time: float
+    flight_time: float
+
+
+def _check_duration(duration: float) -> None:
     if not (math.isfinite(duration) and duration > 0):
         raise ValueError(f"duration [s] must be > 0, got {duration!r}")
+
+
+def _tslip_motion(params: Params, state: TouchdownState, duration: float, camera: Camera,
+                  options: RenderOptions, scaling: Scaling) -> _Motion:
+    """TSLIP run: its one leg alternates near and hind, with an invented swing."""
+    from ..simulation import simulate
+
     T = scaling.factor("time")
     L = scaling.L
-    stride = None
-    n_frames = max(int(round(duration * camera.fps)), 1)
     # two strides of lead-in so each leg has a previous lift-off, two after
     probe = simulate(params, state, 1, dt=0.01)
     stride = probe.steps[0].stance_time + probe.steps[0].flight_time
@@ -266,42 +385,130 @@ def synthesize(params: Params, state: TouchdownState, duration: float, *,
     if traj.status.value != 0 or len(traj.steps) < n_steps:
         raise ValueError(f"the simulated run failed: {traj.status.reason}")
     t_all = traj["t"] * T
-    td = np.array([s_t for s_t in (e.t * T for e in traj.events if e.kind == "touchdown")])
+    td = np.array([e.t * T for e in traj.events if e.kind == "touchdown"])
     lo = np.array([e.t * T for e in traj.events if e.kind == "liftoff"])
     foot_x = np.array([s.foot_x for s in traj.steps]) * L
-    t_start = td[2]
-    x_mean_speed = (np.interp(td[-1], t_all, traj["x"]) - np.interp(td[2], t_all, traj["x"])) \
+    speed = (np.interp(td[-1], t_all, traj["x"]) - np.interp(td[2], t_all, traj["x"])) \
         * L / (td[-1] - td[2])
+    r = params.r * L
 
     def hip_at(t: np.ndarray) -> np.ndarray:
         return np.stack([np.interp(t, t_all, traj["hip_x"]) * L,
                          np.interp(t, t_all, traj["hip_y"]) * L], axis=1)
 
-    def pose_at(t: np.ndarray) -> dict[str, np.ndarray]:
+    def pose(t: np.ndarray) -> dict[str, np.ndarray]:
         hip = hip_at(t)
         phi = np.interp(t, t_all, traj["phi"])
         u = np.stack([np.sin(phi), -np.cos(phi)], axis=1)
-        w = np.stack([np.cos(phi), np.sin(phi)], axis=1)
-        mid = hip + geometry.a * u
-        out = {"hip": hip, "phi": phi, "front": mid + geometry.b * w,
-               "rear": mid - geometry.b * w, "com": hip + geometry.r * u}
-        for leg in (0, 1):
-            out[("near", "hind")[leg]], out[f"stance{leg}"] = _foot(
-                t, leg, td, lo, foot_x, hip_at, options.swing_lift)
+        out = {"hip": hip, "phi": phi, "com": hip + r * u}
+        for leg, name in enumerate(("near", "hind")):
+            out[name], out[f"{name}_stance"] = _foot(t, leg, td, lo, foot_x, hip_at,
+                                                     options.swing_lift)
         return out
+
+    legs = ["near" if i % 2 == 0 else "hind" for i in range(len(lo))]
+    tds = pd.DataFrame({"t": td[: len(lo)], "leg": legs, "liftoff_t": lo})
+    return _Motion(params=params, state=state, t0=0.0, pose=pose, touchdowns=tds,
+                   speed=float(speed), t_start=float(td[2]), t_last=float(td[-3]),
+                   stance_time=float(traj.steps[0].stance_time),
+                   flight_time=float(traj.steps[0].flight_time))
+
+
+def _biped_motion(params: BipedParams, state: BipedState | np.ndarray, duration: float,
+                  t0: float, camera: Camera, scaling: Scaling,
+                  biped_options: BipedOptions | None) -> _Motion:
+    """Biped run (Appendix E): right leg near, left leg hind, both simulated."""
+    from ..biped.dynamics import foot_position, hip_position
+    from ..biped.parameters import BipedState
+    from ..biped.simulate import BipedOptions, simulate
+
+    T = scaling.factor("time")
+    L = scaling.L
+    start = state if isinstance(state, BipedState) else BipedState.from_array(state)
+    if biped_options is None:
+        biped_options = BipedOptions(h_max=min(BipedOptions().h_max, 0.25 / (camera.fps * T)))
+    # one stride of lead-in (the recording starts at the next right touch-down), then the
+    # recording, then two strides so its last stances and the mean speed are complete
+    t_end = t0 + duration / T + 3.0 * params.T
+    n_strides = int(math.ceil((t_end - t0) / params.T)) + 3
+    traj = simulate(params, start, n_strides, t0=t0, t_end=t_end, options=biped_options)
+    if traj.status.fell or traj.status.is_error:
+        raise ValueError(f"the simulated biped run failed at t = {traj.stats['t_end']:.3f} "
+                         f"g^-1/2 L^1/2: {traj.status.reason}")
+    if traj.stats["records_full"]:
+        raise ValueError(f"the biped run needs more than max_records = "
+                         f"{biped_options.max_records} rows; raise BipedOptions.max_records")
+    strides = traj.strides
+    t_all = traj.time * T
+    if traj.n_strides < 2 or t_all[-1] < strides[0, 0] * T + duration:
+        raise ValueError(f"the simulated biped run is too short for a {duration:g} s "
+                         f"recording: it ended after {traj.n_strides} stride(s) at t = "
+                         f"{traj.time[-1]:.3f} g^-1/2 L^1/2")
+    speed = (strides[-1, 1] - strides[0, 1]) * L / ((strides[-1, 0] - strides[0, 0]) * T)
+    q_all = traj.data[:, 1:10]
+    contact = {"near": traj["contact_R"] > 0.5, "hind": traj["contact_L"] > 0.5}
+
+    def pose(t: np.ndarray) -> dict[str, np.ndarray]:
+        q = np.stack([np.interp(t, t_all, q_all[:, j]) for j in range(9)], axis=1)
+        row = np.clip(np.searchsorted(t_all, t, side="right") - 1, 0, len(t_all) - 1)
+        out = {"hip": hip_position(params, q) * L, "phi": -q[:, 2], "com": q[:, :2] * L}
+        for leg, name in enumerate(("near", "hind")):
+            out[name] = foot_position(params, q, leg) * L
+            out[f"{name}_stance"] = contact[name][row]    # contact of the last row <= t
+        return out
+
+    stances = _biped_stances(traj.events, contact["near"][0], contact["hind"][0], traj.time[0])
+    right = stances[(stances["leg"] == "near") & (stances["t"] >= strides[0, 0])].iloc[0]
+    left_td = stances.loc[(stances["leg"] == "hind") & (stances["t"] > right["t"]), "t"]
+    if not len(left_td):
+        raise ValueError("the simulated biped run is too short: no left touch-down after the "
+                         "first right stance")
+    tds = stances.assign(t=stances["t"] * T, liftoff_t=stances["liftoff_t"] * T)
+    return _Motion(params=params, state=start, t0=float(t0), pose=pose, touchdowns=tds,
+                   speed=float(speed), t_start=float(strides[0, 0] * T), t_last=float(t_all[-1]),
+                   stance_time=float(right["liftoff_t"] - right["t"]),
+                   flight_time=float(left_td.iloc[0] - right["liftoff_t"]))
+
+
+def _biped_stances(events: list[Any], on_r: bool, on_l: bool, t0: float) -> pd.DataFrame:
+    """``t``, ``leg``, ``liftoff_t`` [model time] of each completed stance of the biped."""
+    rows = []
+    for leg, side, on in (("near", "R", on_r), ("hind", "L", on_l)):
+        tds = ([t0] if on else []) + [e.t for e in events if e.kind == f"touchdown_{side}"]
+        los = np.array([e.t for e in events if e.kind == f"liftoff_{side}"])
+        for t in tds:
+            later = los[los > t]
+            if len(later):
+                rows.append((t, leg, float(later[0])))
+    return pd.DataFrame(rows, columns=["t", "leg", "liftoff_t"]).sort_values(
+        "t", kind="stable").reset_index(drop=True)
+
+
+# -- shared layout ---------------------------------------------------------------------------
+
+
+def _layout(motion: _Motion, duration: float, camera: Camera, geometry: BodyGeometry,
+            options: RenderOptions, scaling: Scaling) -> SyntheticRun:
+    """Camera frame, markers, motion-blur poses and the truth table of a simulated run."""
+    n_frames = max(int(round(duration * camera.fps)), 1)
+    t_start = motion.t_start
+    t = t_start + np.arange(n_frames) / camera.fps
+    half = 0.5 * options.exposure / camera.fps
+    if t[-1] + half > motion.t_last:
+        raise ValueError("internal: simulated run shorter than the recording")
+    x0 = float(motion.pose(np.array([t_start]))["hip"][0, 0])
 
     def to_camera(p: np.ndarray, t: np.ndarray) -> np.ndarray:
         """World [m] -> camera-frame metres (the treadmill carries the scene back)."""
-        return np.stack([p[:, 0] - x_mean_speed * (t - t_start) - x0, p[:, 1]], axis=1)
+        return np.stack([p[:, 0] - motion.speed * (t - t_start) - x0, p[:, 1]], axis=1)
 
-    t = t_start + np.arange(n_frames) / camera.fps
-    if t[-1] > td[-3]:
-        raise ValueError("internal: simulated run shorter than the recording")
-    x0 = float(np.interp(t_start, t_all, traj["hip_x"]) * L)
-    half = 0.5 * options.exposure / camera.fps
     poses = {}
     for key, tt in (("now", t), ("a", t - half), ("b", t + half)):
-        p = pose_at(tt)
+        p = motion.pose(tt)
+        u = np.stack([np.sin(p["phi"]), -np.cos(p["phi"])], axis=1)
+        w = np.stack([np.cos(p["phi"]), np.sin(p["phi"])], axis=1)
+        mid = p["hip"] + geometry.a * u
+        p["front"], p["rear"] = mid + geometry.b * w, mid - geometry.b * w
         for name in ("hip", "com", "front", "rear", "near", "hind"):
             p[name] = to_camera(p[name], tt)
         poses[key] = p
@@ -316,20 +523,21 @@ def synthesize(params: Params, state: TouchdownState, duration: float, *,
         cols[f"{name}_x_px"], cols[f"{name}_y_px"] = px(now[name]).T
         cols[f"{name}_x_m"], cols[f"{name}_y_m"] = now[name].T
     cols["phi"] = now["phi"]
-    cols["near_stance"] = now["stance0"]
-    cols["hind_stance"] = now["stance1"]
+    cols["near_stance"] = now["near_stance"]
+    cols["hind_stance"] = now["hind_stance"]
     img = {k: {n: px(v[n]) for n in ("hip", "front", "rear", "near", "hind")}
            for k, v in poses.items()}
     img["now"]["phi"] = now["phi"]
     cols["hind_visible"] = _hind_visible(img["now"], camera, geometry)
     truth = pd.DataFrame(cols)
-    legs = ["near" if i % 2 == 0 else "hind" for i in range(len(lo))]
-    tds = pd.DataFrame({"t": td[: len(lo)] - t_start, "leg": legs, "liftoff_t": lo - t_start})
+    st = motion.touchdowns
+    tds = pd.DataFrame({"t": st["t"].to_numpy() - t_start, "leg": st["leg"].to_numpy(),
+                        "liftoff_t": st["liftoff_t"].to_numpy() - t_start})
     tds = tds[(tds["liftoff_t"] > 0) & (tds["t"] < t[-1] - t_start)].reset_index(drop=True)
-    return SyntheticRun(truth=truth, params=params, state=state, scaling=scaling, camera=camera,
-                        geometry=geometry, options=options, belt_speed=float(x_mean_speed),
-                        stance_time=float(traj.steps[0].stance_time),
-                        flight_time=float(traj.steps[0].flight_time), touchdowns=tds,
+    return SyntheticRun(truth=truth, params=motion.params, state=motion.state, scaling=scaling,
+                        camera=camera, geometry=geometry, options=options,
+                        belt_speed=motion.speed, stance_time=motion.stance_time,
+                        flight_time=motion.flight_time, touchdowns=tds, t0=motion.t0,
                         _poses=img)
 
 
@@ -391,181 +599,3 @@ def _inside_quad(p: np.ndarray, c: np.ndarray) -> np.ndarray:
             sign = sgn
         inside &= sgn == sign
     return inside
-
-
-# -- rendering ------------------------------------------------------------------------------
-
-
-def render_frames(run: SyntheticRun, *, start: int = 0, stop: int | None = None
-                  ) -> Iterator[np.ndarray]:
-    """Yield the frames of ``run`` as BGR ``uint8`` arrays, shape (height, width, 3).
-
-    Frames are produced one at a time (memory independent of length).
-    """
-    cam, g, opt = run.camera, run.geometry, run.options
-    H, W, s = cam.height, cam.width, cam.px_per_m
-    rng = np.random.default_rng(opt.seed)
-    background = _background(cam, rng)
-    belt, period = _belt(cam)
-    gy = int(round(cam.ground_px))
-    noise_bank = (rng.normal(0.0, opt.noise, size=(H + 97, W, 3))).astype(np.float32) \
-        if opt.noise > 0 else None
-    gains = 1.0 + opt.flicker * (0.6 * np.sin(2 * np.pi * 100.0 * run.truth["t"].to_numpy())
-                                 + 0.4 * rng.uniform(-1, 1, run.n_frames))
-    P = run._poses
-    stop = run.n_frames if stop is None else min(stop, run.n_frames)
-    leg_w = 0.012 * s
-    for k in range(start, stop):
-        f = background.copy()
-        shift = int(round(run.belt_speed * run.truth["t"].iat[k] * s)) % period
-        f[gy:, :] = belt[:, shift:shift + W]
-        hip = P["now"]["hip"][k]
-        phi = float(P["now"]["phi"][k])
-        _capsule(f, hip, P["now"]["hind"][k], leg_w / 2, _LEG, 0.75)
-        _capsule(f, P["a"]["hind"][k], P["b"]["hind"][k], g.foot_radius * s, FOOT_BGR, 1.0)
-        _quad(f, _body_corners(hip, phi, g, s), _BODY)
-        _capsule(f, hip, P["now"]["near"][k], leg_w / 2, _LEG, 1.0)
-        for name in ("front", "rear"):
-            _capsule(f, P["a"][name][k], P["b"][name][k], g.marker_radius * s,
-                     (_DISC, _DISC, _DISC), 1.0)
-        _capsule(f, hip, hip, 0.01 * s, (30.0, 30.0, 30.0), 1.0)
-        _capsule(f, P["a"]["near"][k], P["b"]["near"][k], g.foot_radius * s, FOOT_BGR, 1.0)
-        f *= gains[k]
-        if noise_bank is not None:
-            off = (k * 37) % 97
-            f += noise_bank[off:off + H]
-        np.clip(f, 0, 255, out=f)
-        yield f.astype(np.uint8)
-
-
-def _background(cam: Camera, rng: np.random.Generator) -> np.ndarray:
-    H, W = cam.height, cam.width
-    yy, xx = np.mgrid[0:H, 0:W].astype(np.float32)
-    base = 205.0 + 20.0 * (xx / W) - 15.0 * (yy / H)
-    for _ in range(6):
-        cx, cy, rr = rng.uniform(0, W), rng.uniform(0, H), rng.uniform(0.1, 0.3) * W
-        base += rng.uniform(-8, 8) * np.exp(-((xx - cx) ** 2 + (yy - cy) ** 2) / (2 * rr * rr))
-    img = np.repeat(base[:, :, None], 3, axis=2)
-    img[:, :, 0] -= 6.0  # slightly warm white paper
-    # a dark vertical support post of the acrylic sheet (static scene element)
-    x0 = int(0.05 * W)
-    img[: int(0.88 * H), x0:x0 + max(int(0.02 * W), 2)] = (90.0, 110.0, 140.0)
-    return img
-
-
-def _belt(cam: Camera) -> tuple[np.ndarray, int]:
-    H, W = cam.height, cam.width
-    gy = int(round(cam.ground_px))
-    period = max(int(0.08 * cam.px_per_m), 8)
-    xs = np.arange(W + period)
-    stripe = 60.0 + 25.0 * (np.sin(2 * np.pi * xs / period) > 0.6)
-    rows = np.clip(np.arange(H - gy, dtype=np.float32)[:, None] / 4.0, 0, 1)
-    belt = (stripe[None, :] * (0.8 + 0.2 * rows)).astype(np.float32)
-    return np.repeat(belt[:, :, None], 3, axis=2), period
-
-
-def _paint(f: np.ndarray, y0: int, x0: int, alpha: np.ndarray, color: tuple[float, ...]) -> None:
-    roi = f[y0:y0 + alpha.shape[0], x0:x0 + alpha.shape[1]]
-    a = alpha[:, :, None]
-    roi *= 1.0 - a
-    roi += a * np.asarray(color, dtype=np.float32)
-
-
-def _bbox(f: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[int, int, int, int] | None:
-    H, W = f.shape[:2]
-    x0, y0 = max(int(math.floor(lo[0])), 0), max(int(math.floor(lo[1])), 0)
-    x1, y1 = min(int(math.ceil(hi[0])) + 1, W), min(int(math.ceil(hi[1])) + 1, H)
-    if x1 <= x0 or y1 <= y0:
-        return None
-    return x0, y0, x1, y1
-
-
-def _capsule(f: np.ndarray, a: np.ndarray, b: np.ndarray, radius: float,
-             color: tuple[float, ...], opacity: float) -> None:
-    """Anti-aliased disc of ``radius`` [px] swept from ``a`` to ``b`` (pixel centres)."""
-    box = _bbox(f, np.minimum(a, b) - radius - 2, np.maximum(a, b) + radius + 2)
-    if box is None:
-        return
-    x0, y0, x1, y1 = box
-    xs = np.arange(x0, x1, dtype=np.float32)[None, :]
-    ys = np.arange(y0, y1, dtype=np.float32)[:, None]
-    d = b - a
-    dd = float(d @ d)
-    if dd < 1e-9:
-        dist = np.sqrt((xs - a[0]) ** 2 + (ys - a[1]) ** 2)
-    else:
-        tt = np.clip(((xs - a[0]) * d[0] + (ys - a[1]) * d[1]) / dd, 0.0, 1.0)
-        dist = np.sqrt((xs - a[0] - tt * d[0]) ** 2 + (ys - a[1] - tt * d[1]) ** 2)
-    alpha = np.clip(radius + 0.5 - dist, 0.0, 1.0) * opacity
-    _paint(f, y0, x0, alpha, color)
-
-
-def _quad(f: np.ndarray, c: np.ndarray, color: tuple[float, ...]) -> None:
-    """Anti-aliased convex quadrilateral with corners ``c`` (order around the edge)."""
-    box = _bbox(f, c.min(axis=0) - 1, c.max(axis=0) + 1)
-    if box is None:
-        return
-    x0, y0, x1, y1 = box
-    xs = np.arange(x0, x1, dtype=np.float32)[None, :]
-    ys = np.arange(y0, y1, dtype=np.float32)[:, None]
-    orient = np.sign((c[1, 0] - c[0, 0]) * (c[2, 1] - c[0, 1])
-                     - (c[1, 1] - c[0, 1]) * (c[2, 0] - c[0, 0]))
-    sd = None
-    for i in range(4):
-        p, q = c[i], c[(i + 1) % 4]
-        e = q - p
-        n = float(np.hypot(*e))
-        side = orient * ((e[0]) * (ys - p[1]) - (e[1]) * (xs - p[0])) / n  # > 0 inside
-        sd = side if sd is None else np.minimum(sd, side)
-    _paint(f, y0, x0, np.clip(sd + 0.5, 0.0, 1.0), color)
-
-
-def write_video(run: SyntheticRun, path: str | Path, *, quality: int = 16,
-                progress: Callable[[int, int], None] | None = None) -> Path:
-    """Render ``run`` to an ``.mp4`` (H.264 via imageio-ffmpeg) or a folder of PNG frames.
-
-    Parameters
-    ----------
-    run : SyntheticRun
-        What to draw.
-    path : str or Path
-        ``*.mp4`` file, or a directory (created) for ``frame_000000.png`` ...
-    quality : int
-        H.264 constant rate factor (lower is better; 0 is lossless).
-    progress : callable, optional
-        ``progress(done, total)`` after each frame.
-
-    Returns
-    -------
-    Path
-        The written file or folder (an ``.mp4`` is written atomically).
-    """
-    import imageio.v2 as iio
-
-    from .._io import atomic_write
-
-    path = Path(path)
-    n = run.n_frames
-    if path.suffix.lower() == ".mp4":
-        def write(tmp: str) -> None:
-            w = iio.get_writer(tmp, format="FFMPEG", mode="I", fps=run.camera.fps,
-                               codec="libx264", quality=None, macro_block_size=1,
-                               pixelformat="yuv420p", ffmpeg_log_level="error",
-                               output_params=["-crf", str(quality), "-preset", "veryfast"])
-            try:
-                for k, frame in enumerate(render_frames(run)):
-                    w.append_data(frame[:, :, ::-1])
-                    if progress is not None:
-                        progress(k + 1, n)
-            finally:
-                w.close()
-
-        return atomic_write(path, write)
-    if path.suffix:
-        raise ValueError(f"video output must be a .mp4 file or a directory, got {str(path)!r}")
-    path.mkdir(parents=True, exist_ok=True)
-    for k, frame in enumerate(render_frames(run)):
-        iio.imwrite(path / f"frame_{k:06d}.png", frame[:, :, ::-1])
-        if progress is not None:
-            progress(k + 1, n)
-    return path
