@@ -81,3 +81,20 @@ def test_too_few_steps_names_frames() -> None:
         tracks[f"{m}_y_m"] = 0.3 if m in ("front", "rear") else 0.05
     with pytest.raises(ValueError, match=r"too few steps to average.*frames 0-99"):
         process_tracks(tracks, 500.0)
+
+
+def test_contact_events_on_a_sinking_stance() -> None:
+    """A compliant ground: the foot sinks 7 mm during the stance, below the
+    threshold above the lowest level; touch-down and lift-off are still found
+    at the corners, to 0.2 frame with 0.2 mm of noise."""
+    fs = 500.0
+    t = np.arange(300) / fs
+    td, lo = 0.1013, 0.2507
+    h = np.where(t < td, 1.5 * (td - t), 2.0 * (t - lo) + 40.0 * (t - lo) ** 2)
+    m = (t >= td) & (t <= lo)
+    h[m] = -0.007 * np.sin(np.pi * (t[m] - td) / (lo - td))
+    h += np.random.default_rng(1).normal(0.0, 2e-4, t.size)
+    ev = contact_events(h, t, float(np.percentile(h, 5)), 0.003)
+    assert len(ev) == 1
+    assert abs(ev[0][0] - td) < 0.2 / fs and abs(ev[0][1] - lo) < 0.2 / fs
+    assert ev[0][2] == 51 and ev[0][3] == 125  # the frames between the two instants

@@ -286,15 +286,21 @@ def contact_events(height: np.ndarray, t: np.ndarray, level: float, threshold: f
                    ) -> list[tuple[float, float, int, int]]:
     """Stance intervals of a foot from its height above the ground.
 
-    A sample is in stance when ``height < level + threshold``. Touch-down and
-    lift-off times are refined below the frame interval by a straight line
-    through the flight samples just outside the stance run, solved for
-    ``height = level``.
+    A sample is in stance when ``height < level + threshold`` (the core of a
+    stance). Each edge of a core is then refined to the contact instant: the
+    corner between the flight samples and the stance samples, found as the
+    best two-line fit (:func:`_corner`). On a rigid ground the stance line is
+    flat at ``level`` and this is where the flight line reaches it; on a
+    compliant ground (the biped's, Table E.3) the foot keeps sinking through
+    the stance, and the corner also catches the start and end of the stance
+    that lie above the core threshold.
 
     Returns
     -------
     list of (t_touchdown, t_liftoff, first_frame, last_frame)
-        Only complete intervals (a flight sample before and after).
+        Only complete intervals (two flight samples before and after); the
+        frames are those between the contact instants. Cores that refine
+        to touching intervals (noise around the threshold) are merged.
     """
     h = np.asarray(height, float)
     with np.errstate(invalid="ignore"):
@@ -307,28 +313,64 @@ def contact_events(height: np.ndarray, t: np.ndarray, level: float, threshold: f
             continue
         if not (np.isfinite(h[a - 1]) and np.isfinite(h[b + 1])):
             continue
-        runs.append((_cross(h, t, level, threshold, a, -1), _cross(h, t, level, threshold, b, 1),
-                     int(a), int(b)))
-    return runs
+        t_td, a2 = _corner(h, t, level, threshold, a, b, -1)
+        t_lo, b2 = _corner(h, t, level, threshold, b, a, 1)
+        if runs and a2 <= runs[-1][3] + 1:  # noise split one stance into two cores
+            runs[-1] = (runs[-1][0], t_lo, runs[-1][2], b2)
+        else:
+            runs.append((t_td, t_lo, a2, b2))
+    return [r for r in runs if math.isfinite(r[0]) and math.isfinite(r[1])]
 
 
-def _cross(h: np.ndarray, t: np.ndarray, level: float, thr: float, i: int, direction: int
-           ) -> float:
-    """Time where the flight samples next to stance index ``i`` reach ``level``."""
-    idx = []
-    j = i + direction
-    while 0 <= j < len(h) and len(idx) < 4 and np.isfinite(h[j]) and h[j] < level + 8 * thr:
-        idx.append(j)
-        j += direction
-    if len(idx) < 2:
-        return float(t[i])
-    hh, tt = h[idx], t[idx]
-    slope, icpt = np.polyfit(tt, hh, 1)
-    if slope == 0:
-        return float(t[i])
-    tc = (level - icpt) / slope
-    dt = 3.0 * (t[1] - t[0])
-    return float(np.clip(tc, t[i] - dt, t[i] + dt))
+def _fit(tt: np.ndarray, hh: np.ndarray, deg: int) -> tuple[np.ndarray, float]:
+    """Least-squares polynomial (highest power first) and its sum of squared residuals."""
+    c = np.polyfit(tt, hh, deg)
+    return c, float(np.sum((np.polyval(c, tt) - hh) ** 2))
+
+
+def _corner(h: np.ndarray, t: np.ndarray, level: float, thr: float, i: int, j: int,
+            direction: int) -> tuple[float, int]:
+    """Contact instant at the edge ``i`` of the stance core ``[i, j]`` (either order).
+
+    The samples outward from ``i`` (``direction``) below ``level + 8 thr``
+    and up to 6 core samples form one sequence from flight to stance. For
+    each split of it, a parabola is fitted to the samples before the split
+    (flight: ballistic or accelerating) and a line to those after it
+    (stance: flat on a rigid ground, sinking on a compliant one); the split
+    with the smallest total squared residual wins, and the contact instant
+    is where the two curves meet, clipped to the samples either side of the
+    split. Returns the instant and the outermost stance frame; the instant
+    is NaN when the samples run out (recording edge or a tracking gap)
+    before the foot is clear of the ground, as the stance is then incomplete.
+    """
+    out = []
+    k = i + direction
+    while (0 <= k < len(h) and len(out) < 40 and np.isfinite(h[k])
+           and h[k] < level + 8 * thr):
+        out.append(k)
+        k += direction
+    if len(out) < 2 or not (0 <= k < len(h) and np.isfinite(h[k])):
+        return math.nan, int(i)  # no flight on this side within the recording
+    core = list(range(i, j - direction, -direction))[:6]  # from the edge inward
+    seq = np.array(out[::-1] + core)
+    best = None
+    for p in range(2, len(seq) - 1):
+        fl, st = seq[:p], seq[p:]
+        cf, e1 = _fit(t[fl], h[fl], 2 if len(fl) >= 4 else 1)
+        cs, e2 = _fit(t[st], h[st], 1)
+        if best is None or e1 + e2 < best[0]:
+            best = (e1 + e2, p, cf, cs)
+    if best is None:
+        return float(t[i]), int(i)
+    _, p, cf, cs = best
+    edge, last_flight = int(seq[p]), int(seq[p - 1])
+    lo_t, hi_t = sorted((t[edge], t[last_flight]))
+    roots = np.roots(np.polysub(cf, cs))
+    roots = roots[np.isreal(roots)].real
+    if not len(roots):
+        return float(t[edge]), edge
+    tc = roots[np.argmin(np.abs(roots - 0.5 * (lo_t + hi_t)))]
+    return float(np.clip(tc, lo_t, hi_t)), edge
 
 
 def process_tracks(tracks: pd.DataFrame, fps: float, geometry: BodyGeometry | None = None, *,
