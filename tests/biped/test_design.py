@@ -3,20 +3,17 @@
 from __future__ import annotations
 
 import json
-import os
 
 import numpy as np
 import pytest
 
 from tslip.biped import BipedParams
 from tslip.biped.design import DESIGN_BOUNDS, apply_design, design_objective
-
-HERE = os.path.dirname(__file__)
+from tslip.biped.stored import gait_path
 
 
 def _load(name):
-    with open(os.path.join(HERE, name)) as fh:
-        data = json.load(fh)
+    data = json.loads(gait_path(name).read_text())
     return data, BipedParams.from_dict(data["params"]), np.array(data["z"])
 
 
@@ -37,7 +34,7 @@ def test_apply_design_keeps_unit_mass_and_scales_inertias():
 
 
 def test_design_objective_penalises_infeasible_designs():
-    _, p, z = _load("stable_gait.json")
+    _, p, z = _load("converged-e2")
     out = design_objective(p, z, {"d": 0.9})
     assert out["score"] == 20.0 and "d must be in" in out["message"]
 
@@ -47,7 +44,7 @@ def test_optimised_gait_is_periodic_and_uses_a_feasible_design():
     report CLI test, 0.428)."""
     from tslip.biped.gait import REFINE_OPTIONS, _wrap, stride_map
 
-    data, p, z = _load("optimised_gait.json")
+    data, p, z = _load("optimised")
     z1, st = stride_map(p, z, REFINE_OPTIONS)
     assert st.name == "OK" and np.linalg.norm(_wrap(z1 - z)) < 1e-8
     assert apply_design(BipedParams(), data["design"]).replace(
@@ -66,7 +63,7 @@ def test_search_interrupt_keeps_the_best_and_checkpoints_it(monkeypatch):
         return {"score": score, "residual": 0.0, "z": list(z_warm), "params": {}}
 
     monkeypatch.setattr(design, "design_objective", bowl)
-    _, p, z = _load("optimised_gait.json")
+    _, p, z = _load("optimised")
     calls, saved = [], []
 
     def log(msg):

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
 
 import numpy as np
 import pytest
@@ -16,6 +15,7 @@ from tslip.biped.gait import (
     stride_map,
     to_section,
 )
+from tslip.biped.stored import gait_path
 from tslip.cli import biped as biped_cli  # noqa: F401  (registers `tslip biped`)
 from tslip.cli.main import app
 
@@ -61,7 +61,7 @@ def test_cli_simulate_search_report(tmp_path):
 
 
 def test_cli_search_from_the_stored_gait_reports_multipliers(tmp_path):
-    gait = os.path.join(os.path.dirname(__file__), "stable_gait.json")
+    gait = str(gait_path("converged-e2"))
     r = CliRunner().invoke(app, ["biped", "search", "--gait", gait, "--out",
                                  str(tmp_path / "g.json"), "-n", "10"])
     assert r.exit_code == 0, r.output
@@ -73,7 +73,7 @@ def test_cli_search_from_the_stored_gait_reports_multipliers(tmp_path):
 
 
 def test_cli_report_loads_a_gait_file(tmp_path):
-    gait = os.path.join(os.path.dirname(__file__), "optimised_gait.json")
+    gait = str(gait_path("optimised"))
     r = CliRunner().invoke(app, ["biped", "report", "--gait", gait, "--out-dir",
                                  str(tmp_path), "-n", "3"])
     assert r.exit_code == 0, r.output
@@ -82,3 +82,18 @@ def test_cli_report_loads_a_gait_file(tmp_path):
     assert (tmp_path / "fig_e4_metacentric.png").exists() and "metacentric test" in r.output
     rows = (tmp_path / "metacentric.csv").read_text().splitlines()
     assert rows[0].startswith("dtheta,I_x,I_z") and len(rows) == 4
+
+
+def test_stored_gaits_load_by_name_and_bad_sources_are_one_line(tmp_path):
+    from tslip.biped.stored import STORED_GAITS, load_gait
+
+    for name in STORED_GAITS:
+        p, y, t0, data = load_gait(name)
+        assert y.shape == (18,) and 0.0 <= t0 < p.T and data["residual"] < 1e-8
+    with pytest.raises(ValueError, match="does not exist.*converged-e2"):
+        load_gait(str(tmp_path / "nope.json"))
+    (tmp_path / "bad.json").write_text('{"params": {}, "z": [1, 2]}')
+    with pytest.raises(ValueError, match="bad.json.*shape"):
+        load_gait(tmp_path / "bad.json")
+    r = CliRunner().invoke(app, ["biped", "simulate", "--gait", "optimised", "-n", "1"])
+    assert r.exit_code == 0 and "1 strides" in r.output, r.output

@@ -2,27 +2,20 @@
 
 from __future__ import annotations
 
-import json
 import math
-import os
 
 import numpy as np
 import pytest
 
 from tslip.biped import BipedOptions, BipedParams, BipedState, simulate
 from tslip.biped.dynamics import body_positions, foot_position, hip_position, momentum
-from tslip.biped.gait import from_section
 from tslip.biped.metacentre import metacentric_table, metacentric_test, pitched_state
+from tslip.biped.stored import load_gait
 from tslip.plotting.biped import plot_metacentric
-
-HERE = os.path.dirname(__file__)
 
 
 def _gait(name: str) -> tuple[BipedParams, BipedState, float]:
-    with open(os.path.join(HERE, name)) as fh:
-        data = json.load(fh)
-    p = BipedParams.from_dict(data["params"])
-    y, t0 = from_section(p, np.asarray(data["z"]))
+    p, y, t0, _ = load_gait(name)
     return p, BipedState.from_array(y), t0
 
 
@@ -56,7 +49,7 @@ def test_momentum_of_a_rigid_translation():
 
 
 def test_pitched_state_keeps_hip_and_feet_in_the_world():
-    p, s, _ = _gait("stable_gait.json")
+    p, s, _ = _gait("converged-e2")
     for d in (0.5, -0.5):
         s2 = pitched_state(p, s, d)
         assert s2.q[2] == pytest.approx(s.q[2] + d)
@@ -69,7 +62,7 @@ def test_pitched_state_keeps_hip_and_feet_in_the_world():
 
 @pytest.fixture(scope="module")
 def converged():
-    p, s, t0 = _gait("stable_gait.json")
+    p, s, t0 = _gait("converged-e2")
     return metacentric_test(p, s, t0)
 
 
@@ -111,7 +104,7 @@ def test_thesis_start_state_is_also_restoring():
 
 
 def test_a_falling_stance_is_a_clear_error():
-    p, s, t0 = _gait("stable_gait.json")  # pitch -0.32 rad; -1.4 more is beyond -pi/2
+    p, s, t0 = _gait("converged-e2")  # pitch -0.32 rad; -1.4 more is beyond -pi/2
     with pytest.raises(ValueError, match="lift-off.*pitch"):
         metacentric_test(p, s, t0, pitches=(-1.4,))
 

@@ -22,6 +22,7 @@ from tslip.biped.gait import (
     to_section,
 )
 from tslip.biped.simulate import simulate
+from tslip.biped.stored import gait_path
 
 
 def test_refine_reduces_the_residual_and_reports_non_convergence():
@@ -37,7 +38,7 @@ def test_refine_reduces_the_residual_and_reports_non_convergence():
 
 def test_stored_converged_gait_is_periodic_and_stable():
     """The gait found by refine_periodic_gait from Table E.2 (see the report)."""
-    with open(os.path.join(os.path.dirname(__file__), "stable_gait.json")) as fh:
+    with open(str(gait_path("converged-e2"))) as fh:
         data = json.load(fh)
     p = BipedParams.from_dict(data["params"])
     z = np.array(data["z"])
@@ -58,7 +59,7 @@ def test_stored_converged_gait_is_periodic_and_stable():
 
 def test_floquet_stays_on_the_section():
     """Perturbing z_b off the section gave 0.649 at the stored gait; on it, 0.788."""
-    with open(os.path.join(os.path.dirname(__file__), "stable_gait.json")) as fh:
+    with open(str(gait_path("converged-e2"))) as fh:
         data = json.load(fh)
     p = BipedParams.from_dict(data["params"])
     z = np.array(data["z"])

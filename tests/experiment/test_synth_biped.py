@@ -14,13 +14,14 @@ import tslip.cli.experiment  # noqa: F401  (registers the commands)
 from tslip.biped import BipedParams, simulate
 from tslip.biped.dynamics import foot_position, hip_position
 from tslip.biped.gait import from_section
+from tslip.biped.stored import gait_path
 from tslip.cli.main import app
 from tslip.experiment.render import render_frames
 from tslip.experiment.synth import Camera, synthesize_biped
 from tslip.experiment.video import Calibration, TrackerOptions, track_frames
 from tslip.model.units import ROBOT_SCALING
 
-GAIT = Path(__file__).parents[1] / "biped" / "stable_gait.json"
+GAIT = gait_path("converged-e2")
 CAM = Camera(width=512, height=408, fps=500.0)
 L = ROBOT_SCALING.L
 T = ROBOT_SCALING.factor("time")

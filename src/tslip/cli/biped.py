@@ -34,8 +34,9 @@ app.add_typer(biped_app, name="biped")
 
 SetOpt = Annotated[list[str] | None, typer.Option(
     "--set", "-s", metavar="KEY=VALUE", help="Override a biped parameter, e.g. Kp_h=0.8.")]
-GaitOpt = Annotated[Path | None, typer.Option(
-    "--gait", metavar="FILE.json", help="Start from a gait written by `tslip biped search`.")]
+GaitOpt = Annotated[str | None, typer.Option(
+    "--gait", metavar="FILE.json|NAME", help="Start from a gait written by `tslip biped search` "
+    "or a stored one: converged-e2, optimised.")]
 TslipOpt = Annotated[str | None, typer.Option(
     "--from-tslip", metavar="PRESET",
     help="Start from this TSLIP preset's periodic gait (Table E.2's '+' entries; the rest "
@@ -79,15 +80,10 @@ def _start(sets: list[str] | None, gait: Path | None,
             raise ValueError(f"TSLIP preset {from_tslip!r} has no converged gait "
                              f"(residual {g.residual:.1e})")
         return p, tslip_start(g.state, p).to_array(), 0.0
-    try:
-        data = json.loads(Path(gait).read_text())
-    except FileNotFoundError:
-        raise ValueError(f"gait file {str(gait)!r} does not exist") from None
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"gait file {str(gait)!r} is not valid JSON: {exc}") from None
-    p = _params(sets, BipedParams.from_dict(data["params"]))
-    y, t0 = from_section(p, np.asarray(data["z"], dtype=float))
-    return p, y, t0
+    from ..biped.stored import load_gait
+
+    p0, y, t0, _ = load_gait(gait)
+    return _params(sets, p0), y, t0
 
 
 def _write_json(path: Path, data: dict[str, Any]) -> None:
@@ -272,8 +268,9 @@ def report_cmd(
 @biped_app.command("optimise")
 def optimise_cmd(
     out: Annotated[Path, typer.Option("--out", help="JSON of the most stable gait found.")],
-    gait: Annotated[Path, typer.Option(
-        "--gait", metavar="FILE.json", help="Converged gait to start from (warm start).")],
+    gait: Annotated[str, typer.Option(
+        "--gait", metavar="FILE.json|NAME",
+        help="Converged gait to start from (warm start), a file or a stored name.")],
     budget: Annotated[float, typer.Option("--budget", help="Wall-clock seconds.")] = 600.0,
     max_evals: Annotated[int, typer.Option("--max-evals")] = 400,
     popsize: Annotated[int, typer.Option("--popsize")] = 8,

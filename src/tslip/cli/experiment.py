@@ -63,10 +63,11 @@ def synth_video_cmd(
                                                help="Scene width in the frame \\[m].")] = 0.88,
     noise: Annotated[float, typer.Option("--noise", help="Sensor noise \\[grey levels].")] = 3.0,
     seed: Annotated[int, typer.Option("--seed", help="Noise seed.")] = 0,
-    biped_gait: Annotated[Path | None, typer.Option(
-        "--biped-gait", metavar="FILE.json",
+    biped_gait: Annotated[str | None, typer.Option(
+        "--biped-gait", metavar="FILE.json|NAME",
         help="Render the two-legged model (Appendix E) from this gait, as written by `tslip "
-             "biped search`, instead of the preset's TSLIP gait.")] = None,
+             "biped search` or stored (converged-e2, optimised), instead of the preset's "
+             "TSLIP gait.")] = None,
 ) -> None:
     """Render a simulated run as a treadmill video with a ground-truth CSV.
 
@@ -84,10 +85,12 @@ def synth_video_cmd(
             if sets:
                 raise ValueError("--set changes the TSLIP preset; it cannot be combined with "
                                  "--biped-gait")
-            bp, y, t0, z = _load_biped_gait(biped_gait)
+            from ..biped.stored import load_gait
+
+            bp, y, t0, gd = load_gait(biped_gait)
             run = synthesize_biped(bp, y, duration, t0=t0, camera=cam, options=render)
             model: dict[str, Any] = {"model": "biped", "gait_file": str(biped_gait),
-                                     "params": bp.to_dict(), "z": z, "t0": t0}
+                                     "params": bp.to_dict(), "z": list(gd["z"]), "t0": t0}
         else:
             params = _build_params(preset_name, sets, None)
             gait = find_gait(params)
@@ -110,32 +113,6 @@ def synth_video_cmd(
         c = _console()
         c.print(f"wrote {out} ({run.n_frames} frames, {width}x{height} px at {fps:g} Hz)")
         c.print(f"wrote {truth}")
-
-
-def _load_biped_gait(path: Path) -> tuple[Any, np.ndarray, float, list[float]]:
-    """Parameters, start state, start time and section vector of a biped gait JSON."""
-    from ..biped.gait import from_section
-    from ..biped.parameters import BipedParams
-
-    name = str(path)
-    try:
-        data = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise ValueError(f"biped gait file {name!r} does not exist") from None
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"biped gait file {name!r} is not valid JSON: {exc}") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"cannot read biped gait file {name!r}: {exc}") from None
-    if not (isinstance(data, dict) and isinstance(data.get("params"), dict) and "z" in data):
-        raise ValueError(f"biped gait file {name!r} needs a 'params' object and a section "
-                         f"vector 'z' (as written by `tslip biped search`)")
-    try:
-        p = BipedParams.from_dict(data["params"])
-        z = np.asarray(data["z"], dtype=float)
-        y, t0 = from_section(p, z)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"biped gait file {name!r}: {exc}") from None
-    return p, y, t0, z.tolist()
 
 
 def _track(video: Path, out: Path, fps: float | None, scale: float | None,
