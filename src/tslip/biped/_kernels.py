@@ -18,6 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .._kernel_cache import check as _check_cache
 from ..simulation._kernels import (
     A21,
     A31,
@@ -726,3 +727,9 @@ def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
     stats[S_TEND] = t
     stats[S_NFEV] = nfev
     return status
+
+
+# numba does not notice when a kernel called from another file changes; drop
+# cached kernels compiled against other sources (see tslip._kernel_cache).
+_check_cache(run, __file__)
+

@@ -15,6 +15,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from .._kernel_cache import check as _check_cache
 from ..model._pack import (
     NOUT,
     NREC,
@@ -787,3 +788,9 @@ def flight_samples(P, lo, ts, out):
     """:func:`flight_state` at each time in ``ts``; ``out`` has shape (n, 10)."""
     for i in range(ts.shape[0]):
         flight_state(P, lo, ts[i], out[i])
+
+
+# numba does not notice when a kernel called from another file changes; drop
+# cached kernels compiled against other sources (see tslip._kernel_cache).
+_check_cache(flight_samples, __file__)
+

@@ -26,6 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .._kernel_cache import check as _check_cache
 from ..model._pack import (
     NREC,
     OUT_LO,
@@ -281,4 +282,7 @@ def stride_jacobian(P, O, td, tx, th, Jq, out):
     return status
 
 
+# numba does not notice when a kernel called from another file changes; drop
+# cached kernels compiled against other sources (see tslip._kernel_cache).
+_check_cache(stride_jacobian, __file__)
 

@@ -1,0 +1,69 @@
+"""Keep numba's on-disk cache of the compiled kernels consistent with their sources.
+
+numba invalidates a cached function when the file that defines it changes,
+but a cached kernel also embeds the compiled code of the kernels it calls
+from other files, and those changes go unnoticed (numba's documentation on
+``cache=True``). Worse, two cached libraries that embed different versions
+of one callee export the same symbol, and in a process that loads both, the
+first one loaded serves both: the biped's integrator once ran the TSLIP's
+older five-component dense output after a TSLIP Floquet computation had
+loaded a stale cached kernel, and fell in its first stride.
+
+So every kernel module calls :func:`check` once at import, before any kernel
+runs: the cache directory of the module carries a marker with a hash of all
+kernel sources (:data:`SOURCES`), and entries written under another hash
+are deleted (they are recompiled on first use). Concurrent imports (spawned
+workers) at worst delete each other's fresh entries, which costs a compile.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+__all__ = ["SOURCES", "sources_hash", "check"]
+
+_ROOT = Path(__file__).parent
+
+#: Package files whose code is compiled into the kernels (njit functions and
+#: the layout constants they read).
+SOURCES: tuple[str, ...] = (
+    "model/_pack.py", "simulation/_kernels.py", "simulation/_variational.py",
+    "biped/_pack.py", "biped/_kernels.py",
+)
+
+
+def sources_hash() -> str:
+    """SHA-256 of the kernel sources (with numba's version)."""
+    import numba
+
+    h = hashlib.sha256(numba.__version__.encode())
+    for rel in SOURCES:
+        h.update(rel.encode())
+        h.update((_ROOT / rel).read_bytes())
+    return h.hexdigest()
+
+
+def check(dispatcher: object, module_file: str) -> None:
+    """Delete the cached kernels of ``module_file`` if they predate the sources.
+
+    ``dispatcher`` is any ``cache=True`` kernel of that module (it tells
+    where numba keeps the module's cache, which ``NUMBA_CACHE_DIR`` moves).
+    Never raises: a cache that cannot be checked is left to numba.
+    """
+    try:
+        cache_dir = Path(dispatcher._cache.cache_path)  # type: ignore[attr-defined]
+        stem = Path(module_file).stem
+        marker = cache_dir / f"{stem}.tslip-sources"
+        digest = sources_hash()
+        if marker.is_file() and marker.read_text() == digest:
+            return
+        for f in cache_dir.glob(f"{stem}.*.nb[ic]"):
+            f.unlink(missing_ok=True)
+        cache_dir.mkdir(parents=True, exist_ok=True)
+        tmp = marker.with_name(f"{marker.name}.{os.getpid()}.tmp")
+        tmp.write_text(digest)
+        os.replace(tmp, marker)
+    except (OSError, AttributeError):
+        return

@@ -1,0 +1,39 @@
+"""The guard that drops numba cache entries compiled against other kernel sources."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+from tslip import _kernel_cache as kc
+
+
+def _fake(tmp_path):
+    return SimpleNamespace(_cache=SimpleNamespace(cache_path=str(tmp_path)))
+
+
+def test_stale_entries_are_deleted_and_fresh_ones_kept(tmp_path):
+    mine = [tmp_path / "_kernels.run-10.py311.nbi", tmp_path / "_kernels.run-10.py311.1.nbc"]
+    other = tmp_path / "_variational.stride-3.py311.nbi"
+    for f in (*mine, other):
+        f.write_text("x")
+    kc.check(_fake(tmp_path), "/somewhere/_kernels.py")  # no marker yet: stale
+    assert not any(f.exists() for f in mine) and other.exists()
+    marker = tmp_path / "_kernels.tslip-sources"
+    assert marker.read_text() == kc.sources_hash()
+    for f in mine:  # entries compiled now, under the current sources, survive
+        f.write_text("x")
+    kc.check(_fake(tmp_path), "/somewhere/_kernels.py")
+    assert all(f.exists() for f in mine)
+    marker.write_text("an older hash")  # a source changed since
+    kc.check(_fake(tmp_path), "/somewhere/_kernels.py")
+    assert not any(f.exists() for f in mine)
+
+
+def test_hash_covers_every_kernel_source():
+    for rel in kc.SOURCES:
+        assert (kc._ROOT / rel).is_file(), rel
+    assert len(kc.sources_hash()) == 64
+
+
+def test_an_unusable_cache_is_left_alone():
+    kc.check(object(), "x.py")  # no _cache attribute: ignored, no exception
