@@ -11,12 +11,12 @@ ALLOWED = {
     "model": set(),
     "simulation": {"model"},
     "gait": {"model", "simulation"},
-    "sweeps": {"model", "simulation", "gait"},
+    "sweeps": {"model", "simulation", "gait", "biped"},
     "experiment": {"model", "simulation", "gait", "biped"},
     "biped": {"model", "simulation", "gait"},
     "plotting": {"model", "simulation", "gait", "sweeps", "experiment", "biped"},
 }
-TOP = {"_io", "__init__", "__main__", "_typing", "__version__"}
+TOP = {"_io", "_kernel_cache", "__init__", "__main__", "_typing", "__version__"}
 
 
 def _imports(path: Path) -> set[str]:

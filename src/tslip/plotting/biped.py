@@ -49,15 +49,20 @@ def plot_tracking(tr: BipedTrajectory, stride: int = 0, leg: int = 0) -> Figure:
     return fig
 
 
-def plot_foot_path(tr: BipedTrajectory, leg: int = 0, ax: Any = None) -> Figure:
-    """Reference and actual foot path relative to the hip (Figure E.3)."""
+def plot_foot_path(tr: BipedTrajectory, leg: int = 0, ax: Any = None,
+                   stride: int | None = None) -> Figure:
+    """Reference and actual foot path relative to the hip (Figure E.3).
+
+    ``stride``: only that stride (from its right touch-down to the next);
+    default every recorded stride.
+    """
     p = tr.params
     if ax is None:
         fig = Figure(figsize=(6, 5), layout="constrained")
         ax = fig.subplots()
     else:
         fig = ax.figure
-    q = tr.data[:, 1:10]
+    q = tr.data[:, 1:10] if stride is None else tr.data[_window(tr, stride), 1:10]
     rel = foot_position(p, q, leg) - hip_position(p, q)
     rho = np.linspace(0, 1, 400)
     ref = controller_references(p, rho)

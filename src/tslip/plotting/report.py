@@ -36,6 +36,7 @@ def figure_png(fig: Figure, dpi: int = 80) -> str:
 
 def _plots(data: Mapping[str, Any]) -> dict[str, Callable[[], Figure]]:
     from ..sweeps.catalogue import GRID_SPEEDS
+    from . import biped as b
     from . import gait as g
     from . import studies as s
 
@@ -72,6 +73,9 @@ def _plots(data: Mapping[str, Any]) -> dict[str, Callable[[], Figure]]:
         "4.7": lambda: g.plot_velocity_angle_effect(data["4.7"]),
         "C.1": lambda: g.plot_friction([data["C.1"]["table2.1"], data["C.1"]["table6.1"]],
                                        titles=["Table 2.1", "Table 6.1"]),
+        "E.2": lambda: b.plot_tracking(data["E"]["e2"]["run"]),
+        "E.3": lambda: b.plot_foot_path(data["E"]["e2"]["run"], stride=0),
+        "E.4": lambda: b.plot_metacentric(data["E"]["converged"]["metacentric"]),
         "4.10": lambda: s.plot_stable_grid({v: data[f"grid_v{v:g}"] for v in GRID_SPEEDS}),
         "4.11": lambda: s.plot_stride_times({n: data[n] for n in
                                              ("stride_v0", "stride_k", "stride_beta0")}),
@@ -107,6 +111,8 @@ SECTIONS: tuple[tuple[tuple[str, ...], str], ...] = (
     (("4.24", "4.25"), "Figures 4.24, 4.25: four controllers over r"),
     (("6.1", "6.2"), "Section 6.1, Tables 6.1-6.2, Figure 6.2: the elliptical-runner fit"),
     (("C.1",), "Figure C.1: friction ratio"),
+    (("E.2", "E.3", "E.4"), "Appendix E, Figures E.2-E.4: the two-legged model (tracking and "
+     "stability from Table E.2; metacentric test on the converged periodic gait)"),
 )
 
 _CSS = """

@@ -2,10 +2,10 @@
 
 Every sweep figure is one :class:`~tslip.sweeps.StudySpec` (or a few, for
 Figures 4.10, 4.11, 4.24-4.25) with a quick and a full resolution; the
-figures that analyse a single gait (4.1-4.7, 6.2, C.1) are small functions
-returning the analysis objects. Nothing here is tuned to a reported number:
-base parameters are the presets of Tables 2.1 and 6.1 and the ranges are
-those of Sections 3.4-3.7.
+figures that analyse a single gait (4.1-4.7, 6.2, C.1, and Appendix E's
+biped) are small functions returning the analysis objects. Nothing here is
+tuned to a reported number: base parameters are the presets of Tables 2.1
+and 6.1 (and Tables E.1-E.4) and the ranges are those of Sections 3.4-3.7.
 
 Choices the thesis leaves open
 ------------------------------
@@ -198,6 +198,38 @@ def fig_friction() -> dict[str, Any]:
         g = _gait(key)
         out[key] = friction_ratio(g.params, g.state, 1.0)
     return out
+
+
+def fig_appendix_e(n_strides: int = 20, n_converged: int = 50) -> dict[str, Any]:
+    """Appendix E, the two-legged model: Figures E.2-E.4 and Section E.4's numbers.
+
+    ``"e2"``: the run from Table E.2 (strides until fall, of ``n_strides``),
+    its Floquet multipliers at that (non-periodic) start, and the tracking
+    errors over its first stride (Figure E.2). ``"converged"``: the stored
+    periodic gait reached from there (:mod:`tslip.biped.stored`), its
+    residual, multipliers and strides until fall (of ``n_converged``), and
+    the metacentric test of Figure E.4 on it.
+    """
+    from ..biped import BipedParams, BipedState, simulate
+    from ..biped.gait import floquet, to_section, tracking_errors
+    from ..biped.metacentre import metacentric_test
+    from ..biped.stored import load_gait
+
+    p, s = BipedParams(), BipedState.thesis()
+    run = simulate(p, s, n_strides)
+    t1 = float(run.strides[0, 0]) if run.n_strides else float(run.time[-1])
+    fl = floquet(p, to_section(p, s.to_array(), 0.0))
+    pc, yc, tc, _ = load_gait("converged-e2")
+    flc = floquet(pc, to_section(pc, yc, tc))
+    runc = simulate(pc, yc, n_converged, t0=tc)
+    return {
+        "e2": {"run": run, "strides": run.n_strides, "of": n_strides,
+               "reason": run.status.reason, "largest": fl.largest, "residual": fl.residual,
+               "tracking": tracking_errors(run, 0, 0.0, t1)},
+        "converged": {"largest": flc.largest, "residual": flc.residual,
+                      "strides": runc.n_strides, "of": n_converged,
+                      "metacentric": metacentric_test(pc, BipedState.from_array(yc), tc)},
+    }
 
 
 def replace_spec(spec: StudySpec, **changes: Any) -> StudySpec:

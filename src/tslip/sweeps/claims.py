@@ -504,6 +504,38 @@ def _cC1(d: Mapping[str, Any]) -> tuple[Numbers, bool]:
     return nums, bool(not a.slips and b.slips and b.first_slip >= 0.8)
 
 
+def _ce2(d: Mapping[str, Any]) -> tuple[Numbers, bool]:
+    te = d["E"]["e2"]["tracking"]
+    return {"thigh RMS [L]": _r(te.thigh_rms, 5), "hip RMS [rad]": _r(te.hip_rms, 4),
+            "ratio": _r(te.thigh_rms / te.hip_rms, 4)}, te.thigh_rms < 0.1 * te.hip_rms
+
+
+def _ce4_unstable(d: Mapping[str, Any]) -> tuple[Numbers, bool]:
+    e = d["E"]["e2"]
+    return {"largest |lambda| at Table E.2": _r(e["largest"], 3), "thesis": 67.0,
+            "periodicity residual there": _r(e["residual"], 3)}, e["largest"] > 1.0
+
+
+def _ce4_falls(d: Mapping[str, Any]) -> tuple[Numbers, bool]:
+    e = d["E"]["e2"]
+    return {"strides until fall": e["strides"], "thesis": "about 10",
+            "reason": e["reason"]}, abs(e["strides"] - 10) <= 2
+
+
+def _ce4_meta(d: Mapping[str, Any]) -> tuple[Numbers, bool]:
+    nums, ok = _pitch(d["E"]["converged"], "metacentric")
+    nums["dtheta_b"] = nums.pop("dphi")
+    nums["hip distance / r_1"] = nums.pop("hip distance / r")
+    return nums, ok and nums["max |direction change| [rad]"] < 0.1
+
+
+def _ce_stable(d: Mapping[str, Any]) -> tuple[Numbers, bool]:
+    c = d["E"]["converged"]
+    return {"largest |lambda|": _r(c["largest"], 4), "periodicity residual": float(
+        f"{c['residual']:.1e}"), "strides run": f"{c['strides']} of {c['of']}"}, bool(
+        c["largest"] < 1.0 and c["residual"] < 1e-8 and c["strides"] == c["of"])
+
+
 def _claim(figure: str, text: str, needs: tuple[str, ...], fn: Callable) -> Claim:
     return Claim(figure, text, needs, fn)
 
@@ -574,6 +606,17 @@ CLAIMS: tuple[Claim, ...] = (
            ("6.2",), _c62),
     _claim("C.1", "Table 2.1 never exceeds friction mu = 1; Table 6.1 exceeds it slightly in "
            "the last part of stance.", ("C.1",), _cC1),
+    _claim("E.2", "Biped: the thigh length tracks its reference far more closely than the hip "
+           "angle (Figure E.2).", ("E",), _ce2),
+    _claim("E.4", "Biped from Table E.2: numerically unstable (largest multiplier 67.0).",
+           ("E",), _ce4_unstable),
+    _claim("E.4", "Biped from Table E.2: falls after about 10 strides (within 2).", ("E",),
+           _ce4_falls),
+    _claim("E.4", "Biped: after +-0.5 rad of body pitch the impulse's moment about the CoM "
+           "restores the pitch and its direction hardly changes (metacentric, Figure E.4).",
+           ("E",), _ce4_meta),
+    _claim("E.4", "Beyond the thesis: a periodic biped gait with all multipliers inside the unit "
+           "circle exists (the thesis found none).", ("E",), _ce_stable),
 )
 
 

@@ -112,7 +112,7 @@ def table61() -> dict[str, float]:
 
 
 def single_figures(quick: bool = False, progress: Progress | None = None) -> dict[str, Any]:
-    """The single-gait analyses (Figures 4.1-4.7, 6.2, C.1) and Table 6.1's numbers."""
+    """The single-gait analyses (Figures 4.1-4.7, 6.2, C.1, E.2-E.4) and Table 6.1's numbers."""
     jobs: dict[str, Callable[[], Any]] = {
         "4.1": catalogue.fig_impulse_linearisation,
         "4.2": lambda: catalogue.fig_pitch_disturbance("table2.1"),
@@ -123,6 +123,7 @@ def single_figures(quick: bool = False, progress: Progress | None = None) -> dic
         "4.7": catalogue.fig_velocity_angle,
         "C.1": catalogue.fig_friction,
         "table6.1": table61,
+        "E": catalogue.fig_appendix_e,
     }
     out = {}
     for key, job in jobs.items():
