@@ -77,7 +77,7 @@ def test_cli_report_loads_a_gait_file(tmp_path):
     r = CliRunner().invoke(app, ["biped", "report", "--gait", gait, "--out-dir",
                                  str(tmp_path), "-n", "3"])
     assert r.exit_code == 0, r.output
-    assert "strides until fall: 3" in r.output and "largest multiplier 0.428" in r.output
+    assert "strides until fall: 3" in r.output and "largest multiplier 0.101" in r.output
     assert (tmp_path / "multipliers.csv").exists() and (tmp_path / "fig_e2_tracking.png").exists()
     assert (tmp_path / "fig_e4_metacentric.png").exists() and "metacentric test" in r.output
     rows = (tmp_path / "metacentric.csv").read_text().splitlines()
