@@ -19,6 +19,8 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from ..model.controllers import check_finite_fields
+
 __all__ = [
     "BipedParameterInfo",
     "BIPED_PARAMETER_TABLE",
@@ -104,24 +106,11 @@ def _f(name: str) -> Any:
     row = _TABLE[name]
     return field(
         default=row.default,
-        metadata={"symbol": row.symbol, "unit": row.unit, "description": row.description,
+        metadata={"symbol": row.symbol, "unit": row.unit, "lower": row.lower,
+                  "upper": row.upper, "lower_open": row.lower_open,
+                  "upper_open": row.upper_open, "description": row.description,
                   "source": row.source},
     )
-
-
-def _check_range(name: str, value: Any) -> None:
-    row = _TABLE[name]
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise ValueError(f"{name} [{row.unit}] must be a number, got {value!r}")
-    v = float(value)
-    lo_ok = v > row.lower if row.lower_open else v >= row.lower
-    hi_ok = v < row.upper if row.upper_open else v <= row.upper
-    if not (math.isfinite(v) and lo_ok and hi_ok):
-        lb = "(" if row.lower_open else "["
-        ub = ")" if row.upper_open else "]"
-        raise ValueError(
-            f"{name} [{row.unit}] must be in {lb}{row.lower:g}, {row.upper:g}{ub}, got {value!r}"
-        )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -207,7 +196,11 @@ class BipedParams:
 
     def __post_init__(self) -> None:
         for row in BIPED_PARAMETER_TABLE:
-            _check_range(row.name, getattr(self, row.name))
+            value = getattr(self, row.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+                raise ValueError(f"{row.name} [{row.unit}] must be a number, got {value!r}")
+            object.__setattr__(self, row.name, float(value))
+        check_finite_fields(self)  # the table's ranges, as for the TSLIP's Params
         for name in ("actuated", "contact"):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
                 raise ValueError(f"{name} must be True or False, got {getattr(self, name)!r}")
