@@ -18,6 +18,7 @@ workers) at worst delete each other's fresh entries, which costs a compile.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 from pathlib import Path
@@ -34,8 +35,9 @@ SOURCES: tuple[str, ...] = (
 )
 
 
+@functools.cache
 def sources_hash() -> str:
-    """SHA-256 of the kernel sources (with numba's version)."""
+    """SHA-256 of the kernel sources (with numba's version); computed once a process."""
     import numba
 
     h = hashlib.sha256(numba.__version__.encode())
