@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import json
 import os
 import tempfile
 import tomllib
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
-__all__ = ["atomic_write", "git_hash", "read_toml", "write_table"]
+__all__ = ["atomic_write", "git_hash", "read_toml", "write_json", "write_table"]
 
 
 def atomic_write(path: str | Path, write: Callable[[str], None]) -> Path:
@@ -31,6 +33,19 @@ def atomic_write(path: str | Path, write: Callable[[str], None]) -> Path:
         if os.path.exists(tmp):
             os.unlink(tmp)
     return path
+
+
+def _json_default(o: Any) -> Any:
+    """NumPy scalars and arrays as Python numbers and lists; anything else as text."""
+    if hasattr(o, "tolist"):
+        return o.tolist()
+    return str(o)
+
+
+def write_json(path: str | Path, data: Any, indent: int = 2) -> Path:
+    """Write ``data`` as JSON atomically (NumPy values converted, others as text)."""
+    text = json.dumps(data, indent=indent, default=_json_default)
+    return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
 def write_table(df, path: str | Path) -> Path:  # noqa: ANN001 - pandas.DataFrame

@@ -6,7 +6,6 @@ imported (``from . import biped`` in :mod:`tslip.cli.main`).
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Annotated, Any
@@ -14,7 +13,7 @@ from typing import Annotated, Any
 import numpy as np
 import typer
 
-from .._io import atomic_write
+from .._io import write_json
 from ..biped import BipedOptions, BipedParams, BipedState, simulate
 from ..biped.gait import (
     find_periodic_gait,
@@ -84,11 +83,6 @@ def _start(sets: list[str] | None, gait: Path | None,
 
     p0, y, t0, _ = load_gait(gait)
     return _params(sets, p0), y, t0
-
-
-def _write_json(path: Path, data: dict[str, Any]) -> None:
-    text = json.dumps(data, indent=2, default=float)
-    atomic_write(path, lambda tmp: Path(tmp).write_text(text))
 
 
 @biped_app.command("simulate")
@@ -189,7 +183,7 @@ def search_cmd(
             data.update(extra)
             for line in lines:
                 c.print(line)
-        _write_json(out, data)
+        write_json(out, data)
         c.print(f"wrote {out}")
 
 
@@ -261,7 +255,7 @@ def report_cmd(
             c.print("robustness (25 strides): " + ", ".join(
                 f"{k} {v:.4f}" for k, v in lim.items()) + "  (TSLIP Table 6.1: step_down "
                 "-0.119, push -0.725, pitch_rate -0.733)")
-            _write_json(out_dir / "robustness.json", lim)
+            write_json(out_dir / "robustness.json", lim)
         c.print(f"wrote figures, multipliers.csv and metacentric.csv to {out_dir}")
 
 
@@ -293,7 +287,7 @@ def optimise_cmd(
         c = _console()
 
         def checkpoint(b: dict[str, Any]) -> None:  # a usable --gait file at every new best
-            _write_json(out, {"design": b["design"], "bounds": DESIGN_BOUNDS,
+            write_json(out, {"design": b["design"], "bounds": DESIGN_BOUNDS,
                               "evaluations": b["evaluations"], "residual": b["residual"],
                               "largest_multiplier": b["score"], "converged": True,
                               "params": b["params"], "z": b["z"], "checkpoint": True})
@@ -316,5 +310,5 @@ def optimise_cmd(
                 c.print(line)
         c.print(f"best score {b['score']:.4f} after {r['evaluations']} designs "
                 f"({r['seconds']:.0f} s)")
-        _write_json(out, data)
+        write_json(out, data)
         c.print(f"wrote {out}")

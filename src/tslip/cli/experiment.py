@@ -8,7 +8,6 @@ non-zero after writing what was tracked.
 
 from __future__ import annotations
 
-import json
 import math
 import time
 from pathlib import Path
@@ -19,7 +18,7 @@ import pandas as pd
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-from .._io import atomic_write, write_table
+from .._io import atomic_write, write_json, write_table
 from .main import PresetOpt, SetOpt, _build_params, _console, _errors, _fail, app
 
 __all__ = ["synth_video_cmd", "track_cmd", "process_cmd", "fit_cmd", "experiment_cmd"]
@@ -27,11 +26,6 @@ __all__ = ["synth_video_cmd", "track_cmd", "process_cmd", "fit_cmd", "experiment
 _SPACING = 0.18
 _MARKER_R = 0.025
 _FOOT_R = 0.016
-
-
-def _write_json(path: Path, data: dict[str, Any]) -> Path:
-    return atomic_write(path, lambda tmp: Path(tmp).write_text(
-        json.dumps(data, indent=2, default=str)))
 
 
 def _bar(label: str) -> Progress:
@@ -103,7 +97,7 @@ def synth_video_cmd(
             write_video(run, out, progress=lambda d, n: bar.update(task, completed=d))
         truth = out.with_name(out.stem + ".truth.csv") if out.suffix else out / "truth.csv"
         write_table(run.truth, truth)
-        _write_json(truth.with_suffix(".json"), {
+        write_json(truth.with_suffix(".json"), {
             **model, "fps": fps, "px_per_m": cam.px_per_m,
             "ground_y_px": cam.ground_px, "belt_speed_m_s": run.belt_speed,
             "stance_time": run.stance_time, "flight_time": run.flight_time,
@@ -142,7 +136,7 @@ def _track(video: Path, out: Path, fps: float | None, scale: float | None,
         res = track_video(video, cal, opt, fps=fps, max_frames=max_frames,
                           progress=lambda d, n: bar.update(task, completed=d, total=n or None))
     write_table(res.tracks, out)
-    _write_json(out.with_suffix(".json"), {
+    write_json(out.with_suffix(".json"), {
         "video": str(video), "fps": res.fps, "px_per_m": cal.px_per_m, "ground_y_px":
         cal.ground_y, "x0_px": cal.x0, "problems": res.problems, "fatal": res.fatal,
         "body_detection_rate": res.body_detection_rate})
@@ -185,7 +179,7 @@ def _process(tracks_path: Path, out: Path) -> Any:
     data = process_tracks(tracks, fps)
     table = data.samples.merge(data.steps[["step", "stance_time", "flight_time"]], on="step")
     write_table(table, out)
-    _write_json(out.with_suffix(".json"), {"belt_speed_m_s": data.belt_speed,
+    write_json(out.with_suffix(".json"), {"belt_speed_m_s": data.belt_speed,
                                            "problems": data.problems, **data.meta})
     write_table(data.frames, out.with_name(out.stem + ".frames" + out.suffix))
     c = _console()
@@ -224,7 +218,7 @@ def _fit(steps_path: Path, out_dir: Path, frames: Any = None) -> Any:
     out_dir.mkdir(parents=True, exist_ok=True)
     write_table(res.times, out_dir / "table6_2.csv")
     write_table(res.scores, out_dir / "table6_3.csv")
-    _write_json(out_dir / "fit.json", {"values": res.values, "params": res.params.to_dict(),
+    write_json(out_dir / "fit.json", {"values": res.values, "params": res.params.to_dict(),
                                        "stance_time": res.stance_time,
                                        "flight_time": res.flight_time, "converged":
                                        res.converged, "message": res.message,

@@ -12,7 +12,6 @@ from __future__ import annotations
 import base64
 import html
 import io
-import json
 import math
 from collections.abc import Callable, Mapping, Sequence
 from datetime import UTC, datetime
@@ -22,7 +21,7 @@ from typing import Any
 from matplotlib.figure import Figure
 
 from .. import __version__
-from .._io import atomic_write
+from .._io import atomic_write, write_json
 
 __all__ = ["reproduce", "write_report", "figure_png", "SECTIONS"]
 
@@ -240,8 +239,7 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
     atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
     claims_json = [{"figure": c.figure, "claim": c.text, "holds": c.holds,
                     "numbers": c.numbers, "error": c.error} for c in claims]
-    atomic_write(path.with_name("claims.json"), lambda tmp: Path(tmp).write_text(
-        json.dumps(claims_json, indent=1, default=str)))
+    write_json(path.with_name("claims.json"), claims_json, indent=1)
     return path
 
 

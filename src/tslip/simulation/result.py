@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import enum
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._io import atomic_write, git_hash, write_table
+from .._io import git_hash, write_json, write_table
 from ..model import _pack as pk
 from ..model.parameters import Params
 from ..model.state import TouchdownState
@@ -266,7 +265,6 @@ step-down from a :class:`Disturbance`). ``steps`` holds the :class:`StepResult` 
             "git": git_hash(),
             **self.meta,
         }
-        atomic_write(path.with_suffix(".json"),
-                     lambda tmp: Path(tmp).write_text(json.dumps(meta, indent=2, default=str)))
+        write_json(path.with_suffix(".json"), meta)
         return path
 

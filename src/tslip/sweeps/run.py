@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
-from .._io import atomic_write, git_hash, write_table
+from .._io import atomic_write, git_hash, write_json, write_table
 from ..gait.continuation import continue_gait, get_param
 from ..gait.fixed_point import Gait, GaitProblem, find_gait
 from ..gait.robustness import KINDS, robustness_report
@@ -380,8 +380,7 @@ def run_study(
         write_table(frame, out / "results.parquet")
         if csv:
             write_table(frame, out / "results.csv")
-        atomic_write(out / "run.json", lambda tmp: Path(tmp).write_text(
-            json.dumps(meta, indent=2, default=float)))
+        write_json(out / "run.json", meta)
     return StudyResult(spec, frame, meta)
 
 
