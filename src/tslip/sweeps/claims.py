@@ -17,35 +17,88 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from enum import StrEnum
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-__all__ = ["Claim", "ClaimResult", "CLAIMS", "evaluate", "stable_mask", "stable_range"]
+__all__ = ["Check", "Claim", "ClaimResult", "CLAIMS", "Verdict", "evaluate", "stable_mask",
+           "stable_range"]
 
 Numbers = dict[str, Any]
 
 
+class Verdict(StrEnum):
+    """How a claim compares with our numbers.
+
+    ``HOLDS``: under the plain reading of the thesis sentence.
+    ``HOLDS_UNDER_READING``: the sentence allows more than one reading (or
+    set-up) and it holds under the one named in the result's ``reading``;
+    the numbers of every reading are shown. ``FAILS``: it does not hold; the
+    result's ``evidence`` holds what the package computed to find out why.
+    """
+
+    HOLDS = "holds"
+    HOLDS_UNDER_READING = "holds under a stated reading"
+    FAILS = "does not hold"
+
+
+@dataclass(frozen=True)
+class Check:
+    """What a claim's test returns.
+
+    ``numbers``: our measured values (shown for every verdict);
+    ``evidence``: further numbers that explain a ``FAILS`` or a
+    ``HOLDS_UNDER_READING`` (each reading's result, variants tried);
+    ``note``: one sentence for the reader, e.g. that the claim fails only at
+    quick resolution.
+    """
+
+    numbers: Numbers
+    verdict: Verdict
+    evidence: Numbers = field(default_factory=dict)
+    note: str = ""
+
+
 @dataclass(frozen=True)
 class Claim:
-    """A thesis claim and its test."""
+    """A thesis claim and its test.
+
+    ``text`` is the claim in one short sentence (the summary table);
+    ``quote`` the thesis's own words and ``source`` where they stand (section,
+    figure or table); ``reading`` what the test checks and why its threshold
+    is a fair reading of the wording.
+    """
 
     figure: str
     text: str
     needs: tuple[str, ...]
-    test: Callable[[Mapping[str, Any]], tuple[Numbers, bool]] = field(repr=False)
+    test: Callable[[Mapping[str, Any]], Check | tuple[Numbers, bool]] = field(repr=False)
+    quote: str = ""
+    source: str = ""
+    reading: str = ""
 
 
 @dataclass(frozen=True)
 class ClaimResult:
-    """A claim with the numbers we measured and whether it holds."""
+    """A claim with the numbers we measured and its verdict."""
 
     figure: str
     text: str
     numbers: Numbers
-    holds: bool
+    verdict: Verdict
     error: str = ""
+    quote: str = ""
+    source: str = ""
+    reading: str = ""
+    evidence: Numbers = field(default_factory=dict)
+    note: str = ""
+
+    @property
+    def holds(self) -> bool:
+        """True for ``HOLDS`` and ``HOLDS_UNDER_READING``."""
+        return self.verdict is not Verdict.FAILS
 
 
 # -- helpers ------------------------------------------------------------------
@@ -620,6 +673,13 @@ CLAIMS: tuple[Claim, ...] = (
 )
 
 
+def _as_check(out: Check | tuple[Numbers, bool]) -> Check:
+    if isinstance(out, Check):
+        return out
+    nums, ok = out
+    return Check(nums, Verdict.HOLDS if ok else Verdict.FAILS)
+
+
 def evaluate(data: Mapping[str, Any],
              claims: tuple[Claim, ...] = CLAIMS) -> list[ClaimResult]:
     """Test every claim whose data is present; a failing computation counts as not holding."""
@@ -627,9 +687,12 @@ def evaluate(data: Mapping[str, Any],
     for c in claims:
         if not all(n in data for n in c.needs):
             continue
+        common = {"quote": c.quote, "source": c.source, "reading": c.reading}
         try:
-            nums, ok = c.test(data)
-            out.append(ClaimResult(c.figure, c.text, nums, bool(ok)))
+            k = _as_check(c.test(data))
+            out.append(ClaimResult(c.figure, c.text, k.numbers, k.verdict, evidence=k.evidence,
+                                   note=k.note, **common))
         except Exception as exc:  # noqa: BLE001 - shown in the report as a failure
-            out.append(ClaimResult(c.figure, c.text, {}, False, f"{type(exc).__name__}: {exc}"))
+            out.append(ClaimResult(c.figure, c.text, {}, Verdict.FAILS,
+                                   f"{type(exc).__name__}: {exc}", **common))
     return out

@@ -1,0 +1,144 @@
+"""A hash of the code that computes a result, for caches that never go stale.
+
+A cached result is valid while the code that produced it is unchanged. That
+code is a module and everything it imports from ``tslip``, found here by
+reading the import statements of the sources (``ast``, nothing is
+imported): :func:`module_closure` follows them transitively, and
+:func:`code_hash` hashes those files together with the versions of the
+numerical libraries they call. So an edit to :mod:`tslip.gait.robustness`
+invalidates the cached points that ran a robustness analysis and no others,
+and an edit to the biped leaves every TSLIP study cached.
+
+Imports inside functions count too (they run when the function does). A
+``from package import name`` counts ``package/name.py`` when that file
+exists, else the module the package's ``__init__`` takes ``name`` from, else
+the ``__init__``'s own source (for a name it defines, like ``__version__``).
+"""
+
+from __future__ import annotations
+
+import ast
+import functools
+import hashlib
+from importlib import metadata
+from pathlib import Path
+
+__all__ = ["module_closure", "code_hash"]
+
+_ROOT = Path(__file__).parent
+_PKG = "tslip"
+
+#: Third-party libraries whose version can change a computed number.
+LIBRARIES: tuple[str, ...] = ("numpy", "scipy", "numba", "llvmlite", "cma")
+
+
+def _file(module: str) -> Path | None:
+    """Source file of a ``tslip`` module (dotted name), or None if there is none."""
+    parts = module.split(".")
+    if parts[0] != _PKG:
+        return None
+    base = _ROOT.joinpath(*parts[1:])
+    for cand in (base.with_suffix(".py"), base / "__init__.py"):
+        if cand.is_file():
+            return cand
+    return None
+
+
+def _resolve(node: ast.ImportFrom, package: str) -> str:
+    """The absolute module name an ``ImportFrom`` reads from."""
+    if not node.level:
+        return node.module or ""
+    up = package.split(".")
+    up = up[:len(up) - (node.level - 1)]
+    return ".".join(up + ([node.module] if node.module else []))
+
+
+def _package_of(module: str) -> str:
+    path = _file(module)
+    return module if path is not None and path.name == "__init__.py" else module.rpartition(".")[0]
+
+
+def _provider(package: str, name: str) -> str:
+    """The module that defines ``name`` imported from ``package``.
+
+    A submodule of that name; else the module the package's ``__init__``
+    re-exports it from; else the ``__init__`` itself, as a leaf
+    (``"<package>:self"``: its own source, not what it imports).
+    """
+    sub = f"{package}.{name}"
+    if _file(sub) is not None:
+        return sub
+    init = _file(package)
+    if init is None or init.name != "__init__.py":
+        return package
+    for node in ast.parse(init.read_text(encoding="utf-8")).body:
+        if isinstance(node, ast.ImportFrom) and any((a.asname or a.name) == name
+                                                     for a in node.names):
+            base = _resolve(node, package)
+            orig = next(a.name for a in node.names if (a.asname or a.name) == name)
+            return _provider(base, orig) if _file(base) is not None else package
+    return f"{package}:self"
+
+
+def _imports(module: str) -> set[str]:
+    """The ``tslip`` modules that ``module``'s source imports (anywhere in the file)."""
+    path = _file(module)
+    if path is None:
+        return set()
+    package = _package_of(module)
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            out.update(a.name for a in node.names if a.name.split(".")[0] == _PKG)
+        elif isinstance(node, ast.ImportFrom):
+            base = _resolve(node, package)
+            if base.split(".")[0] != _PKG:
+                continue
+            if _file(base) is not None and _file(base).name == "__init__.py":  # type: ignore
+                out.update(_provider(base, a.name) for a in node.names if a.name != "*")
+                if any(a.name == "*" for a in node.names):
+                    out.add(base)
+            else:
+                out.add(base)
+    return {m for m in out if _file(m.removesuffix(":self")) is not None}
+
+
+@functools.cache
+def module_closure(*modules: str) -> tuple[str, ...]:
+    """Every ``tslip`` module that ``modules`` import, transitively, themselves included."""
+    seen: set[str] = set()
+    todo = list(modules)
+    unknown = [m for m in modules if _file(m) is None]
+    if unknown:
+        raise ValueError(f"not a tslip module: {', '.join(unknown)}")
+    while todo:
+        m = todo.pop()
+        if m in seen:
+            continue
+        seen.add(m)
+        if not m.endswith(":self"):
+            todo.extend(_imports(m) - seen)
+    return tuple(sorted(seen))
+
+
+def _version(lib: str) -> str:
+    try:
+        return metadata.version(lib)
+    except metadata.PackageNotFoundError:
+        return "absent"
+
+
+@functools.cache
+def code_hash(*modules: str) -> str:
+    """SHA-256 (hex, 24 characters) of the sources of ``module_closure(*modules)``.
+
+    The versions of :data:`LIBRARIES` are part of the hash. Computed once a
+    process per set of modules.
+    """
+    h = hashlib.sha256()
+    for lib in LIBRARIES:
+        h.update(f"{lib}={_version(lib)}\n".encode())
+    for m in module_closure(*modules):
+        h.update(m.encode() + b"\n")
+        h.update(_file(m.removesuffix(":self")).read_bytes())  # type: ignore[union-attr]
+    return h.hexdigest()[:24]

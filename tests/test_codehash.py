@@ -1,0 +1,53 @@
+"""The code hash that keys cached results: which sources it covers, and that edits change it."""
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+import tslip
+from tslip import _codehash as ch
+
+
+def test_closure_follows_imports_and_reexports():
+    rob = ch.module_closure("tslip.gait.robustness")
+    stab = ch.module_closure("tslip.gait.stability")
+    # what robustness calls (through `from ..gait import floquet` style re-exports) ...
+    assert {"tslip.gait.stability", "tslip.simulation._kernels", "tslip.model.parameters",
+            "tslip.simulation._variational"} <= set(rob)
+    # ... and not what it does not
+    assert "tslip.gait.robustness" not in stab
+    assert not any(m.startswith(("tslip.biped", "tslip.sweeps", "tslip.plotting")) for m in rob)
+    assert not any(m.startswith("tslip.gait") for m in ch.module_closure("tslip.biped._kernels"))
+
+
+def test_unknown_module_is_an_error():
+    with pytest.raises(ValueError, match="not a tslip module: tslip.nope"):
+        ch.module_closure("tslip.nope")
+
+
+def test_an_edit_changes_exactly_the_hashes_that_depend_on_it(tmp_path, monkeypatch):
+    root = tmp_path / "tslip"
+    shutil.copytree(Path(tslip.__file__).parent, root,
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(ch, "_ROOT", root)
+
+    def hashes():
+        ch.module_closure.cache_clear()
+        ch.code_hash.cache_clear()
+        return {m: ch.code_hash(m) for m in ("tslip.gait.robustness", "tslip.gait.stability",
+                                             "tslip.biped.simulate")}
+
+    before = hashes()
+    f = root / "gait" / "robustness.py"
+    f.write_text(f.read_text() + "\n# an edit\n")
+    after = hashes()
+    assert after["tslip.gait.robustness"] != before["tslip.gait.robustness"]
+    assert after["tslip.gait.stability"] == before["tslip.gait.stability"]
+    assert after["tslip.biped.simulate"] == before["tslip.biped.simulate"]
+    k = root / "simulation" / "_kernels.py"
+    k.write_text(k.read_text() + "\n# a kernel edit\n")
+    again = hashes()
+    assert all(again[m] != after[m] for m in again)
+    ch.module_closure.cache_clear()
+    ch.code_hash.cache_clear()
