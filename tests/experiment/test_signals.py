@@ -98,3 +98,17 @@ def test_contact_events_on_a_sinking_stance() -> None:
     assert len(ev) == 1
     assert abs(ev[0][0] - td) < 0.2 / fs and abs(ev[0][1] - lo) < 0.2 / fs
     assert ev[0][2] == 51 and ev[0][3] == 125  # the frames between the two instants
+
+
+def test_vaf_is_measured_against_the_measurement_not_the_model() -> None:
+    """Eq. 5.2 normalises by var(y), the measurement: a model at half the
+    measured amplitude leaves 1 - var(0.5 y) / var(y) = 75 %; one at twice
+    the amplitude leaves 1 - var(-y) / var(y) = 0 %. Swapping y and yhat
+    would give 0 % and 75 %."""
+    y = np.sin(np.linspace(0.0, 5.0, 80)) + 0.3
+    assert vaf(y, 0.5 * y) == pytest.approx(75.0, abs=1e-9)
+    assert vaf(y, 2.0 * y) == pytest.approx(0.0, abs=1e-9)
+    assert vaf(y, 2.0 * y, centred=False) == pytest.approx(
+        (1 - np.mean(y ** 2) / np.var(y)) * 100, abs=1e-9)
+    # and a model with no variance (a constant) explains nothing: 0 %
+    assert vaf(y, np.full_like(y, 7.0)) == pytest.approx(0.0, abs=1e-9)

@@ -156,15 +156,19 @@ def test_pixels_agree_with_metres_and_disc_geometry(run, gait) -> None:  # noqa:
 
 
 def test_tracking_recovers_the_markers(run) -> None:  # noqa: ANN001
+    """First 100 frames. Measured: discs 0.065 (front) and 0.098 (rear) px RMS,
+    every frame detected; feet 0.10 and 0.12 px RMS on their legs. Tolerances
+    about 1.5-2x that: 0.15 px for the discs, 0.25 px for the feet. Without
+    the sub-pixel circle fit the discs are 0.38 and 0.45 px RMS off."""
     cal = Calibration(CAM.px_per_m, CAM.ground_px, CAM.hip_px)
     res = track_frames(render_frames(run, stop=100), cal, TrackerOptions.for_scale(cal.px_per_m),
                        fps=CAM.fps)
     tr, tru = res.tracks, run.truth.iloc[:100]
-    assert not res.fatal and res.body_detection_rate >= 0.95
+    assert not res.fatal and res.body_detection_rate == 1.0
     ok = tr["body_q"] == 1
     for m in ("front", "rear"):
         e = np.hypot(tr[f"{m}_x_px"] - tru[f"{m}_x_px"], tr[f"{m}_y_px"] - tru[f"{m}_y_px"])
-        assert np.sqrt(np.mean(e[ok] ** 2)) < 0.5
+        assert np.sqrt(np.mean(e[ok] ** 2)) < 0.15, m
     # each foot series follows one leg of the model, and the two series follow different legs
     err = {}
     for f in ("foot1", "foot2"):
@@ -175,7 +179,7 @@ def test_tracking_recovers_the_markers(run) -> None:  # noqa: ANN001
             err[f, leg] = np.sqrt(np.mean(e[okf] ** 2))
     best = {f: min(("near", "hind"), key=lambda leg: err[f, leg]) for f in ("foot1", "foot2")}
     assert set(best.values()) == {"near", "hind"}
-    assert max(err[f, leg] for f, leg in best.items()) < 1.0
+    assert max(err[f, leg] for f, leg in best.items()) < 0.25
 
 
 def test_falls_and_bad_input_raise(gait) -> None:  # noqa: ANN001

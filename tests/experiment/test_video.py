@@ -34,21 +34,29 @@ def _opts(cal: Calibration) -> TrackerOptions:
     return TrackerOptions.for_scale(cal.px_per_m)
 
 
-def test_tracking_within_one_pixel(run) -> None:  # noqa: ANN001
+def test_tracking_to_a_tenth_of_a_pixel(run) -> None:  # noqa: ANN001
+    """Marker centres against the rendered truth on this 0.4 s clip (200 frames).
+
+    Measured here: front and rear discs 0.059 and 0.082 px RMS, every frame
+    detected; near foot 0.12 px RMS. The tolerances leave about twice that:
+    0.15 px for the discs, 0.25 px for the foot. Without the sub-pixel circle
+    fit (``video._refine_circle``) the Hough centres alone are 0.40 and
+    0.43 px RMS off, so the disc check fails.
+    """
     cal = Calibration(CAM.px_per_m, CAM.ground_px, CAM.hip_px)
     res = track_frames(render_frames(run), cal, _opts(cal), fps=CAM.fps)
     tr, tru = res.tracks, run.truth
-    assert res.body_detection_rate >= 0.95
+    assert res.body_detection_rate == 1.0
+    ok = tr["body_q"] == 1
     for m in ("front", "rear"):
-        ok = tr["body_q"] == 1
         e = np.hypot(tr[f"{m}_x_px"] - tru[f"{m}_x_px"], tr[f"{m}_y_px"] - tru[f"{m}_y_px"])
-        assert np.sqrt(np.mean(e[ok] ** 2)) < 1.0          # tolerance: 1 px RMS (issue)
+        assert np.sqrt(np.mean(e[ok] ** 2)) < 0.15, m
     # near foot: the series detected more often, never occluded
     near = max(("foot1", "foot2"), key=lambda f: int((tr[f"{f}_q"] == 1).sum()))
     ok = tr[f"{near}_q"] == 1
     assert ok.mean() > 0.95
     e = np.hypot(tr[f"{near}_x_px"] - tru["near_x_px"], tr[f"{near}_y_px"] - tru["near_y_px"])
-    assert np.sqrt(np.mean(e[ok] ** 2)) < 1.0
+    assert np.sqrt(np.mean(e[ok] ** 2)) < 0.25
     # the hind foot is occluded by the body: those frames are gaps, not guesses
     hind = "foot2" if near == "foot1" else "foot1"
     hidden = tru["hind_visible"] < 0.5
