@@ -165,14 +165,13 @@ class _Page(HTMLParser):
     def __init__(self) -> None:
         super().__init__()
         self.ids: dict[str, dict] = {}
-        self.hrefs: list[tuple[str, str | None]] = []  # (href, id of enclosing nav or None)
+        self.hrefs: list[tuple[str, set[str]]] = []  # (href, ids of the enclosing elements)
         self.stack: list[dict] = []
 
     def handle_starttag(self, tag, attrs) -> None:  # noqa: ANN001
         a = dict(attrs)
         if "href" in a:
-            nav = next((e["id"] for e in self.stack if e["tag"] == "nav"), None)
-            self.hrefs.append((a["href"], nav))
+            self.hrefs.append((a["href"], {e["id"] for e in self.stack if e["id"]}))
         if tag in self.VOID:
             return
         el = {"tag": tag, "id": a.get("id"), "class": a.get("class", ""), "text": []}
@@ -217,13 +216,13 @@ def test_every_link_resolves_and_the_contents_reach_every_section_and_claim(page
     claims, p, _, _ = page
     local = [h for h, _ in p.hrefs if h.startswith("#")]
     assert local and all(h[1:] in p.ids for h in local)
-    toc = {h[1:] for h, nav in p.hrefs if nav == "contents"}
+    toc = {h[1:] for h, within in p.hrefs if "contents" in within}
     sections = {"fig-" + figs[0].replace(".", "-") for figs, _ in report.SECTIONS}
     assert sections <= toc and sections <= set(p.ids)
     claim_ids = {k for k, el in p.ids.items() if "claim" in el["class"].split()}
     assert len(claim_ids) == len(claims) and claim_ids <= toc
-    summary = {h[1:] for h, nav in p.hrefs if nav is None and h[1:] in claim_ids}
-    assert summary == claim_ids  # the summary table links each claim
+    summary = {h[1:] for h, within in p.hrefs if "summary" in within}
+    assert claim_ids | {"contents"} <= summary  # the summary links each claim and the contents
 
 
 def test_each_claim_section_shows_quote_reading_numbers_verdict_evidence(page) -> None:
@@ -248,7 +247,7 @@ def test_summary_counts_three_verdicts_and_escapes_quotes(page) -> None:
     summary = "".join(p.ids["summary"]["text"])
     for v in Verdict:
         n = sum(c.verdict is v for c in claims)
-        assert f"{n} {v.value}" in summary
+        assert f"{v.value}: {n}" in summary
     for cls in ("holds", "reading", "fails"):
         assert f"class='verdict {cls}'" in text
     assert "<sentence" not in text and "&lt;sentence 3&gt; &amp; more" in text
@@ -262,3 +261,24 @@ def test_claims_json_carries_verdict_quote_reading_evidence(page) -> None:
         for k in ("quote", "source", "reading", "note", "error"):
             assert j[k] == getattr(c, k)
         assert j["evidence"] == json.loads(json.dumps(c.evidence))
+
+
+def test_reproduce_cli_prints_each_verdict_and_the_count_per_verdict(page, tmp_path,
+                                                                     monkeypatch) -> None:
+    """The CLI's table reads claims.json; the run itself is replaced by the page fixture's."""
+    from typer.testing import CliRunner
+
+    from tslip.cli import studies as studies_cli  # noqa: F401  (registers `tslip reproduce`)
+    from tslip.cli.main import app
+
+    claims = page[0]
+    monkeypatch.setattr(report, "reproduce", lambda out, **kw: tmp_path / "index.html")
+    r = CliRunner().invoke(app, ["reproduce", "--quick", "--out", str(tmp_path)],
+                           env={"COLUMNS": "200"})
+    assert r.exit_code == 0, r.output
+    rows = [ln for ln in r.output.splitlines() if "claim number" in ln]
+    assert len(rows) == len(claims)
+    for c, row in zip(claims, rows, strict=True):
+        assert row.rstrip().endswith(c.verdict.value)
+    for v in Verdict:
+        assert f"{v.value}: {sum(c.verdict is v for c in claims)}" in r.output

@@ -117,6 +117,6 @@ def reproduce_cmd(
         v = Verdict(c["verdict"])
         t.add_row(c["figure"], c["claim"], Text(v.value, style=style[v]))
     console.print(t)
-    counts = ", ".join(f"{sum(c['verdict'] == v for c in claims)} {v.value}" for v in Verdict)
-    console.print(f"{len(claims)} claims: {counts}; {time.perf_counter() - t0:.1f} s")
+    counts = ", ".join(f"{v.value}: {sum(c['verdict'] == v for c in claims)}" for v in Verdict)
+    console.print(f"{len(claims)} claims; {counts}; {time.perf_counter() - t0:.1f} s")
     console.print(f"report: {path}")

@@ -126,7 +126,8 @@ td,th{border:1px solid #ccc;padding:3px 7px;text-align:left;vertical-align:top}
 .claim.holds{border-color:#146c14}.claim.reading{border-color:#d08a1c}
 .claim.fails{border-color:#b00}.claim h3{font-size:1em;margin:.3em 0}
 .claim.holds *,.claim.reading *,.claim.fails *{font-weight:normal;color:#222}
-.claim .verdict,.claim h3{font-weight:bold}
+.claim .verdict,.claim h3{font-weight:bold}.verdict{white-space:nowrap}
+.up{float:right;font-size:.8em;font-weight:normal}
 .claim .verdict.holds{color:#146c14}.claim .verdict.reading{color:#a05a00}
 .claim .verdict.fails{color:#b00}
 blockquote{margin:.3em 0 .3em 1em;font-style:italic}cite{font-style:normal;color:#555}
@@ -159,6 +160,9 @@ def _verdict(c: Any) -> Verdict:
     return Verdict(c.verdict)
 
 
+_UP = "<a class='up' href='#contents'>contents</a>"
+
+
 def _claim_ids(claims: Sequence[Any]) -> list[str]:
     """The HTML id of each claim's section: ``claim-1``, ``claim-2``, ..."""
     return [f"claim-{i + 1}" for i in range(len(claims))]
@@ -185,7 +189,7 @@ def _claim_section(c: Any, cid: str) -> str:
     """One claim: thesis sentence and source, our reading, numbers, verdict, evidence, note."""
     v = _verdict(c)
     out = [f"<div class='claim {VERDICT_CLASS[v]}' id='{cid}'>",
-           f"<h3>Figure {_e(c.figure)}: {_e(c.text)}</h3>"]
+           f"<h3>Figure {_e(c.figure)}: {_e(c.text)}{_UP}</h3>"]
     if c.quote:
         src = f" <cite>({_e(c.source)})</cite>" if c.source else ""
         out.append(f"<blockquote class='quote'>“{_e(c.quote)}”{src}</blockquote>")
@@ -215,9 +219,10 @@ def _counts(claims: Sequence[Any]) -> dict[Verdict, int]:
 
 
 def _counts_html(claims: Sequence[Any]) -> str:
-    parts = [f"<span class='verdict {VERDICT_CLASS[v]}'>{n} {_e(v.value)}</span>"
+    parts = [f"<span class='verdict {VERDICT_CLASS[v]}'>{_e(v.value)}: {n}</span>"
              for v, n in _counts(claims).items()]
-    return f"<p class='counts'>{len(claims)} claims: " + ", ".join(parts) + ".</p>"
+    return (f"<p class='counts'>{len(claims)} claims; " + ", ".join(parts)
+            + ". Every figure and claim is listed in the <a href='#contents'>contents</a>.</p>")
 
 
 def _sec_id(figs: Sequence[str]) -> str:
@@ -310,7 +315,7 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
              "<section id='summary'><h2>Summary</h2>", _counts_html(claims),
              _summary_table(claims, ids), "</section>", _toc(claims, ids)]
     for figs, title in SECTIONS:
-        parts.append(f"<section id='{_sec_id(figs)}'><h2>{_e(title)}</h2>")
+        parts.append(f"<section id='{_sec_id(figs)}'><h2>{_e(title)}{_UP}</h2>")
         for fkey in figs:
             if fkey in plots:
                 try:
