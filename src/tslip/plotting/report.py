@@ -120,16 +120,12 @@ body{font-family:sans-serif;max-width:1000px;margin:1em auto;padding:0 1em;color
 h2{border-bottom:1px solid #ccc;padding-top:.6em}
 table{border-collapse:collapse;margin:.5em 0;font-size:.9em}
 td,th{border:1px solid #ccc;padding:3px 7px;text-align:left;vertical-align:top}
-.holds{color:#146c14;font-weight:bold}.reading{color:#a05a00;font-weight:bold}
-.fails{color:#b00;font-weight:bold}
+.verdict{font-weight:bold;white-space:nowrap}.verdict.holds{color:#146c14}
+.verdict.reading{color:#a05a00}.verdict.fails{color:#b00}.failed{color:#b00}
 .claim{border-left:4px solid #ccc;padding:.2em .8em;margin:1em 0}
 .claim.holds{border-color:#146c14}.claim.reading{border-color:#d08a1c}
 .claim.fails{border-color:#b00}.claim h3{font-size:1em;margin:.3em 0}
-.claim.holds *,.claim.reading *,.claim.fails *{font-weight:normal;color:#222}
-.claim .verdict,.claim h3{font-weight:bold}.verdict{white-space:nowrap}
 .up{float:right;font-size:.8em;font-weight:normal}
-.claim .verdict.holds{color:#146c14}.claim .verdict.reading{color:#a05a00}
-.claim .verdict.fails{color:#b00}
 blockquote{margin:.3em 0 .3em 1em;font-style:italic}cite{font-style:normal;color:#555}
 img{max-width:100%;display:block;margin:.4em 0}.note{color:#555;font-size:.9em}
 nav ol{columns:2;font-size:.9em}nav ol ol{columns:1;font-size:.95em}
@@ -323,7 +319,7 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
                 except KeyError:
                     parts.append(f"<p class='note'>Figure {fkey}: data not computed.</p>")
                 except Exception as exc:  # noqa: BLE001 - a broken plot must not lose the rest
-                    parts.append(f"<p class='fails'>Figure {fkey}: plot failed: {_e(exc)}</p>")
+                    parts.append(f"<p class='failed'>Figure {fkey}: plot failed: {_e(exc)}</p>")
         if "4.24" in figs:
             parts.append(_global_pd_note(data))
         if "6.1" in figs:
