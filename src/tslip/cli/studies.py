@@ -81,8 +81,11 @@ def reproduce_cmd(
     scheduler: SchedulerOpt = None,
 ) -> None:
     """Run every thesis study and write a report (out/index.html)."""
+    from rich.text import Text
+
     from ..plotting.report import reproduce
     from ..sweeps import catalogue
+    from ..sweeps.claims import Verdict
 
     console = _console()
     n_studies = len(catalogue.STUDIES)
@@ -107,10 +110,13 @@ def reproduce_cmd(
     t = Table(title="thesis claims", box=box.SIMPLE_HEAD, title_justify="left")
     t.add_column("figure")
     t.add_column("claim")
-    t.add_column("holds")
+    t.add_column("verdict")
+    style = {Verdict.HOLDS: "green", Verdict.HOLDS_UNDER_READING: "yellow",
+             Verdict.FAILS: "bold red"}
     for c in claims:
-        t.add_row(c["figure"], c["claim"], "yes" if c["holds"] else "NO")
+        v = Verdict(c["verdict"])
+        t.add_row(c["figure"], c["claim"], Text(v.value, style=style[v]))
     console.print(t)
-    n = sum(c["holds"] for c in claims)
-    console.print(f"{n} of {len(claims)} claims hold; {time.perf_counter() - t0:.1f} s")
+    counts = ", ".join(f"{v.value}: {sum(c['verdict'] == v for c in claims)}" for v in Verdict)
+    console.print(f"{len(claims)} claims; {counts}; {time.perf_counter() - t0:.1f} s")
     console.print(f"report: {path}")

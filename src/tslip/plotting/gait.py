@@ -172,7 +172,8 @@ def plot_impulse_linearisation(lin: ImpulseLinearisation, ax: Axes | None = None
                 transform=ax.get_xaxis_transform(), ha="center", va="center",
                 fontsize="small")
     ax.axhline(0.0, color="k", lw=0.6)
-    ax.set_ylabel(r"gradient w.r.t. $\phi$ [per rad]")
+    ax.set_xlabel(r"quantity $q$: $x_p, y_p$ [L]; $I_x, I_y$ [M g$^{1/2}$ L$^{1/2}$]")
+    ax.set_ylabel(r"$\partial q / \partial\phi$ [unit of $q$ / rad]")
     ax.set_title(r"impulse linearised in pitch ($\Delta\phi$ = " f"{lin.dphi:g} rad)")
     return fig
 
@@ -184,7 +185,7 @@ def plot_impulse_linearisation(lin: ImpulseLinearisation, ax: Axes | None = None
 
 def _plot_xd_height(resp: StepDownResponse, ax: Axes) -> None:
     ax.plot(resp.stride, resp.xd, marker="o", ms=3, color="C0", label=LABELS["xd"])
-    ax.set_xlabel("touch-down number")
+    ax.set_xlabel("touch-down number [-]")
     ax.set_ylabel(LABELS["xd"], color="C0")
     ax2 = ax.twinx()
     ax2.plot(resp.stride, resp.height, marker="s", ms=3, color="C3", label="height")

@@ -22,6 +22,7 @@ from matplotlib.figure import Figure
 
 from .. import __version__
 from .._io import atomic_write, write_json
+from ..sweeps.claims import Verdict
 
 __all__ = ["reproduce", "write_report", "figure_png", "SECTIONS"]
 
@@ -56,7 +57,7 @@ def _plots(data: Mapping[str, Any]) -> dict[str, Callable[[], Figure]]:
             a.set_xlabel("Δh [L]")
             a.set_title(title, fontsize=9)
             a.legend(fontsize=7)
-        axes[0].set_ylabel("Δv [g½L½]")
+        axes[0].set_ylabel("Δv [g^1/2 L^1/2]")
         return fig
 
     ctrl = {"passive": "mass_offset", "global PD": "controller_global_pd",
@@ -119,10 +120,22 @@ body{font-family:sans-serif;max-width:1000px;margin:1em auto;padding:0 1em;color
 h2{border-bottom:1px solid #ccc;padding-top:.6em}
 table{border-collapse:collapse;margin:.5em 0;font-size:.9em}
 td,th{border:1px solid #ccc;padding:3px 7px;text-align:left;vertical-align:top}
-.yes{color:#146c14;font-weight:bold}.no{color:#b00;font-weight:bold}
+.verdict{font-weight:bold;white-space:nowrap}.verdict.holds{color:#146c14}
+.verdict.reading{color:#a05a00}.verdict.fails{color:#b00}.failed{color:#b00}
+.claim{border-left:4px solid #ccc;padding:.2em .8em;margin:1em 0}
+.claim.holds{border-color:#146c14}.claim.reading{border-color:#d08a1c}
+.claim.fails{border-color:#b00}.claim h3{font-size:1em;margin:.3em 0}
+.up{float:right;font-size:.8em;font-weight:normal}
+blockquote{margin:.3em 0 .3em 1em;font-style:italic}cite{font-style:normal;color:#555}
 img{max-width:100%;display:block;margin:.4em 0}.note{color:#555;font-size:.9em}
+nav ol{columns:2;font-size:.9em}nav ol ol{columns:1;font-size:.95em}
 code{font-size:.85em}
 """
+
+#: CSS class of each verdict (three colours).
+VERDICT_CLASS: dict[Verdict, str] = {Verdict.HOLDS: "holds",
+                                     Verdict.HOLDS_UNDER_READING: "reading",
+                                     Verdict.FAILS: "fails"}
 
 
 def _e(x: Any) -> str:
@@ -134,20 +147,102 @@ def _num(v: Any) -> str:
         return "–" if not math.isfinite(v) else f"{v:.4g}"
     if isinstance(v, list | tuple):
         return "[" + ", ".join(_num(x) for x in v) + "]"
+    if isinstance(v, Mapping):
+        return "; ".join(f"{k}: {_num(x)}" for k, x in v.items())
     return str(v)
 
 
-def _claims_table(claims: Sequence[Any]) -> str:
-    rows = []
-    for c in claims:
-        nums = "<br>".join(f"{_e(k)}: {_e(_num(v))}" for k, v in c.numbers.items())
-        if c.error:
-            nums += f"<br><i>{_e(c.error)}</i>"
-        cls, word = ("yes", "holds") if c.holds else ("no", "does not hold")
-        rows.append(f"<tr><td>{_e(c.figure)}</td><td>{_e(c.text)}</td><td>{nums}</td>"
-                    f"<td class='{cls}'>{word}</td></tr>")
-    return ("<table><tr><th>figure</th><th>thesis claim</th><th>our numbers</th>"
-            "<th>verdict</th></tr>" + "".join(rows) + "</table>")
+def _verdict(c: Any) -> Verdict:
+    return Verdict(c.verdict)
+
+
+_UP = "<a class='up' href='#contents'>contents</a>"
+
+
+def _claim_ids(claims: Sequence[Any]) -> list[str]:
+    """The HTML id of each claim's section: ``claim-1``, ``claim-2``, ..."""
+    return [f"claim-{i + 1}" for i in range(len(claims))]
+
+
+def _verdict_span(c: Any) -> str:
+    v = _verdict(c)
+    return f"<span class='verdict {VERDICT_CLASS[v]}'>{_e(v.value)}</span>"
+
+
+def _summary_table(claims: Sequence[Any], ids: Sequence[str]) -> str:
+    rows = [f"<tr><td>{_e(c.figure)}</td><td><a href='#{i}'>{_e(c.text)}</a></td>"
+            f"<td>{_verdict_span(c)}</td></tr>" for c, i in zip(claims, ids, strict=True)]
+    return ("<table><tr><th>figure</th><th>thesis claim</th><th>verdict</th></tr>"
+            + "".join(rows) + "</table>")
+
+
+def _numbers_table(numbers: Mapping[str, Any]) -> str:
+    return ("<table>" + "".join(f"<tr><td>{_e(k)}</td><td>{_e(_num(v))}</td></tr>"
+                                for k, v in numbers.items()) + "</table>")
+
+
+def _claim_section(c: Any, cid: str) -> str:
+    """One claim: thesis sentence and source, our reading, numbers, verdict, evidence, note."""
+    v = _verdict(c)
+    out = [f"<div class='claim {VERDICT_CLASS[v]}' id='{cid}'>",
+           f"<h3>Figure {_e(c.figure)}: {_e(c.text)}{_UP}</h3>"]
+    if c.quote:
+        src = f" <cite>({_e(c.source)})</cite>" if c.source else ""
+        out.append(f"<blockquote class='quote'>“{_e(c.quote)}”{src}</blockquote>")
+    else:
+        out.append("<p class='quote note'>Thesis sentence not recorded.</p>")
+    if c.reading:
+        out.append(f"<p class='reading-text'><b>Our reading:</b> {_e(c.reading)}</p>")
+    out.append("<p><b>Our numbers:</b></p>" + (_numbers_table(c.numbers) if c.numbers
+                                                else "<p class='note'>none</p>"))
+    if c.error:
+        out.append(f"<p class='note'><i>{_e(c.error)}</i></p>")
+    out.append(f"<p><b>Verdict:</b> {_verdict_span(c)}</p>")
+    if c.evidence:
+        out.append("<div class='evidence'><p><b>Evidence:</b></p>"
+                   + _numbers_table(c.evidence) + "</div>")
+    elif v is not Verdict.HOLDS:
+        out.append("<p class='evidence note'>No further evidence recorded.</p>")
+    if c.note:
+        out.append(f"<p class='note'>{_e(c.note)}</p>")
+    out.append("</div>")
+    return "\n".join(out)
+
+
+def _counts(claims: Sequence[Any]) -> dict[Verdict, int]:
+    """Claims per verdict, every verdict present (zero if none)."""
+    return {v: sum(_verdict(c) is v for c in claims) for v in Verdict}
+
+
+def _counts_html(claims: Sequence[Any]) -> str:
+    parts = [f"<span class='verdict {VERDICT_CLASS[v]}'>{_e(v.value)}: {n}</span>"
+             for v, n in _counts(claims).items()]
+    return (f"<p class='counts'>{len(claims)} claims; " + ", ".join(parts)
+            + ". Every figure and claim is listed in the <a href='#contents'>contents</a>.</p>")
+
+
+def _sec_id(figs: Sequence[str]) -> str:
+    return "fig-" + figs[0].replace(".", "-")
+
+
+def _toc(claims: Sequence[Any], ids: Sequence[str]) -> str:
+    """Contents: every figure section and, under it, its claims."""
+    items = ["<li><a href='#summary'>Summary</a></li>"]
+    for figs, title in SECTIONS:
+        sub = "".join(f"<li><a href='#{i}'>{_e(c.text)}</a> {_verdict_span(c)}</li>"
+                      for c, i in zip(claims, ids, strict=True) if c.figure in figs)
+        items.append(f"<li><a href='#{_sec_id(figs)}'>{_e(title)}</a>"
+                     + (f"<ol>{sub}</ol>" if sub else "") + "</li>")
+    if _orphans(claims):
+        items.append("<li><a href='#other-claims'>Other claims</a></li>")
+    items.append("<li><a href='#studies'>Studies</a></li>")
+    return "<nav id='contents'><h2>Contents</h2><ol>" + "".join(items) + "</ol></nav>"
+
+
+def _orphans(claims: Sequence[Any]) -> list[int]:
+    """Indices of claims whose figure has no section."""
+    shown = {f for figs, _ in SECTIONS for f in figs}
+    return [k for k, c in enumerate(claims) if c.figure not in shown]
 
 
 def _table6(data: Mapping[str, Any]) -> str:
@@ -164,8 +259,8 @@ def _table6(data: Mapping[str, Any]) -> str:
                  for a, b, c, k in rows6) + "</table>"
     rob = [("Largest multiplier |λ|", 0.92, "max_nontrivial"),
            ("Step-down Δh [L]", -0.12, "step_down"),
-           ("Push Δẋ [g½L½]", -0.73, "push"),
-           ("Pitch rate Δφ̇ [rad g½L-½]", -1.50, "pitch_rate"),
+           ("Push Δẋ [g^1/2 L^1/2]", -0.73, "push"),
+           ("Pitch rate Δφ̇ [rad g^1/2 L^-1/2]", -1.50, "pitch_rate"),
            ("Controller reference α̇_ref (solved)", 2.42, "alphad_ref")]
     s += ("<h3>Section 6.1: stability and robustness of the Table 6.1 model</h3><table>"
           "<tr><th>quantity</th><th>thesis</th><th>ours</th></tr>")
@@ -194,21 +289,29 @@ def _global_pd_note(data: Mapping[str, Any]) -> str:
 def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any], *,
                  quick: bool = False, seconds: float | None = None,
                  workers: int | None = None) -> Path:
-    """Write the report page; return its path."""
+    """Write the report page and ``claims.json`` beside it; return the page's path.
+
+    The page: a summary with the count of claims per verdict (holds; holds
+    under a stated reading; does not hold) and a table linking each claim
+    to its section, a table of contents, one section per figure (our plots,
+    then each claim with the thesis sentence and its source, our reading,
+    our numbers, the verdict, its evidence and a note), and the studies.
+    """
     plots = _plots(data)
-    n_hold = sum(c.holds for c in claims)
+    ids = _claim_ids(claims)
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'>"
              f"<title>tslip reproduce</title><style>{_CSS}</style></head><body>",
              "<h1>TSLIP thesis reproduction</h1>",
              f"<p>tslip {_e(__version__)}, {'quick' if quick else 'full'} resolution, "
              f"{datetime.now(UTC):%Y-%m-%d %H:%M} UTC"
              + (f", {seconds:.1f} s on {workers} worker(s)" if seconds is not None else "")
-             + f". <b>{n_hold} of {len(claims)} claims hold.</b> A claim that does not hold "
-             "is shown with our numbers; no study was tuned to agree.</p>",
-             "<h2>Summary</h2>", _claims_table(claims)]
+             + ". A claim that does not hold is shown with our numbers and the evidence; no "
+             "study was tuned to agree. A claim that holds under a stated reading shows the "
+             "reading and the numbers of each reading.</p>",
+             "<section id='summary'><h2>Summary</h2>", _counts_html(claims),
+             _summary_table(claims, ids), "</section>", _toc(claims, ids)]
     for figs, title in SECTIONS:
-        sec_id = "fig-" + figs[0].replace(".", "-")
-        parts.append(f"<section id='{sec_id}'><h2>{_e(title)}</h2>")
+        parts.append(f"<section id='{_sec_id(figs)}'><h2>{_e(title)}{_UP}</h2>")
         for fkey in figs:
             if fkey in plots:
                 try:
@@ -216,29 +319,35 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
                 except KeyError:
                     parts.append(f"<p class='note'>Figure {fkey}: data not computed.</p>")
                 except Exception as exc:  # noqa: BLE001 - a broken plot must not lose the rest
-                    parts.append(f"<p class='no'>Figure {fkey}: plot failed: {_e(exc)}</p>")
+                    parts.append(f"<p class='failed'>Figure {fkey}: plot failed: {_e(exc)}</p>")
         if "4.24" in figs:
             parts.append(_global_pd_note(data))
         if "6.1" in figs:
             parts.append(_table6(data))
-        mine = [c for c in claims if c.figure in figs]
-        if mine:
-            parts.append(_claims_table(mine))
+        parts += [_claim_section(c, i) for c, i in zip(claims, ids, strict=True)
+                  if c.figure in figs]
+        parts.append("</section>")
+    if _orphans(claims):
+        parts.append("<section id='other-claims'><h2>Other claims</h2>")
+        parts += [_claim_section(claims[k], ids[k]) for k in _orphans(claims)]
         parts.append("</section>")
     studies = {k: v.meta for k, v in data.items() if hasattr(v, "meta") and hasattr(v, "frame")}
-    parts.append("<h2>Studies</h2><table><tr><th>study</th><th>description</th><th>points</th>"
-                 "<th>computed</th><th>seconds</th></tr>")
+    parts.append("<section id='studies'><h2>Studies</h2><table><tr><th>study</th>"
+                 "<th>description</th><th>points</th><th>computed</th><th>seconds</th></tr>")
     for k, m in studies.items():
         desc = data[k].spec.description
         parts.append(f"<tr><td>{_e(k)}</td><td>{_e(desc)}</td><td>{m.get('points')}</td>"
                      f"<td>{m.get('computed')}</td><td>{m.get('seconds', 0):.1f}</td></tr>")
     parts.append("</table><p class='note'>Data: <code>studies/&lt;name&gt;/results.parquet"
-                 "</code> and <code>run.json</code> beside this page.</p></body></html>")
+                 "</code> and <code>run.json</code> beside this page.</p></section>"
+                 "</body></html>")
     text = "\n".join(parts)
     path = Path(path)
     atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
-    claims_json = [{"figure": c.figure, "claim": c.text, "holds": c.holds,
-                    "numbers": c.numbers, "error": c.error} for c in claims]
+    claims_json = [{"figure": c.figure, "claim": c.text, "verdict": _verdict(c).value,
+                    "holds": c.holds, "quote": c.quote, "source": c.source,
+                    "reading": c.reading, "numbers": c.numbers, "evidence": c.evidence,
+                    "note": c.note, "error": c.error} for c in claims]
     write_json(path.with_name("claims.json"), claims_json, indent=1)
     return path
 

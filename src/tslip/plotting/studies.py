@@ -16,8 +16,9 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
+from matplotlib.patches import Patch
 
-from .sweeps import _STABLE_GREEN, _runs
+from .sweeps import _STABLE_GREEN, _runs, param_label
 
 if TYPE_CHECKING:
     from ..sweeps.run import StudyResult
@@ -25,8 +26,8 @@ if TYPE_CHECKING:
 __all__ = ["plot_study_multipliers", "plot_study_robustness", "plot_stable_grid",
            "plot_stride_times", "plot_controllers_multipliers", "plot_controllers_robustness"]
 
-_ROB = (("step_down", "max step-down Δh [L]"), ("push", "max push Δẋ [g½L½]"),
-        ("pitch_rate", "max pitch rate Δφ̇ [rad g½L-½]"))
+_ROB = (("step_down", "max step-down Δh [L]"), ("push", "max push Δẋ [g^1/2 L^1/2]"),
+        ("pitch_rate", "max pitch rate Δφ̇ [rad g^1/2 L^-1/2]"))
 
 
 def _stable(frame) -> np.ndarray:  # noqa: ANN001 - DataFrame
@@ -78,8 +79,8 @@ def plot_study_multipliers(result: StudyResult, ax: Axes | None = None, *,
     ax.axhline(1.0, color="k", ls="--", lw=0.8)
     top = np.nanmax(mags) if np.isfinite(mags).any() else 1.5
     ax.set_ylim(0, min(max(1.5, top * 1.05), 3.0))
-    ax.set_xlabel(param)
-    ax.set_ylabel("|λ|")
+    ax.set_xlabel(param_label(param))
+    ax.set_ylabel("|λ| [-]")
     ax.legend(loc="upper right", fontsize=7)
     ax.set_title(title or f"{result.spec.name}: Floquet multipliers (green: stable)", fontsize=9)
     return fig
@@ -103,18 +104,26 @@ def plot_study_robustness(result: StudyResult, axes: Sequence[Axes] | None = Non
         a.plot(x, f[col].to_numpy(float) if col in f else np.full(len(x), np.nan), "o-",
                ms=3, lw=1, color=color, label=label)
         a.set_ylabel(ylabel, fontsize=8)
-    axes[-1].set_xlabel(param)
+    axes[-1].set_xlabel(param_label(param))
     if label:
         axes[0].legend(fontsize=7)
     return fig
 
 
+#: Figure 4.10's three classes: colour and legend text, by code 0, 1, 2.
+GRID_CLASSES: tuple[tuple[str, str], ...] = (
+    ("white", "no periodic gait"),
+    ("#f4b6b6", "periodic gait, unstable"),
+    (_STABLE_GREEN, "stable (non-trivial |λ| < 1)"),
+)
+
+
 def plot_stable_grid(results: Mapping[float, StudyResult]) -> Figure:
     """Figure 4.10: one k x beta0 panel per speed; stable / unstable / no gait."""
     n = len(results)
-    fig = Figure(figsize=(3.0 * n, 3.2), layout="constrained")
+    fig = Figure(figsize=(3.0 * n, 3.6), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, n, sharey=True))
-    cmap = ListedColormap(["white", "#f4b6b6", _STABLE_GREEN])
+    cmap = ListedColormap([c for c, _ in GRID_CLASSES])
     for a, (v, res) in zip(axes, results.items()):
         f = res.frame
         code = np.where(_stable(f), 2, np.where(f["converged"].to_numpy(bool), 1, 0))
@@ -122,8 +131,11 @@ def plot_stable_grid(results: Mapping[float, StudyResult]) -> Figure:
         k, b = res.spec.axes[0].values, res.spec.axes[1].values
         a.pcolormesh(b, k, grid, cmap=cmap, vmin=0, vmax=2, shading="nearest")
         a.set_title(f"v0 = {v:g}: stable {np.mean(grid == 2):.0%}", fontsize=9)
-        a.set_xlabel("β0 [rad]")
-    axes[0].set_ylabel("k [Mg/L]")
+        a.set_xlabel(param_label(res.spec.axes[1].param))
+        a.set_ylabel(param_label(res.spec.axes[0].param))
+    fig.legend(handles=[Patch(facecolor=c, edgecolor="0.4", lw=0.5, label=t)
+                        for c, t in GRID_CLASSES],
+               loc="outside lower center", ncols=len(GRID_CLASSES), fontsize=8)
     return fig
 
 
@@ -136,15 +148,16 @@ def plot_stride_times(results: Mapping[str, StudyResult]) -> Figure:
         f = res.frame
         param = res.spec.axes[-1].param
         x = f[param].to_numpy(float)
-        for i, (col, lab) in enumerate((("stance_time", "t_s"), ("flight_time", "t_f"))):
+        for i, (col, lab, eq) in enumerate((("stance_time", "t_s", "3.10"),
+                                            ("flight_time", "t_f", "3.11"))):
             a = axes[i, j]
             a.plot(x, f[col], "o", ms=3, label=f"{lab} model")
             pred = f.get(f"{col}_predicted")
             if pred is not None:
-                a.plot(x, pred, "-", color="C1", label=f"{lab} eq. {3.10 if i == 0 else 3.11}")
-            a.set_ylabel(f"{lab} [g-½L½]")
+                a.plot(x, pred, "-", color="C1", label=f"{lab} eq. {eq}")
+            a.set_xlabel(param_label(param))
+            a.set_ylabel(f"{lab} [g^-1/2 L^1/2]")
             a.legend(fontsize=7)
-        axes[1, j].set_xlabel(param)
     return fig
 
 

@@ -11,9 +11,35 @@ from matplotlib.figure import Figure
 if TYPE_CHECKING:
     from ..gait.continuation import Branch
 
-__all__ = ["plot_branch"]
+__all__ = ["plot_branch", "param_label"]
 
 _STABLE_GREEN = "#c8eec8"
+
+
+def param_label(name: str) -> str:
+    """Axis label of a swept parameter: its name and unit (thesis Table 3.1).
+
+    Units are those of :data:`tslip.model.parameters.PARAMETER_TABLE` and of
+    the controllers' field metadata (dotted ``"controller.<gain>"`` names, as
+    :mod:`tslip.gait.continuation` takes them); ``omega_r_bar`` (eq. 2.18) is
+    a ratio, ``[-]``. A name the package does not know is returned as is.
+    """
+    from dataclasses import fields
+
+    from ..model.controllers import CONTROLLERS
+    from ..model.parameters import PARAMETER_TABLE
+
+    if name == "omega_r_bar":
+        return "omega_r_bar = omega_r l0 / v0 [-]"
+    for row in PARAMETER_TABLE:
+        if row.name == name:
+            return f"{name} [{row.unit}]"
+    gain = name.removeprefix("controller.")
+    for cls in CONTROLLERS.values():
+        for f in fields(cls):
+            if f.name == gain and f.metadata.get("unit"):
+                return f"{gain} [{f.metadata['unit']}]"
+    return name
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -54,8 +80,8 @@ def plot_branch(branch: Branch, ax: Axes | None = None) -> Figure:
     for k in range(mags.shape[1]):
         ax.plot(v, mags[:, k], "o", ms=3, color="C0", label="|λ|" if k == 0 else None)
     ax.axhline(1.0, color="k", ls="--", lw=0.8)
-    ax.set_xlabel(branch.param)
-    ax.set_ylabel("|λ| (non-trivial)")
+    ax.set_xlabel(param_label(branch.param))
+    ax.set_ylabel("|λ| (non-trivial) [-]")
     ax.set_ylim(0, max(1.5, float(np.nanmin([np.nanmax(mags), 3.0])) if np.isfinite(mags).any()
                        else 1.5))
     ax.set_title(f"Floquet multipliers along {branch.param} (green: stable)")

@@ -1,0 +1,284 @@
+"""The reproduce report a reviewer reads: labelled figures, three verdicts, working links.
+
+Figures are built by the report's own plot table (``report._plots``) from
+constructed study results (a synthetic frame per catalogue study, so every
+axis the report draws exists) and the real single-gait analyses, which take
+a second or two each.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import re
+from html.parser import HTMLParser
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+from matplotlib.collections import QuadMesh
+from matplotlib.colors import to_rgba
+
+from tslip.plotting import report
+from tslip.sweeps import catalogue
+from tslip.sweeps.claims import ClaimResult, Verdict
+from tslip.sweeps.run import StudyResult
+
+pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning")
+
+UNIT = re.compile(r"\[[^\[\]]+\]")  # a unit in brackets: "[L]", "[rad]", "[-]"
+
+
+def _stable_code(i: int) -> int:
+    """0 no gait, 1 unstable gait, 2 stable: cycles through all three."""
+    return i % 3
+
+
+def _study(name: str) -> StudyResult:
+    """A catalogue study at quick resolution with a constructed result frame."""
+    spec = catalogue.study(name, quick=True)
+    pts = list(itertools.product(*(a.values for a in spec.axes)))
+    n = len(pts)
+    code = np.array([_stable_code(i) for i in range(n)])
+    rows = {a.param: [p[j] for p in pts] for j, a in enumerate(spec.axes)}
+    x = np.linspace(0.0, 1.0, n)
+    frame = pd.DataFrame({
+        **rows,
+        "converged": code > 0,
+        "stability": np.where(code == 2, "asymptotic", "unstable"),
+        "max_nontrivial": np.where(code == 2, 0.5, 1.5),
+        "n_trivial": np.ones(n, int),
+        **{f"abs_lambda_{j}": 0.2 * j + 0.1 * x for j in range(1, 6)},
+        "step_down": -0.1 - x, "push": -0.5 * x, "pitch_rate": -x,
+        "stance_time": 0.5 + x, "stance_time_predicted": 0.5 + 1.1 * x,
+        "flight_time": 0.2 + x, "flight_time_predicted": 0.2 + 0.9 * x,
+        "residual": np.full(n, 1e-12),
+    })
+    return StudyResult(spec, frame, {"points": n, "computed": n, "seconds": 0.0})
+
+
+def _height_change() -> dict:
+    r = SimpleNamespace(dv=0.1, dv_expected=0.12)
+    dh = (-0.1, 0.05)
+    return {"dh": dh, "passive": [r, r], "local_velocity": [r, r]}
+
+
+@pytest.fixture(scope="module")
+def data() -> dict:
+    out: dict = {name: _study(name) for name in catalogue.STUDIES}
+    out.update({
+        "4.1": catalogue.fig_impulse_linearisation(),
+        "4.2": catalogue.fig_pitch_disturbance("table2.1"),
+        "4.3": catalogue.fig_pitch_disturbance("table2.1-global-pd"),
+        "6.2": catalogue.fig_pitch_disturbance("table6.1"),
+        "4.4": _height_change(),
+        "4.5": catalogue.fig_step_down(n_steps=6),
+        "4.7": catalogue.fig_velocity_angle(),
+        "C.1": catalogue.fig_friction(),
+        "E": _appendix_e(),
+    })
+    return out
+
+
+def _appendix_e() -> dict:
+    """The parts of :func:`catalogue.fig_appendix_e` the plots use, without its Floquet runs."""
+    from tslip.biped import BipedParams, BipedState, simulate
+    from tslip.biped.metacentre import metacentric_test
+    from tslip.biped.stored import load_gait
+
+    pc, yc, tc, _ = load_gait("converged-e2")
+    return {"e2": {"run": simulate(BipedParams(), BipedState.thesis(), 1)},
+            "converged": {"metacentric": metacentric_test(pc, BipedState.from_array(yc), tc)}}
+
+
+@pytest.fixture(scope="module")
+def figures(data) -> dict:
+    return {key: make() for key, make in report._plots(data).items()}
+
+
+def _labelled(ax, which: str) -> bool:
+    """``ax`` has a unit-carrying label on x or y, itself or through a shared axis."""
+    get = f"get_{which}label"
+    shared = getattr(ax, f"get_shared_{which}_axes")().get_siblings(ax)
+    return any(UNIT.search(getattr(a, get)()) for a in [ax, *shared] if a.figure is ax.figure)
+
+
+def test_every_report_figure_is_built(figures) -> None:
+    shown = {f for figs, _ in report.SECTIONS for f in figs}
+    assert set(figures) <= shown
+    # every plotted figure of a section (4.6 is drawn with 4.5, 6.1 is a table)
+    assert shown - set(figures) == {"4.6", "6.1"}
+
+
+def test_every_axis_is_labelled_with_a_quantity_and_unit(figures) -> None:
+    """No report axes is exempt: there are no image or table axes in the report."""
+    bad = []
+    for key, fig in figures.items():
+        for k, ax in enumerate(fig.axes):
+            for which in ("x", "y"):
+                if not _labelled(ax, which):
+                    bad.append(f"Figure {key} axes {k} {which}: "
+                               f"{getattr(ax, f'get_{which}label')()!r}")
+    assert not bad, "\n".join(bad)
+
+
+def _legend_texts(legend) -> list[str]:
+    return [t.get_text() for t in legend.get_texts()]
+
+
+def test_figure_4_11_legend_names_eqs_3_10_and_3_11(figures) -> None:
+    fig = figures["4.11"]
+    axes = np.array(fig.axes).reshape(2, -1)
+    for ax in axes[0]:
+        assert _legend_texts(ax.get_legend()) == ["t_s model", "t_s eq. 3.10"]
+    for ax in axes[1]:
+        assert _legend_texts(ax.get_legend()) == ["t_f model", "t_f eq. 3.11"]
+
+
+def test_figure_4_10_legend_names_each_colour(data, figures) -> None:
+    fig = figures["4.10"]
+    (legend,) = fig.legends
+    colour = {t.get_text(): to_rgba(h.get_facecolor())
+              for t, h in zip(legend.get_texts(), legend.legend_handles, strict=True)}
+    words = {0: "no periodic gait", 1: "periodic gait, unstable",
+             2: "stable (non-trivial |λ| < 1)"}
+    assert set(colour) == set(words.values())
+    # the legend's colour of each class is the colour its grid cells are drawn in
+    ax = fig.axes[0]
+    (mesh,) = [c for c in ax.collections if isinstance(c, QuadMesh)]
+    cells = mesh.to_rgba(np.asarray(mesh.get_array()).ravel())
+    n = len(cells)
+    assert n == data[f"grid_v{catalogue.GRID_SPEEDS[0]:g}"].spec.n_points
+    for i in range(n):
+        assert tuple(cells[i]) == pytest.approx(colour[words[_stable_code(i)]])
+
+
+# -- the HTML page -----------------------------------------------------------
+
+
+class _Page(HTMLParser):
+    """Ids with their tag, class and text; every ``href``."""
+
+    VOID = {"meta", "img", "br", "hr", "link", "input"}
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.ids: dict[str, dict] = {}
+        self.hrefs: list[tuple[str, set[str]]] = []  # (href, ids of the enclosing elements)
+        self.stack: list[dict] = []
+
+    def handle_starttag(self, tag, attrs) -> None:  # noqa: ANN001
+        a = dict(attrs)
+        if "href" in a:
+            self.hrefs.append((a["href"], {e["id"] for e in self.stack if e["id"]}))
+        if tag in self.VOID:
+            return
+        el = {"tag": tag, "id": a.get("id"), "class": a.get("class", ""), "text": []}
+        self.stack.append(el)
+        if el["id"]:
+            assert el["id"] not in self.ids, f"duplicate id {el['id']}"
+            self.ids[el["id"]] = el
+
+    def handle_endtag(self, tag) -> None:  # noqa: ANN001
+        while self.stack:
+            if self.stack.pop()["tag"] == tag:
+                break
+
+    def handle_data(self, d) -> None:  # noqa: ANN001
+        for el in self.stack:
+            el["text"].append(d)
+
+
+def _claim(verdict: Verdict, k: int, **kw) -> ClaimResult:
+    return ClaimResult(
+        figure=kw.pop("figure", "4.8"), text=f"claim number {k}", numbers={"x_max": 1.5 + k},
+        verdict=verdict, quote=f"The thesis says <sentence {k}> & more.",
+        source=f"Section 4.{k}", reading=f"we read it as reading {k}",
+        evidence={"reading A": {"x_max": 1.0}, "variant tried": k} if verdict != Verdict.HOLDS
+        else {}, note=f"note {k}", **kw)
+
+
+@pytest.fixture
+def page(tmp_path):
+    claims = [_claim(Verdict.HOLDS, 0), _claim(Verdict.HOLDS, 1, figure="4.10"),
+              _claim(Verdict.HOLDS_UNDER_READING, 2, figure="E.4"),
+              _claim(Verdict.FAILS, 3, figure="4.11"), _claim(Verdict.FAILS, 4),
+              _claim(Verdict.FAILS, 5, figure="C.1", error="ValueError: no gait")]
+    path = report.write_report(tmp_path / "index.html", {}, claims, quick=True)
+    p = _Page()
+    text = path.read_text(encoding="utf-8")
+    p.feed(text)
+    return claims, p, text, json.loads((tmp_path / "claims.json").read_text())
+
+
+def test_every_link_resolves_and_the_contents_reach_every_section_and_claim(page) -> None:
+    claims, p, _, _ = page
+    local = [h for h, _ in p.hrefs if h.startswith("#")]
+    assert local and all(h[1:] in p.ids for h in local)
+    toc = {h[1:] for h, within in p.hrefs if "contents" in within}
+    sections = {"fig-" + figs[0].replace(".", "-") for figs, _ in report.SECTIONS}
+    assert sections <= toc and sections <= set(p.ids)
+    claim_ids = {k for k, el in p.ids.items() if "claim" in el["class"].split()}
+    assert len(claim_ids) == len(claims) and claim_ids <= toc
+    summary = {h[1:] for h, within in p.hrefs if "summary" in within}
+    assert claim_ids | {"contents"} <= summary  # the summary links each claim and the contents
+
+
+def test_each_claim_section_shows_quote_reading_numbers_verdict_evidence(page) -> None:
+    claims, p, _, _ = page
+    sections = [el for el in p.ids.values() if "claim" in el["class"].split()]
+    kind = {"holds": Verdict.HOLDS, "reading": Verdict.HOLDS_UNDER_READING,
+            "fails": Verdict.FAILS}
+    for c in claims:
+        (el,) = [e for e in sections if c.text in "".join(e["text"])]
+        body = "".join(el["text"])
+        (cls,) = set(el["class"].split()) & set(kind)
+        assert kind[cls] is c.verdict
+        assert c.quote in body and c.source in body and c.reading in body
+        assert f"{c.numbers['x_max']:.4g}" in body and c.verdict.value in body
+        assert c.note in body and c.error in body
+        if c.verdict is not Verdict.HOLDS:
+            assert "variant tried" in body and "reading A" in body
+
+
+def test_summary_counts_three_verdicts_and_escapes_quotes(page) -> None:
+    claims, p, text, _ = page
+    summary = "".join(p.ids["summary"]["text"])
+    for v in Verdict:
+        n = sum(c.verdict is v for c in claims)
+        assert f"{v.value}: {n}" in summary
+    for cls in ("holds", "reading", "fails"):
+        assert f"class='verdict {cls}'" in text
+    assert "<sentence" not in text and "&lt;sentence 3&gt; &amp; more" in text
+
+
+def test_claims_json_carries_verdict_quote_reading_evidence(page) -> None:
+    claims, _, _, js = page
+    assert len(js) == len(claims)
+    for c, j in zip(claims, js, strict=True):
+        assert j["verdict"] == c.verdict.value and j["holds"] == (c.verdict != Verdict.FAILS)
+        for k in ("quote", "source", "reading", "note", "error"):
+            assert j[k] == getattr(c, k)
+        assert j["evidence"] == json.loads(json.dumps(c.evidence))
+
+
+def test_reproduce_cli_prints_each_verdict_and_the_count_per_verdict(page, tmp_path,
+                                                                     monkeypatch) -> None:
+    """The CLI's table reads claims.json; the run itself is replaced by the page fixture's."""
+    from typer.testing import CliRunner
+
+    from tslip.cli import studies as studies_cli  # noqa: F401  (registers `tslip reproduce`)
+    from tslip.cli.main import app
+
+    claims = page[0]
+    monkeypatch.setattr(report, "reproduce", lambda out, **kw: tmp_path / "index.html")
+    r = CliRunner().invoke(app, ["reproduce", "--quick", "--out", str(tmp_path)],
+                           env={"COLUMNS": "200"})
+    assert r.exit_code == 0, r.output
+    rows = [ln for ln in r.output.splitlines() if "claim number" in ln]
+    assert len(rows) == len(claims)
+    for c, row in zip(claims, rows, strict=True):
+        assert row.rstrip().endswith(c.verdict.value)
+    for v in Verdict:
+        assert f"{v.value}: {sum(c.verdict is v for c in claims)}" in r.output
