@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import pytest
 
+from tslip.model.parameters import preset
 from tslip.sweeps import catalogue, run_study
-from tslip.sweeps.claims import CLAIMS, evaluate, grid_stable_fractions
+from tslip.sweeps.claims import CLAIMS, Verdict, evaluate, grid_stable_fractions
 
 pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning")
 
@@ -80,19 +81,38 @@ def test_grid_fraction_helper_uses_every_panel() -> None:
 def test_failing_claim_is_reported_not_raised() -> None:
     res = evaluate({"table6.1": {"max_nontrivial": 0.5}}, tuple(c for c in CLAIMS
                                                                  if c.figure == "6.1"))
-    assert res[0].holds is False and res[0].numbers["max|lambda|"] == 0.5
+    assert res[0].holds is False and res[0].numbers["ours"] == 0.5
     assert res[1].holds is False and res[1].error  # missing numbers -> an error, not a crash
 
 
 def test_appendix_e_claims() -> None:
-    """Section E.4 on the biped: tracking (E.2), instability from Table E.2, the
-    metacentric test and the stable gait hold; 'falls after about 10 strides' does
-    not (we fall after 5) and is reported with our number, not asserted away."""
+    """Section E.4 on the biped: tracking (E.2), instability from Table E.2 (though
+    not its 67.0), the metacentric test and the stable gait hold; 'falls after
+    about 10 strides' holds exactly when our count is 8-12 (or under the
+    perturbed-start reading) and is reported with our number either way."""
     e = catalogue.fig_appendix_e(n_strides=8, n_converged=10)
     res = evaluate({"E": e}, tuple(c for c in CLAIMS if c.figure in ("E.2", "E.4")))
     assert [r.figure for r in res] == ["E.2", "E.4", "E.4", "E.4", "E.4"]
     tracking, unstable, falls, meta, stable = res
     for r in (tracking, unstable, meta, stable):
         assert r.holds, (r.text, r.numbers, r.error)
-    assert not falls.holds and falls.numbers["strides until fall"] == 5
+    n = falls.numbers["strides until fall"]
+    assert falls.holds == (abs(n - 10) <= 2 or falls.verdict is Verdict.HOLDS_UNDER_READING)
+    assert unstable.evidence["largest |lambda| 67.0 (to the printed 0.05): ours"] == round(
+        e["e2"]["largest"], 3)  # the thesis's 67.0 is shown next to ours, not passed over
     assert stable.numbers["strides run"] == "10 of 10"
+
+
+def test_velocity_bar_holds_the_normalised_retraction_rate() -> None:
+    """The twin of the "velocity" study: same speeds, omega_r l0 / v0 (eq. 2.18) held."""
+    base = preset("table2.1")
+    twin, bar = catalogue.STUDIES["velocity"], catalogue.STUDIES["velocity_bar"]
+    for quick in (True, False):
+        a, b = twin.at(quick), bar.at(quick)
+        assert b.axes[0].values == a.axes[0].values and b.shape == (len(a.axes[0].values), 1)
+        for v in (b.axes[0].values[0], b.axes[0].values[-1]):
+            p = b.params_at({"v0": v, "omega_r_bar": b.axes[1].values[0]})
+            q = a.params_at({"v0": v})
+            assert p.v0 == q.v0 == v
+            assert p.omega_r * p.l0 / p.v0 == pytest.approx(base.omega_r * base.l0 / base.v0)
+            assert q.omega_r == base.omega_r

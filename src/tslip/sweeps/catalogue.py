@@ -9,6 +9,10 @@ and 6.1 (and Tables E.1-E.4) and the ranges are those of Sections 3.4-3.7.
 
 Choices the thesis leaves open
 ------------------------------
+* Velocity (4.8, 4.9): the thesis varies ``v0`` without saying whether the
+  retraction rate ``omega_r`` or its normalised form ``omega_r_bar = omega_r
+  l0 / v0`` (eq. 2.18) is held; ``velocity`` holds ``omega_r``,
+  ``velocity_bar`` holds ``omega_r_bar``, and the claims report both.
 * Stiffness (4.18, 4.19): ``k`` must be positive, so the sweep starts at
   ``k = 1`` instead of 0.
 * Leg damping (4.12, 4.13) and hip damping (4.14, 4.15) use the constant
@@ -65,9 +69,10 @@ class Study:
     spec: StudySpec
 
     def at(self, quick: bool) -> StudySpec:
-        """The spec at quick or full resolution."""
-        if len(self.spec.axes) == 1:
-            return self.spec.with_resolution([QUICK_LINE if quick else FULL_LINE])
+        """The spec at quick or full resolution (an axis with one value is held, not swept)."""
+        if sum(len(a.values) > 1 for a in self.spec.axes) == 1:
+            n = QUICK_LINE if quick else FULL_LINE
+            return self.spec.with_resolution([n] * len(self.spec.axes))
         n = QUICK_GRID if quick else FULL_GRID
         return self.spec.with_resolution([n, n])
 
@@ -84,10 +89,28 @@ def _line(name: str, figures: tuple[str, ...], base: Params, param: str, start: 
     return Study(name, figures, spec)
 
 
+def _velocity_bar() -> Study:
+    """Figure 4.9's speed line with ``omega_r_bar = omega_r l0 / v0`` (eq. 2.18) held.
+
+    The thesis describes retraction by the normalised rate, so "varying
+    velocity" may hold ``omega_r_bar`` (this study) or ``omega_r`` (the
+    ``velocity`` study) fixed. The held rate is an axis with one value after
+    the ``v0`` axis, so each point sets ``v0`` first and then ``omega_r``.
+    """
+    base = _p("table2.1")
+    spec = StudySpec("velocity_bar", base,
+                     (Axis.linspace("v0", 1.0, 10.0, FULL_LINE),
+                      Axis("omega_r_bar", (base.omega_r_bar,))), ROB,
+                     description=f"passive Table 2.1, v0 in [1, 10] with omega_r_bar = "
+                                 f"{base.omega_r_bar:g} held (eq. 2.18)")
+    return Study(spec.name, ("4.8", "4.9"), spec)
+
+
 def _build() -> dict[str, Study]:
     out: list[Study] = [
         _line("velocity", ("4.8", "4.9"), _p("table2.1"), "v0", 1.0, 10.0,
               description="passive Table 2.1, v0 in [1, 10]"),
+        _velocity_bar(),
     ]
     for v in GRID_SPEEDS:
         spec = StudySpec(
