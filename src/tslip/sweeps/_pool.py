@@ -1,0 +1,95 @@
+"""Worker processes that die with their parent and stay quiet on Ctrl-C.
+
+:func:`process_pool` is the one way this package starts worker processes
+(``tslip study`` and ``tslip reproduce``). Each worker
+
+* runs numba single-threaded (one process per core, no nested threads),
+* ignores SIGINT: Ctrl-C reaches the whole process group, and only the
+  parent decides what to do (it stops the workers itself, no worker prints
+  a traceback),
+* watches its parent: a daemon thread polls ``os.getppid()`` and ends the
+  worker within :data:`WATCH_SECONDS` of the parent's death, whatever killed
+  it (SIGKILL included), so no worker is left behind as an orphan,
+* can report progress to the parent through a queue (:func:`notify`).
+
+Leaving the ``with`` block normally waits for the submitted work; leaving it
+by an exception (Ctrl-C included) cancels what has not started and
+terminates the workers instead of waiting for them.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import multiprocessing as mp
+import os
+import signal
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+__all__ = ["WATCH_SECONDS", "notify", "process_pool", "progress_queue", "stop_workers"]
+
+#: How often a worker checks that its parent is alive [s].
+WATCH_SECONDS = 0.5
+
+_queue: Any = None  # the progress queue, in a worker
+
+
+def _watch_parent(parent: int) -> None:  # pragma: no cover - runs in worker processes
+    while True:
+        time.sleep(WATCH_SECONDS)
+        if os.getppid() != parent:  # re-parented: the parent is gone
+            os._exit(1)
+
+
+def _init_worker(parent: int, queue: Any) -> None:  # pragma: no cover - in workers
+    global _queue
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True,
+                     name="tslip-parent-watch").start()
+    _queue = queue
+    import numba
+
+    numba.set_num_threads(1)  # one process per core; no nested threads
+
+
+def notify(n: int = 1) -> None:
+    """In a worker: tell the parent that ``n`` more points are done (else nothing)."""
+    if _queue is not None:
+        _queue.put(n)
+
+
+def stop_workers(pool: cf.ProcessPoolExecutor) -> None:
+    """Cancel pending work and terminate the pool's workers now (no waiting)."""
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in procs:
+        if p.is_alive():
+            p.terminate()
+    for p in procs:
+        p.join(timeout=5)
+
+
+@contextmanager
+def process_pool(workers: int, queue: Any = None) -> Iterator[cf.ProcessPoolExecutor]:
+    """A spawn-context process pool of ``workers`` watched, SIGINT-deaf workers.
+
+    ``queue`` (from :func:`progress_queue`) receives the workers' :func:`notify`
+    calls.
+    """
+    ctx = mp.get_context("spawn")  # numba threads and fork do not mix
+    pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                  initializer=_init_worker, initargs=(os.getpid(), queue))
+    try:
+        yield pool
+    except BaseException:
+        stop_workers(pool)
+        raise
+    pool.shutdown(wait=True)
+
+
+def progress_queue() -> Any:
+    """A queue that :func:`process_pool` workers can :func:`notify` through."""
+    return mp.get_context("spawn").Queue()
