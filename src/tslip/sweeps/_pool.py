@@ -4,9 +4,10 @@
 (``tslip study`` and ``tslip reproduce``). Each worker
 
 * runs numba single-threaded (one process per core, no nested threads),
-* ignores SIGINT: Ctrl-C reaches the whole process group, and only the
-  parent decides what to do (it stops the workers itself, no worker prints
-  a traceback),
+* ignores SIGINT from its first instruction (it is spawned with SIGINT
+  ignored, so not even a Ctrl-C during its seconds of start-up prints a
+  traceback): Ctrl-C reaches the whole process group, and only the parent
+  decides what to do (it stops the workers itself),
 * watches its parent: a daemon thread polls ``os.getppid()`` and ends the
   worker within :data:`WATCH_SECONDS` of the parent's death, whatever killed
   it (SIGKILL included), so no worker is left behind as an orphan,
@@ -73,6 +74,27 @@ def stop_workers(pool: cf.ProcessPoolExecutor) -> None:
 
 
 @contextmanager
+def _sigint_ignored() -> Iterator[None]:
+    """Ignore SIGINT in this block; processes started in it inherit that."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
+class _Executor(cf.ProcessPoolExecutor):
+    """Starts its workers (which happens in ``submit``) with SIGINT ignored."""
+
+    def submit(self, fn, /, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN201
+        with _sigint_ignored():
+            return super().submit(fn, *args, **kwargs)
+
+
+@contextmanager
 def process_pool(workers: int, queue: Any = None) -> Iterator[cf.ProcessPoolExecutor]:
     """A spawn-context process pool of ``workers`` watched, SIGINT-deaf workers.
 
@@ -80,8 +102,8 @@ def process_pool(workers: int, queue: Any = None) -> Iterator[cf.ProcessPoolExec
     calls.
     """
     ctx = mp.get_context("spawn")  # numba threads and fork do not mix
-    pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
-                                  initializer=_init_worker, initargs=(os.getpid(), queue))
+    pool = _Executor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
+                     initargs=(os.getpid(), queue))
     try:
         yield pool
     except BaseException:
