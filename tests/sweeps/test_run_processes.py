@@ -57,6 +57,14 @@ def _n_cached(out: Path) -> int:
     return len(list(cache.glob("*.json"))) if cache.is_dir() else 0
 
 
+def _wait_gone(procs, seconds=10.0):
+    """The processes still alive after up to ``seconds`` (the resource tracker ends last)."""
+    deadline = time.monotonic() + seconds
+    while _alive(procs) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    return _alive(procs)
+
+
 def _alive(procs):
     out = []
     for p in procs:
@@ -82,10 +90,7 @@ def test_sigkill_of_the_parent_ends_its_workers_and_the_study_resumes(tmp_path):
         proc.kill()
         proc.wait()
     assert len(children) >= 2
-    deadline = time.monotonic() + 10.0
-    while _alive(children) and time.monotonic() < deadline:
-        time.sleep(0.1)
-    assert not _alive(children), [p.pid for p in _alive(children)]
+    assert not _wait_gone(children)
     # the points the killed run saved are reused, and the result is exactly the full run's
     spec = StudySpec.from_toml(spec_file)
     saved = _n_cached(out)
@@ -118,7 +123,7 @@ def test_ctrl_c_prints_one_resume_line_and_exits_130(tmp_path):
                   re.MULTILINE)
     assert m, err
     assert int(m.group(1)) == _n_cached(out) >= 28
-    assert not _alive(children)
+    assert not _wait_gone(children)
 
 
 def test_second_run_on_a_locked_folder_is_refused_in_one_line(tmp_path):

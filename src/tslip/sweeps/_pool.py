@@ -8,9 +8,12 @@
   ignored, so not even a Ctrl-C during its seconds of start-up prints a
   traceback): Ctrl-C reaches the whole process group, and only the parent
   decides what to do (it stops the workers itself),
-* watches its parent: a daemon thread polls ``os.getppid()`` and ends the
-  worker within :data:`WATCH_SECONDS` of the parent's death, whatever killed
-  it (SIGKILL included), so no worker is left behind as an orphan,
+* dies with its parent, whatever killed it (SIGKILL included): on Linux the
+  kernel kills it at once (``PR_SET_PDEATHSIG``), elsewhere a daemon thread
+  polling ``os.getppid()`` ends it within :data:`WATCH_SECONDS` or so; no
+  worker is left behind as an orphan. (Workers start in ``submit``, so on
+  Linux they also end with the thread that submitted first: use a pool from
+  one thread.)
 * can report progress to the parent through a queue (:func:`notify`).
 
 Leaving the ``with`` block normally waits for the submitted work; leaving it
@@ -21,9 +24,11 @@ terminates the workers instead of waiting for them.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import ctypes
 import multiprocessing as mp
 import os
 import signal
+import sys
 import threading
 import time
 from collections.abc import Iterator
@@ -38,18 +43,35 @@ WATCH_SECONDS = 0.5
 _queue: Any = None  # the progress queue, in a worker
 
 
-def _watch_parent(parent: int) -> None:  # pragma: no cover - runs in worker processes
-    while True:
-        time.sleep(WATCH_SECONDS)
-        if os.getppid() != parent:  # re-parented: the parent is gone
-            os._exit(1)
+def _die_with_parent(parent: int) -> None:  # pragma: no cover - runs in worker processes
+    """End this process when ``parent`` ends.
+
+    Linux: the kernel sends SIGKILL on the parent's death (``PR_SET_PDEATHSIG``),
+    immediate even while a compiled kernel holds the GIL. Everywhere: a daemon
+    thread polls ``os.getppid()`` (a worker is re-parented when its parent dies).
+    """
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # 1 = PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            pass
+    if os.getppid() != parent:  # it died before we were watching
+        os._exit(1)
+
+    def watch() -> None:
+        while True:
+            time.sleep(WATCH_SECONDS)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="tslip-parent-watch").start()
 
 
 def _init_worker(parent: int, queue: Any) -> None:  # pragma: no cover - in workers
     global _queue
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    threading.Thread(target=_watch_parent, args=(parent,), daemon=True,
-                     name="tslip-parent-watch").start()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # already inherited when submit started us
+    _die_with_parent(parent)
     _queue = queue
     import numba
 

@@ -202,10 +202,14 @@ def run_study(
     n_workers = workers if workers is not None else (os.cpu_count() or 1)
     if n_workers < 1:
         raise ValueError(f"workers must be >= 1, got {n_workers}")
-    if out_dir is None:
-        return _run(spec, None, n_workers, scheduler, progress, csv)
-    with folder_lock(out_dir, wait=wait):
-        return _run(spec, Path(out_dir), n_workers, scheduler, progress, csv)
+    try:
+        if out_dir is None:
+            return _run(spec, None, n_workers, scheduler, progress, csv)
+        with folder_lock(out_dir, wait=wait):
+            return _run(spec, Path(out_dir), n_workers, scheduler, progress, csv)
+    except KeyboardInterrupt:  # the workers are stopped by now
+        saved = saved_points(spec, out_dir) if out_dir is not None else 0
+        raise StudyInterrupted(saved, spec.n_points) from None
 
 
 def _run(spec: StudySpec, out: Path | None, n_workers: int, scheduler: str | None,
@@ -254,28 +258,24 @@ def _run(spec: StudySpec, out: Path | None, n_workers: int, scheduler: str | Non
                 str(cache) if cache is not None and ex.writes else None)
 
     ready = [i for i in range(len(plan)) if pred[i] is None]
-    try:
-        with _executor(scheduler, n_workers, len(plan), tick) as ex:
-            running: dict[Any, int] = {}
-            while ready or running:
-                while ready:
-                    i = ready.pop(0)
-                    if any(r is None for r in records[i]):
-                        running[ex.submit(*task(i, ex))] = i
-                    else:
-                        ready.extend(succ[i])  # fully cached: its successors may start
-                if running:
-                    for fut in ex.wait_first(list(running)):
-                        i = running.pop(fut)
-                        recs = fut.result()
-                        if not ex.writes:
-                            _keep(cache, plan[i][2], records[i], recs, tick)
-                        records[i] = recs
-                        ready.extend(succ[i])
-                ex.poll()
-    except KeyboardInterrupt:
-        saved = saved_points(spec, out) if out is not None else 0
-        raise StudyInterrupted(saved, n_total) from None
+    with _executor(scheduler, n_workers, len(plan), tick) as ex:
+        running: dict[Any, int] = {}
+        while ready or running:
+            while ready:
+                i = ready.pop(0)
+                if any(r is None for r in records[i]):
+                    running[ex.submit(*task(i, ex))] = i
+                else:
+                    ready.extend(succ[i])  # fully cached: its successors may start
+            if running:
+                for fut in ex.wait_first(list(running)):
+                    i = running.pop(fut)
+                    recs = fut.result()
+                    if not ex.writes:
+                        _keep(cache, plan[i][2], records[i], recs, tick)
+                    records[i] = recs
+                    ready.extend(succ[i])
+            ex.poll()
     if progress:
         progress(n_total, n_total)
     by_point = {tuple(r[a.param] for a in spec.axes): r for line in records for r in line}
