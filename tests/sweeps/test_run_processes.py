@@ -170,3 +170,24 @@ def test_idle_workers_ignore_sigint_and_the_parent_stops_them():
                 inner_workers = list(inner._processes.values())
                 raise KeyboardInterrupt
     assert not any(w.is_alive() for w in inner_workers)  # stopped, not waited for
+
+
+def test_wait_blocks_until_the_holder_releases(tmp_path, caplog):
+    import threading
+
+    got = threading.Event()
+
+    def second():
+        with folder_lock(tmp_path, wait=True):
+            got.set()
+
+    with caplog.at_level("WARNING", logger="tslip"):
+        with folder_lock(tmp_path):
+            t = threading.Thread(target=second)
+            t.start()
+            _wait_for(lambda: any("waiting for" in r.getMessage() for r in caplog.records),
+                      timeout=30)
+            assert not got.is_set()  # still held here
+        t.join(timeout=30)
+    assert got.is_set()
+    assert f"pid {os.getpid()}" in caplog.records[0].getMessage()
