@@ -54,7 +54,9 @@ def _wait_for(cond, timeout=240.0):
 
 def _n_cached(out: Path) -> int:
     cache = out / "cache"
-    return len(list(cache.glob("*.json"))) if cache.is_dir() else 0
+    # not ".<key>.json.<random>.json": a write that the kill interrupted
+    return len([f for f in cache.glob("*.json") if not f.name.startswith(".")]) \
+        if cache.is_dir() else 0
 
 
 def _wait_gone(procs, seconds=10.0):
