@@ -1,7 +1,6 @@
 """The study runner: serial == parallel, resume, cache invalidation, spec validation."""
 
 import dataclasses
-import json
 
 import pandas as pd
 import pytest
@@ -31,38 +30,13 @@ def test_two_by_two_serial_equals_parallel(tmp_path):
     _cmp(serial.frame, parallel.frame)
 
 
-def test_interrupted_study_resumes_only_missing_points(tmp_path, monkeypatch):
-    spec = _spec()
-    calls: list[list[float]] = []
-    real = run_mod.solve_line
-
-    def flaky(spec_, assignment, values, seeds=None):
-        calls.append(list(values))
-        if len(calls) == 2:
-            raise KeyboardInterrupt  # the second line is interrupted
-        return real(spec_, assignment, values, seeds)
-
-    monkeypatch.setattr(run_mod, "solve_line", flaky)
-    with pytest.raises(KeyboardInterrupt):
-        run_study(spec, tmp_path, workers=1)
-    assert len(list((tmp_path / "cache").glob("*.json"))) == 2  # first line kept
-    calls.clear()
-    res = run_study(spec, tmp_path, workers=1)
-    assert res.meta["computed"] == 2 and res.meta["cached"] == 2
-    assert calls == [[20.0, 25.0]]  # only the missing line ran
-    again = run_study(spec, tmp_path, workers=1)
-    assert again.meta["computed"] == 0 and calls == [[20.0, 25.0]]
-    _cmp(res.frame, again.frame)
-    assert json.loads((tmp_path / "run.json").read_text())["points"] == 4
-
-
-def test_cache_invalidated_by_parameter_and_version(tmp_path, monkeypatch):
+def test_cache_invalidated_by_parameter_and_code(tmp_path, monkeypatch):
     spec = _spec()
     run_study(spec, tmp_path, workers=1)
     changed = _spec(base=dataclasses.replace(tslip.preset("table2.1-local-velocity"), J=0.12))
     assert run_study(changed, tmp_path, workers=1).meta["computed"] == 4
     assert run_study(spec, tmp_path, workers=1).meta["computed"] == 0
-    monkeypatch.setattr(run_mod, "__version__", "999.0")
+    monkeypatch.setattr(run_mod, "code_version", lambda analyses: "edited")
     assert run_study(spec, tmp_path, workers=1).meta["computed"] == 4
 
 

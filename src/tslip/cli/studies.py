@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated
 
@@ -41,6 +43,31 @@ class _Rate(TextColumn):
         return Text(f"{speed:5.1f} pt/s" if speed else "   -- pt/s")
 
 
+def _stopped(message: str) -> None:
+    """Ctrl-C: one line on stderr, exit code 130 (128 + SIGINT), no traceback."""
+    typer.echo(message, err=True)
+    raise typer.Exit(code=130)
+
+
+@contextmanager
+def _interruptible() -> Iterator[None]:
+    """A Ctrl-C outside the study itself (e.g. while loading) also ends quietly."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        _stopped("interrupted")
+
+
+def _saved_message(out: Path, quick: bool) -> str:
+    """``N of M points saved`` over every catalogue study under ``out/studies``."""
+    from ..sweeps import catalogue
+    from ..sweeps.run import StudyInterrupted, saved_points
+
+    specs = catalogue.studies(quick)
+    saved = sum(saved_points(spec, out / "studies" / name) for name, spec in specs.items())
+    return str(StudyInterrupted(saved, sum(s.n_points for s in specs.values())))
+
+
 @app.command("study")
 def study_cmd(
     spec_path: Annotated[Path, typer.Argument(help="Study spec (TOML).", metavar="SPEC.toml")],
@@ -49,20 +76,32 @@ def study_cmd(
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,
     csv: Annotated[bool, typer.Option("--csv", help="Also write results.csv.")] = False,
+    wait: Annotated[bool, typer.Option("--wait", help="If another run is writing the "
+                                       "output folder, wait for it (default: stop).")] = False,
 ) -> None:
-    """Run (or resume) one parameter study from a TOML spec."""
+    """Run (or resume) one parameter study from a TOML spec.
+
+    Every point is saved as it finishes: after Ctrl-C (or a crash) the same
+    command resumes with the missing points.
+    """
     from ..sweeps import StudySpec, run_study
+    from ..sweeps.run import StudyInterrupted
 
     console = _console()
-    with _errors():
+    with _errors(), _interruptible():
         spec = StudySpec.from_toml(spec_path)
         out_dir = out if out is not None else Path("studies") / spec.name
         with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                       _Rate(), TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(),
                       console=_console(stderr=True), transient=False) as bar:
             task = bar.add_task(f"study {spec.name}", total=spec.n_points)
-            res = run_study(spec, out_dir, workers=workers, scheduler=scheduler, csv=csv,
-                            progress=lambda done, total: bar.update(task, completed=done))
+            try:
+                res = run_study(spec, out_dir, workers=workers, scheduler=scheduler, csv=csv,
+                                wait=wait,
+                                progress=lambda done, total: bar.update(task, completed=done))
+            except StudyInterrupted as exc:
+                bar.stop()
+                _stopped(str(exc))
     f = res.frame
     n_stable = int(f["stability"].isin(["asymptotic", "neutral"]).sum())
     console.print(f"{spec.name}: {len(f)} points ({res.meta['cached']} cached), "
@@ -101,9 +140,12 @@ def reproduce_cmd(
         elif stage == "figure":
             console.print(f"[{el:6.1f} s] figure {name} ({seconds:.1f} s)")
 
-    with _errors():
-        path = reproduce(out, quick=quick, workers=workers, scheduler=scheduler,
-                         progress=progress)
+    with _errors(), _interruptible():
+        try:
+            path = reproduce(out, quick=quick, workers=workers, scheduler=scheduler,
+                             progress=progress)
+        except KeyboardInterrupt:
+            _stopped(_saved_message(out, quick))
     import json
 
     claims = json.loads(path.with_name("claims.json").read_text())

@@ -16,7 +16,6 @@ that Dask cluster instead.
 from __future__ import annotations
 
 import concurrent.futures as cf
-import multiprocessing as mp
 import os
 import time
 from collections.abc import Callable
@@ -26,8 +25,9 @@ from typing import Any
 from ..gait import find_gait, floquet, robustness_report, stride_properties
 from ..model.parameters import preset
 from . import catalogue
+from ._pool import process_pool
 from .claims import ClaimResult, evaluate
-from .run import StudyResult, _init_worker, run_study
+from .run import StudyResult, run_study
 from .spec import StudySpec
 
 __all__ = ["run_all", "run_catalogue", "single_figures", "table61"]
@@ -73,10 +73,8 @@ def run_catalogue(out_dir: str | Path, *, quick: bool = False, workers: int | No
             done(name, run_study(specs[name], root / name, workers=1, scheduler=scheduler), t0)
         return results, side
     _warm_up()
-    ctx = mp.get_context("spawn")
     t0 = time.perf_counter()
-    with cf.ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx,
-                                initializer=_init_worker) as pool:
+    with process_pool(n_workers) as pool:
         futs = {pool.submit(_run_one, specs[n], str(root / n)): n for n in order}
         if side_job is not None:
             side = side_job()

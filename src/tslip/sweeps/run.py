@@ -1,19 +1,25 @@
-"""Run a study: continuation lines in parallel, a resumable per-point cache.
+"""Run a study: continuation lines in parallel, every point cached as it finishes.
 
-Work is split into continuation lines (:meth:`StudySpec.lines`). Each line is
-solved by :func:`tslip.gait.continue_gait` (warm starts from neighbours) and
-each of its gaits is analysed (multipliers, robustness, stride). Lines run in
-worker processes (all cores by default), or on a Dask cluster given its
-address, and return plain records; the calling process writes every point to
-the cache as soon as its line is done, atomically. The cache key is a hash of
-the point's full parameters, the analyses and the package version, so
+Work is split into continuation lines (:meth:`StudySpec.lines`), solved
+point by point by :func:`tslip.sweeps.point.solve_line`. Lines run in worker
+processes (all cores by default; see :mod:`tslip.sweeps._pool`), or on a
+Dask cluster given its address. Each point is written to ``cache/`` the
+moment it is final, atomically, by the process that computed it, and the
+progress callback advances with it. The cache key is a hash of the study's
+base parameters, the point's axis values, the analyses and the code that
+computes them (:func:`tslip.sweeps.point.code_version`), so
 
-* an interrupted study resumes with only the missing points,
+* an interrupted study resumes with only the missing points, and ends
+  bit-identical to an uninterrupted run (a line replays its cached points),
 * a finished study reruns instantly,
-* changing a parameter or upgrading the package recomputes.
+* changing a parameter, or the code behind an analysis, recomputes the
+  points it affects and no others.
 
-A point without a periodic gait is a record with ``converged = False`` and
-``stability = "none"``, not an error.
+One run at a time per output folder (``.lock``, :mod:`tslip.sweeps._lock`).
+Ctrl-C stops the workers and raises :class:`StudyInterrupted` ("N of M
+points saved"). A point without a periodic gait is a record with
+``converged = False`` and ``stability = "none"``, not an error. On a Dask
+cluster the points of a line are cached when the line is done.
 """
 
 from __future__ import annotations
@@ -21,11 +27,11 @@ from __future__ import annotations
 import concurrent.futures as cf
 import hashlib
 import json
-import math
-import multiprocessing as mp
 import os
+import queue as queue_mod
 import time
 from collections.abc import Callable
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -35,23 +41,35 @@ import pandas as pd
 
 from .. import __version__
 from .._io import atomic_write, git_hash, write_json, write_table
-from ..gait.continuation import continue_gait, get_param
-from ..gait.fixed_point import Gait, GaitProblem, find_gait
-from ..gait.robustness import KINDS, robustness_report
-from ..gait.stability import floquet
-from ..gait.stride import stride_properties
+from ..gait.continuation import get_param
+from . import _pool
+from ._lock import folder_lock
+from .point import code_version, seeds_from_records, solve_line
 from .spec import StudySpec
 
-__all__ = ["StudyResult", "run_study", "point_key", "solve_line"]
+__all__ = ["StudyInterrupted", "StudyResult", "run_study", "point_key", "saved_points",
+           "study_keys"]
 
 Progress = Callable[[int, int], None]
 
 
-def point_key(spec: StudySpec, assignment: dict[str, float]) -> str:
-    """Cache key of one point: its full parameters, the analyses, the version."""
-    payload = {
-        "version": __version__,
-        "params": spec.params_at(assignment).to_dict(),
+class StudyInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a study: how many of its points are saved."""
+
+    def __init__(self, saved: int, total: int) -> None:
+        super().__init__(saved, total)
+        self.saved, self.total = saved, total
+
+    def __str__(self) -> str:
+        return f"{self.saved} of {self.total} points saved; rerun the same command to resume"
+
+
+def _key_prefix(spec: StudySpec) -> Any:
+    """The hash state shared by a study's points: code, base parameters, analyses."""
+    payload: dict[str, Any] = {
+        "code": code_version(spec.analyses),
+        "base": spec.base.to_dict(),
+        "axes": [a.param for a in spec.axes],
         "analyses": sorted(spec.analyses),
         "n_steps": spec.n_steps if "robustness" in spec.analyses else None,
     }
@@ -59,186 +77,69 @@ def point_key(spec: StudySpec, assignment: dict[str, float]) -> str:
         payload["tol"] = float(spec.meta["tol"])
     if "neutral_tol" in spec.meta:
         payload["neutral_tol"] = float(spec.meta["neutral_tol"])
-    blob = json.dumps(payload, sort_keys=True, default=float).encode()
-    return hashlib.sha256(blob).hexdigest()[:24]
+    return hashlib.sha256(json.dumps(payload, sort_keys=True, default=float).encode())
 
 
-def _num(x: Any) -> float:
-    try:
-        x = float(x)
-    except (TypeError, ValueError):
-        return math.nan
-    return x
+def _key(prefix: Any, point: tuple[float, ...]) -> str:
+    h = prefix.copy()
+    h.update(repr(tuple(float(x) for x in point)).encode())
+    return h.hexdigest()[:24]
 
 
-def _seeded_gaits(spec: StudySpec, assignment: dict[str, float], values: np.ndarray,
-                  seeds: dict[float, list[float]], tol: float,
-                  known: list[Gait | None] | None = None) -> list[Gait | None]:
-    """Gaits along a line, grown from seeds (2-D continuation).
-
-    First every point with a seed (its neighbour's unknowns in the previous
-    line) starts once from it; then the solved points grow outward along the
-    line, each unsolved neighbour starting once from an adjacent solution. No
-    automatic guesses: a point without a gait costs one short least-squares run
-    per attempt.
-    """
-    inner = spec.axes[-1].param
-    n = len(values)
-    gaits: list[Gait | None] = list(known) if known is not None else [None] * n
-    problems = {}
-
-    def attempt(i: int, z: list[float] | np.ndarray) -> bool:
-        if i not in problems:
-            p = spec.params_at({**assignment, inner: float(values[i])})
-            problems[i] = (p, GaitProblem.from_params(p).names)
-        p, names = problems[i]
-        if len(z) != len(names) or not np.all(np.isfinite(z)):
-            return False
-        g = find_gait(p, guess=np.asarray(z, dtype=float), tol=tol)
-        if g.converged:
-            gaits[i] = g
-        return g.converged
-
-    for i in range(n):
-        if gaits[i] is None and float(values[i]) in seeds:
-            attempt(i, seeds[float(values[i])])
-    tried: set[tuple[int, int]] = set()
-    grown = True
-    while grown:
-        grown = False
-        for i in range(n):
-            if gaits[i] is None:
-                continue
-            for j in (i - 1, i + 1):
-                if 0 <= j < n and gaits[j] is None and (i, j) not in tried:
-                    tried.add((i, j))
-                    names = problems[j][1] if j in problems else GaitProblem.from_params(
-                        spec.params_at({**assignment, inner: float(values[j])})).names
-                    grown |= attempt(j, _unknowns(gaits[i], names))
-    return gaits
+def point_key(spec: StudySpec, assignment: dict[str, float]) -> str:
+    """Cache key of one point: base parameters, axis values, analyses, code version."""
+    return _key(_key_prefix(spec), tuple(assignment[a.param] for a in spec.axes))
 
 
-def _scan_line(spec: StudySpec, assignment: dict[str, float], values: np.ndarray,
-               tol: float, n_probe: int = 10) -> list[Gait | None]:
-    """Cold searches at ``n_probe`` evenly spread values, then grow from any found."""
-    inner = spec.axes[-1].param
-    gaits: list[Gait | None] = [None] * len(values)
-    for i in np.unique(np.linspace(0, len(values) - 1, min(n_probe, len(values))).round()):
-        i = int(i)
-        g = find_gait(spec.params_at({**assignment, inner: float(values[i])}), tol=tol)
-        if g.converged:
-            gaits[i] = g
-    if any(g is not None for g in gaits):
-        gaits = _seeded_gaits(spec, assignment, values, {}, tol, known=gaits)
-    return gaits
-
-
-def _unknowns(g: Gait, names: tuple[str, ...]) -> list[float]:
-    src = {"delta": g.state.delta, "phi": g.state.phi, "phid": g.state.phid,
-           "alpha_r": g.params.alpha_r,
-           "alphad_ref": getattr(g.params.controller, "alphad_ref", math.nan),
-           "tau_c": getattr(g.params.controller, "tau_c", math.nan)}
-    return [float(src[n]) for n in names]
-
-
-def seeds_from_records(spec: StudySpec, records: list[dict[str, Any]]) -> dict[float, list]:
-    """Unknowns of a solved line, by inner value, to seed its neighbour line."""
-    inner = spec.axes[-1].param
-    out = {}
-    for rec in records:
-        if rec.get("converged"):
-            out[float(rec[inner])] = [rec.get(n, math.nan) for n in
-                                      ("delta", "phi", "phid", "alpha_r", "alphad_ref",
-                                       "tau_c")]
+def study_keys(spec: StudySpec) -> list[tuple[dict[str, float], list[float], list[str]]]:
+    """Per line: its assignment, its values (ascending) and their cache keys."""
+    prefix = _key_prefix(spec)
+    out = []
+    for assignment, axis in spec.lines():
+        values = sorted(float(v) for v in axis.values)
+        outer = tuple(assignment[a.param] for a in spec.axes[:-1])
+        keys = [_key(prefix, outer + (v,)) for v in values]
+        out.append((assignment, values, keys))
     return out
 
 
-def solve_line(spec: StudySpec, assignment: dict[str, float], values: list[float],
-               seeds: dict[float, list] | None = None) -> list[dict[str, Any]]:
-    """Solve and analyse the points of one continuation line.
+def _cached_names(cache: Path | None) -> set[str]:
+    """File names in the cache; removes temporary files of interrupted writes."""
+    if cache is None or not cache.is_dir():
+        return set()
+    names = set()
+    for entry in os.scandir(cache):
+        if entry.name.startswith("."):  # an atomic write that was killed midway
+            Path(entry.path).unlink(missing_ok=True)
+        else:
+            names.add(entry.name)
+    return names
 
-    Pure: returns one record (a flat dict of numbers and strings) per value;
-    runs in worker processes. Without ``seeds`` the line is followed by
-    :func:`continue_gait` from a cold start; with ``seeds`` (the unknowns of
-    the neighbouring line, see :func:`seeds_from_records`) each point starts
-    from its neighbour's solution, as 2-D continuation.
-    """
-    inner = spec.axes[-1].param
-    params = spec.params_at(assignment)
-    t0 = time.perf_counter()
-    tol = float(spec.meta.get("tol", 1e-10))  # global PD has no exact fixed point
-    vals = np.sort(np.asarray(values, dtype=float))
-    if seeds is None:  # a 1-D study or the root line of a grid: cold start
-        branch = continue_gait(params, inner, vals, tol=tol, max_failures=3, multipliers=False)
-        gaits = list(branch.gaits)
-        residual = list(branch.residual)
-        messages = list(branch.messages)
-        if len(spec.axes) == 2 and not any(g is not None for g in gaits):
-            # the base value may lie outside the gait's band: probe along the line
-            gaits = _scan_line(spec, assignment, vals, tol)
-            residual = [g.residual if g is not None else math.nan for g in gaits]
-            messages = ["found by probing the line" if g is not None else
-                        "no periodic gait found along this line" for g in gaits]
-    else:  # seeded from the neighbouring line (empty seeds: it had no gait)
-        names = GaitProblem.from_params(params).names
-        full = {v: [z[("delta", "phi", "phid", "alpha_r", "alphad_ref", "tau_c").index(n)]
-                    for n in names] for v, z in seeds.items()}
-        gaits = _seeded_gaits(spec, assignment, vals, full, tol)
-        residual = [g.residual if g is not None else math.nan for g in gaits]
-        messages = ["continued from the neighbouring line" if g is not None else
-                    "no periodic gait continuing from the neighbouring line" for g in gaits]
-    neutral_tol = float(spec.meta.get("neutral_tol", 1e-6))
-    records = []
-    for i, v in enumerate(vals):
-        g = gaits[i]
-        rec: dict[str, Any] = {**assignment, inner: float(v)}
-        rec["converged"] = g is not None and bool(g.converged)
-        rec["residual"] = _num(residual[i])
-        fl = None
-        if g is not None:
-            try:
-                fl = floquet(g, unit_tol=neutral_tol)
-            except ValueError:
-                fl = None
-        rec["stability"] = (fl.stability if fl is not None else
-                            ("unknown" if g is not None else "none"))
-        mags = np.sort(np.abs(fl.multipliers))[::-1] if fl is not None else np.full(5, np.nan)
-        for j in range(5):
-            rec[f"abs_lambda_{j + 1}"] = _num(mags[j])
-        rec["max_nontrivial"] = _num(fl.max_nontrivial) if fl is not None else math.nan
-        rec["n_trivial"] = int(np.sum(fl.trivial)) if fl is not None else 0
-        nt = np.abs(fl.multipliers[~fl.trivial]) if fl is not None else np.array([])
-        rec["min_nontrivial"] = _num(nt.min()) if nt.size else math.nan
-        rec["stance_time"] = _num(g.stance_time) if g is not None else math.nan
-        rec["flight_time"] = _num(g.flight_time) if g is not None else math.nan
-        if g is not None:
-            s = g.state
-            rec.update(delta=s.delta, phi=s.phi, phid=s.phid, alpha_r=g.params.alpha_r)
-            ctrl = g.params.controller
-            rec["alphad_ref"] = _num(getattr(ctrl, "alphad_ref", math.nan))
-            rec["tau_c"] = _num(getattr(ctrl, "tau_c", math.nan))
-        if "stride" in spec.analyses and g is not None:
-            sp = stride_properties(g)
-            rec.update(duty_factor=sp.duty_factor, step_frequency=sp.step_frequency,
-                       stance_time_predicted=sp.stance_time_predicted,
-                       flight_time_predicted=sp.flight_time_predicted,
-                       fast_running_index=sp.fast_running_index, bounce_time=sp.bounce_time)
-        if "robustness" in spec.analyses:
-            for kind in KINDS:
-                rec[kind] = math.nan
-                rec[f"{kind}_status"] = ""
-            if g is not None and rec["converged"] and rec["stability"] in ("asymptotic",
-                                                                            "neutral"):
-                rr = robustness_report(g, n_steps=spec.n_steps, check=False)
-                for lim in rr.limits:
-                    rec[lim.kind] = _num(lim.limit)
-                    rec[f"{lim.kind}_status"] = lim.status.name if lim.status else ""
-        rec["message"] = messages[i]
-        records.append(rec)
-    dt = (time.perf_counter() - t0) / max(len(records), 1)
-    for rec in records:
-        rec["seconds"] = dt
-    return records
+
+def saved_points(spec: StudySpec, out_dir: str | Path) -> int:
+    """How many of the study's points ``out_dir/cache`` holds."""
+    names = _cached_names(Path(out_dir) / "cache")
+    return sum(f"{k}.json" in names for _, _, keys in study_keys(spec) for k in keys)
+
+
+def _save(cache: Path, key: str, rec: dict[str, Any]) -> None:
+    text = json.dumps(rec)
+    atomic_write(cache / f"{key}.json", lambda tmp: Path(tmp).write_text(text))
+
+
+def _line_task(spec: StudySpec, assignment: dict[str, float], values: list[float],
+               keys: list[str], cached: dict[float, dict[str, Any]],
+               seeds: dict[float, dict[str, float]] | None, cache: str | None,
+               tick: Callable[[int], None] | None = None) -> list[dict[str, Any]]:
+    """Solve one line, caching each point as it is final (runs in workers)."""
+    tick = tick or _pool.notify
+
+    def emit(i: int, rec: dict[str, Any]) -> None:
+        if cache is not None:
+            _save(Path(cache), keys[i], rec)
+        tick(1)
+
+    return solve_line(spec, assignment, values, seeds=seeds, cached=cached, emit=emit)
 
 
 @dataclass(frozen=True)
@@ -258,12 +159,6 @@ class StudyResult:
         return self.frame[name].to_numpy().reshape(self.spec.shape)
 
 
-def _init_worker() -> None:  # pragma: no cover - runs in worker processes
-    import numba
-
-    numba.set_num_threads(1)  # one process per core; no nested threads
-
-
 def run_study(
     spec: StudySpec,
     out_dir: str | Path | None = None,
@@ -272,6 +167,7 @@ def run_study(
     scheduler: str | None = None,
     progress: Progress | None = None,
     csv: bool = False,
+    wait: bool = False,
 ) -> StudyResult:
     """Run (or resume) a study and return its results.
 
@@ -280,108 +176,133 @@ def run_study(
     spec : StudySpec
     out_dir : path, optional
         Study folder: ``cache/`` (one JSON per point), ``results.parquet``
-        (and ``results.csv`` with ``csv=True``) and ``run.json``. Without it
-        nothing is cached or written.
+        (and ``results.csv`` with ``csv=True``), ``run.json`` and ``.lock``.
+        Without it nothing is cached or written.
     workers : int, optional
         Worker processes (default: all cores; 1 runs in this process).
     scheduler : str, optional
         Address of a Dask distributed scheduler (``tslip[dask]``); the same
         lines then run on that cluster.
     progress : callable, optional
-        ``progress(points_done, points_total)`` after each line.
+        ``progress(points_done, points_total)`` as points finish.
+    wait : bool
+        If another run holds ``out_dir``, wait for it instead of raising.
 
     Returns
     -------
     StudyResult
+
+    Raises
+    ------
+    StudyInterrupted
+        On Ctrl-C, after stopping the workers; the finished points stay cached.
+    tslip.sweeps._lock.FolderLocked
+        If another live run holds ``out_dir`` (a ValueError).
     """
+    n_workers = workers if workers is not None else (os.cpu_count() or 1)
+    if n_workers < 1:
+        raise ValueError(f"workers must be >= 1, got {n_workers}")
+    try:
+        if out_dir is None:
+            return _run(spec, None, n_workers, scheduler, progress, csv)
+        with folder_lock(out_dir, wait=wait):
+            return _run(spec, Path(out_dir), n_workers, scheduler, progress, csv)
+    except KeyboardInterrupt:  # the workers are stopped by now
+        saved = saved_points(spec, out_dir) if out_dir is not None else 0
+        raise StudyInterrupted(saved, spec.n_points) from None
+
+
+def _run(spec: StudySpec, out: Path | None, n_workers: int, scheduler: str | None,
+         progress: Progress | None, csv: bool) -> StudyResult:
     t_start = time.perf_counter()
-    cache = Path(out_dir) / "cache" if out_dir is not None else None
-    lines = spec.lines()
-    inner = spec.axes[-1]
-    keys: dict[tuple, str] = {}
-    records: dict[str, dict[str, Any]] = {}
-    missing: list[list[float]] = []
-    for assignment, axis in lines:
-        miss = []
-        for v in axis.values:
-            point = {**assignment, inner.param: v}
-            key = point_key(spec, point)
-            keys[tuple(point[a.param] for a in spec.axes)] = key
-            f = cache / f"{key}.json" if cache is not None else None
-            if f is not None and f.exists():
-                records[key] = json.loads(f.read_text())
-            else:
-                miss.append(v)
-        missing.append(miss)
+    cache = out / "cache" if out is not None else None
+    plan = study_keys(spec)
     n_total = spec.n_points
-    n_cached = len(records)
+    names = _cached_names(cache)
+    records: list[list[dict[str, Any] | None]] = []
+    n_cached = 0
+    for _, _, keys in plan:
+        line: list[dict[str, Any] | None] = []
+        for k in keys:
+            rec = None
+            if f"{k}.json" in names:
+                try:
+                    rec = json.loads((cache / f"{k}.json").read_text())  # type: ignore[operator]
+                except ValueError:  # unreadable: compute it again
+                    rec = None
+            line.append(rec)
+            n_cached += rec is not None
+            if progress and n_cached % 5000 == 1:
+                progress(n_cached, n_total)
+        records.append(line)
     done = n_cached
     if progress:
         progress(done, n_total)
 
-    def store(recs: list[dict[str, Any]]) -> None:
+    def tick(n: int) -> None:
         nonlocal done
-        for rec in recs:
-            key = keys[tuple(rec[a.param] for a in spec.axes)]
-            records[key] = rec
-            if cache is not None:
-                text = json.dumps(rec, default=float)
-                atomic_write(cache / f"{key}.json", lambda tmp, t=text: Path(tmp).write_text(t))
-        done += len(recs)
+        done += n
         if progress:
-            progress(done, n_total)
+            progress(min(done, n_total), n_total)
 
     # 2-D studies: lines form two chains outward from the line nearest the base
     # value; each line is seeded with its predecessor's solutions.
     pred, succ = _chains(spec)
+    inner = spec.axes[-1].param
 
-    def seeds(i: int) -> dict[float, list] | None:
-        if pred[i] is None:
-            return None
-        assignment, axis = lines[pred[i]]
-        recs = [records[keys[tuple({**assignment, inner.param: v}[a.param]
-                                   for a in spec.axes)]] for v in axis.values]
-        return seeds_from_records(spec, recs)
+    def task(i: int, ex: _Serial) -> tuple:
+        assignment, values, keys = plan[i]
+        cached = {v: r for v, r in zip(values, records[i]) if r is not None}
+        seeds = None if pred[i] is None else seeds_from_records(records[pred[i]], inner)
+        return (_line_task, spec, assignment, values, keys, cached, seeds,
+                str(cache) if cache is not None and ex.writes else None)
 
-    n_workers = workers if workers is not None else (os.cpu_count() or 1)
-    if n_workers < 1:
-        raise ValueError(f"workers must be >= 1, got {n_workers}")
-    ready = [i for i in range(len(lines)) if pred[i] is None]
-    with _executor(scheduler, n_workers, len(lines)) as ex:
+    ready = [i for i in range(len(plan)) if pred[i] is None]
+    with _executor(scheduler, n_workers, len(plan), tick) as ex:
         running: dict[Any, int] = {}
-        try:
-            while ready or running:
-                while ready:
-                    i = ready.pop(0)
-                    if missing[i]:
-                        running[ex.submit(solve_line, spec, lines[i][0], missing[i],
-                                          seeds(i))] = i
-                    else:
-                        ready.extend(succ[i])  # fully cached: its successors may start
-                if running:
-                    for fut in ex.wait_first(list(running)):
-                        i = running.pop(fut)
-                        store(fut.result())
-                        ready.extend(succ[i])
-        except BaseException:
-            for fut in running:
-                fut.cancel()
-            raise
-    rows = [records[keys[tuple(pt)]] for pt in _points(spec)]
-    frame = pd.DataFrame(rows)
+        while ready or running:
+            while ready:
+                i = ready.pop(0)
+                if any(r is None for r in records[i]):
+                    running[ex.submit(*task(i, ex))] = i
+                else:
+                    ready.extend(succ[i])  # fully cached: its successors may start
+            if running:
+                for fut in ex.wait_first(list(running)):
+                    i = running.pop(fut)
+                    recs = fut.result()
+                    if not ex.writes:
+                        _keep(cache, plan[i][2], records[i], recs, tick)
+                    records[i] = recs
+                    ready.extend(succ[i])
+            ex.poll()
+    if progress:
+        progress(n_total, n_total)
+    by_point = {tuple(r[a.param] for a in spec.axes): r for line in records for r in line}
+    frame = pd.DataFrame([by_point[pt] for pt in _points(spec)])  # type: ignore[index]
+    frame = frame.drop(columns=[c for c in frame.columns if c.startswith("_")])
     meta = {
-        "tslip_version": __version__, "git": git_hash(), "study": spec.to_dict(),
-        "points": n_total, "computed": n_total - n_cached, "cached": n_cached,
-        "seconds": time.perf_counter() - t_start, "workers": n_workers,
+        "tslip_version": __version__, "code": code_version(spec.analyses), "git": git_hash(),
+        "study": spec.to_dict(), "points": n_total, "computed": n_total - n_cached,
+        "cached": n_cached, "seconds": time.perf_counter() - t_start, "workers": n_workers,
         "scheduler": scheduler, "tol": float(spec.meta.get("tol", 1e-10)),
     }
-    if out_dir is not None:
-        out = Path(out_dir)
+    if out is not None:
         write_table(frame, out / "results.parquet")
         if csv:
             write_table(frame, out / "results.csv")
         write_json(out / "run.json", meta)
     return StudyResult(spec, frame, meta)
+
+
+def _keep(cache: Path | None, keys: list[str], old: list[dict[str, Any] | None],
+          new: list[dict[str, Any]], tick: Callable[[int], None]) -> None:
+    """Cache the new points of a line that ran where the cache is not (Dask)."""
+    fresh = [(k, r) for k, o, r in zip(keys, old, new) if o is None]
+    if cache is not None:
+        for k, r in fresh:
+            _save(cache, k, r)
+    tick(len(fresh))
 
 
 def _points(spec: StudySpec) -> list[tuple[float, ...]]:
@@ -407,7 +328,12 @@ def _chains(spec: StudySpec) -> tuple[list[int | None], list[list[int]]]:
 
 
 class _Serial:
-    """Runs each task when submitted; same interface as the pools below."""
+    """Runs each line when submitted, in this process."""
+
+    writes = True  #: the tasks write the cache themselves
+
+    def __init__(self, tick: Callable[[int], None]) -> None:
+        self.tick = tick
 
     def __enter__(self) -> _Serial:
         return self
@@ -417,61 +343,85 @@ class _Serial:
 
     def submit(self, fn: Callable, *args: Any) -> cf.Future:
         fut: cf.Future = cf.Future()
-        fut.set_result(fn(*args))
+        fut.set_result(fn(*args, self.tick))
         return fut
 
-    @staticmethod
-    def wait_first(futs: list) -> list:
+    def wait_first(self, futs: list) -> list:
         return futs
+
+    def poll(self) -> None:
+        return None
 
 
 class _Pool(_Serial):
-    def __init__(self, n: int) -> None:
-        ctx = mp.get_context("spawn")  # numba threads and fork do not mix
-        self.pool = cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx,
-                                           initializer=_init_worker)
+    """Worker processes (:func:`tslip.sweeps._pool.process_pool`); progress by queue."""
+
+    def __init__(self, n: int, tick: Callable[[int], None]) -> None:
+        super().__init__(tick)
+        self.n = n
+        self.stack = ExitStack()
 
     def __enter__(self) -> _Pool:
+        self.queue = _pool.progress_queue()
+        self.pool = self.stack.enter_context(_pool.process_pool(self.n, self.queue))
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.pool.shutdown(wait=True, cancel_futures=True)
+    def __exit__(self, *exc: Any) -> None:
+        self.stack.__exit__(*exc)
+        self.queue.close()
 
     def submit(self, fn: Callable, *args: Any) -> cf.Future:
         return self.pool.submit(fn, *args)
 
-    @staticmethod
-    def wait_first(futs: list) -> list:
-        return list(cf.wait(futs, return_when=cf.FIRST_COMPLETED).done)
+    def wait_first(self, futs: list) -> list:
+        return list(cf.wait(futs, timeout=0.2, return_when=cf.FIRST_COMPLETED).done)
+
+    def poll(self) -> None:
+        n = 0
+        try:
+            while True:
+                n += self.queue.get_nowait()
+        except (queue_mod.Empty, OSError, ValueError):
+            pass
+        if n:
+            self.tick(n)
 
 
 class _Dask(_Serial):
-    def __init__(self, address: str) -> None:
+    writes = False  # the cluster may not see the cache: this process writes it
+
+    def __init__(self, address: str, tick: Callable[[int], None]) -> None:
+        super().__init__(tick)
         try:
             from dask.distributed import Client
         except ImportError:
             raise ValueError("--scheduler needs Dask: pip install 'tslip[dask]'") from None
         self.client = Client(address)
+        self.futures: list = []
 
     def __enter__(self) -> _Dask:
         return self
 
     def __exit__(self, *exc: object) -> None:
+        if exc[0] is not None:
+            self.client.cancel(self.futures)
         self.client.close()
 
     def submit(self, fn: Callable, *args: Any) -> Any:
-        return self.client.submit(fn, *args, pure=False)
+        fut = self.client.submit(fn, *args, pure=False)
+        self.futures.append(fut)
+        return fut
 
-    @staticmethod
-    def wait_first(futs: list) -> list:
+    def wait_first(self, futs: list) -> list:
         from dask.distributed import wait
 
         return list(wait(futs, return_when="FIRST_COMPLETED").done)
 
 
-def _executor(scheduler: str | None, workers: int, n_lines: int) -> _Serial:
+def _executor(scheduler: str | None, workers: int, n_lines: int,
+              tick: Callable[[int], None]) -> _Serial:
     if scheduler is not None:
-        return _Dask(scheduler)
+        return _Dask(scheduler, tick)
     if workers == 1 or n_lines <= 1:
-        return _Serial()
-    return _Pool(min(workers, n_lines))
+        return _Serial(tick)
+    return _Pool(min(workers, n_lines), tick)

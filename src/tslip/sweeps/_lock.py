@@ -1,0 +1,87 @@
+"""One writer per study folder: ``folder/.lock``.
+
+The lock is an advisory ``flock`` on ``folder/.lock``; the file holds the
+holder's pid, host and start time. The kernel releases the lock when its
+process ends, however it ends, so a crashed or killed run never blocks the
+next one: its lock is stale, and the next run takes it over (and says so,
+naming the old pid). A run that ends normally empties the file. The file is
+never deleted: deleting a locked file lets two later runs lock two
+different files.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import socket
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - Windows: no locking
+    fcntl = None  # type: ignore[assignment]
+
+__all__ = ["FolderLocked", "folder_lock"]
+
+log = logging.getLogger("tslip")
+
+
+class FolderLocked(ValueError):
+    """Another run holds the study folder (one line: the folder and the holder)."""
+
+
+def _holder(fd: int) -> dict:
+    os.lseek(fd, 0, os.SEEK_SET)
+    text = os.read(fd, 4096).decode(errors="replace").strip()
+    try:
+        return json.loads(text) if text else {}
+    except ValueError:
+        return {"pid": "?", "host": "?", "started": text[:40]}
+
+
+def _describe(h: dict) -> str:
+    return f"pid {h.get('pid', '?')} on {h.get('host', '?')} (started {h.get('started', '?')})"
+
+
+@contextmanager
+def folder_lock(folder: str | Path, *, wait: bool = False) -> Iterator[None]:
+    """Hold ``folder/.lock`` for the block.
+
+    Raises
+    ------
+    FolderLocked
+        If another live process holds it and ``wait`` is false; with ``wait``
+        the call blocks until that process ends.
+    """
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    fd = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        if fcntl is not None:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                who = _describe(_holder(fd))
+                if not wait:
+                    raise FolderLocked(f"study folder {folder} is in use by {who}; wait "
+                                       "for that run to finish (or pass --wait)") from None
+                log.warning("waiting for %s to release %s", who, folder)
+                fcntl.flock(fd, fcntl.LOCK_EX)
+        old = _holder(fd)
+        if old:  # the last holder ended without releasing: crashed or killed
+            log.warning("taking over the stale lock on %s from %s, which is no longer "
+                        "running", folder, _describe(old))
+        info = {"pid": os.getpid(), "host": socket.gethostname(),
+                "started": time.strftime("%Y-%m-%d %H:%M:%S")}
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, json.dumps(info).encode(), 0)
+        try:
+            yield
+        finally:
+            os.ftruncate(fd, 0)
+    finally:
+        os.close(fd)

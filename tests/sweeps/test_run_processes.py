@@ -1,0 +1,195 @@
+"""Processes: no worker outlives a killed parent; Ctrl-C ends quietly with a resume line;
+one writer per study folder."""
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import psutil
+import pytest
+
+import tslip
+from tslip.sweeps import Axis, StudySpec, run_study
+from tslip.sweeps._lock import FolderLocked, folder_lock
+
+# a 2-D study of 5 lines of 13 points: the line at the base value v0 = 5 first, then
+# two continuation chains (v0 = 4.5; v0 = 5.5, 6, 6.5) in two workers, one soon idle
+_TOML = """name = "grid"
+preset = "table2.1-local-velocity"
+analyses = ["floquet"]
+[[axis]]
+param = "v0"
+values = [4.5, 5.0, 5.5, 6.0, 6.5]
+[[axis]]
+param = "k"
+from = 20.0
+to = 26.0
+points = 13
+"""
+
+_SCRIPT = """
+import sys
+from tslip.sweeps import StudySpec, run_study
+run_study(StudySpec.from_toml(sys.argv[1]), sys.argv[2], workers=2)
+"""
+
+
+def _env():
+    src = str(Path(tslip.__file__).parents[1])
+    return {**os.environ, "PYTHONPATH": src + os.pathsep + os.environ.get("PYTHONPATH", "")}
+
+
+def _wait_for(cond, timeout=240.0):
+    t0 = time.monotonic()
+    while not cond():
+        if time.monotonic() - t0 > timeout:
+            raise TimeoutError
+        time.sleep(0.1)
+
+
+def _n_cached(out: Path) -> int:
+    cache = out / "cache"
+    # not ".<key>.json.<random>.json": a write that the kill interrupted
+    return len([f for f in cache.glob("*.json") if not f.name.startswith(".")]) \
+        if cache.is_dir() else 0
+
+
+def _wait_gone(procs, seconds=10.0):
+    """The processes still alive after up to ``seconds`` (the resource tracker ends last)."""
+    deadline = time.monotonic() + seconds
+    while _alive(procs) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    return _alive(procs)
+
+
+def _alive(procs):
+    out = []
+    for p in procs:
+        try:
+            if p.status() != psutil.STATUS_ZOMBIE:
+                out.append(p)
+        except psutil.NoSuchProcess:
+            pass
+    return out
+
+
+def test_sigkill_of_the_parent_ends_its_workers_and_the_study_resumes(tmp_path):
+    spec_file = tmp_path / "grid.toml"
+    spec_file.write_text(_TOML)
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-c", _SCRIPT, str(spec_file), str(out)],
+                            env=_env(), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    parent = psutil.Process(proc.pid)
+    try:  # the root line (13 points) is done and both chains are running
+        _wait_for(lambda: _n_cached(out) >= 15 and len(parent.children(recursive=True)) >= 2)
+        children = parent.children(recursive=True)
+    finally:
+        proc.kill()
+        proc.wait()
+    assert len(children) >= 2
+    assert not _wait_gone(children)
+    # the points the killed run saved are reused, and the result is exactly the full run's
+    spec = StudySpec.from_toml(spec_file)
+    saved = _n_cached(out)
+    resumed = run_study(spec, out, workers=1)
+    assert resumed.meta["cached"] == saved and 15 <= saved < spec.n_points
+    full = run_study(spec, tmp_path / "full", workers=1)
+    pd.testing.assert_frame_equal(full.frame.drop(columns="seconds"),
+                                  resumed.frame.drop(columns="seconds"), check_exact=True)
+
+
+def test_ctrl_c_prints_one_resume_line_and_exits_130(tmp_path):
+    spec_file = tmp_path / "grid.toml"
+    spec_file.write_text(_TOML)
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-m", "tslip.cli", "study", str(spec_file),
+                             "--out", str(out), "--workers", "2"], env=_env(),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    try:  # the first two lines are done: one worker is busy, the other idle
+        _wait_for(lambda: _n_cached(out) >= 28)
+        children = psutil.Process(proc.pid).children(recursive=True)
+        os.killpg(proc.pid, signal.SIGINT)  # as a terminal does: the whole process group
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err
+    m = re.search(r"^(\d+) of 65 points saved; rerun the same command to resume$", err,
+                  re.MULTILINE)
+    assert m, err
+    assert int(m.group(1)) == _n_cached(out) >= 28
+    assert not _wait_gone(children)
+
+
+def test_second_run_on_a_locked_folder_is_refused_in_one_line(tmp_path):
+    spec = StudySpec("one", tslip.preset("table2.1"), (Axis("v0", (5.0,)),))
+    with folder_lock(tmp_path):
+        with pytest.raises(FolderLocked) as exc:
+            run_study(spec, tmp_path, workers=1)
+    msg = str(exc.value)
+    assert str(tmp_path) in msg and f"pid {os.getpid()}" in msg and "\n" not in msg
+    assert not (tmp_path / "cache").exists()  # it computed nothing
+    run_study(spec, tmp_path, workers=1)  # released: the folder is free again
+
+
+def test_lock_of_a_killed_run_is_stale_and_taken_over(tmp_path, caplog):
+    code = ("import os, sys\nfrom tslip.sweeps._lock import folder_lock\n"
+            "with folder_lock(sys.argv[1]):\n    os.kill(os.getpid(), 9)\n")
+    proc = subprocess.run([sys.executable, "-c", code, str(tmp_path)], env=_env(),
+                          timeout=60)
+    assert proc.returncode == -9
+    dead = int(re.search(r'"pid": (\d+)', (tmp_path / ".lock").read_text()).group(1))
+    with caplog.at_level("WARNING", logger="tslip"), folder_lock(tmp_path):
+        pass
+    assert [f"pid {dead}" in r.getMessage() and "stale" in r.getMessage()
+            for r in caplog.records] == [True]
+    with caplog.at_level("WARNING", logger="tslip"), folder_lock(tmp_path):
+        pass  # released cleanly last time: nothing to report
+    assert len(caplog.records) == 1
+
+
+def test_idle_workers_ignore_sigint_and_the_parent_stops_them():
+    from tslip.sweeps._pool import process_pool
+
+    with process_pool(2) as pool:
+        assert list(pool.map(abs, [-1, -2])) == [1, 2]
+        workers = list(pool._processes.values())
+        for w in workers:  # Ctrl-C reaches the whole process group, idle workers included
+            os.kill(w.pid, signal.SIGINT)
+        time.sleep(1.0)
+        assert all(w.is_alive() for w in workers)
+        assert pool.submit(abs, -3).result(timeout=60) == 3
+        with pytest.raises(KeyboardInterrupt):  # the parent's Ctrl-C
+            with process_pool(2) as inner:
+                inner.submit(time.sleep, 60)
+                inner_workers = list(inner._processes.values())
+                raise KeyboardInterrupt
+    assert not any(w.is_alive() for w in inner_workers)  # stopped, not waited for
+
+
+def test_wait_blocks_until_the_holder_releases(tmp_path, caplog):
+    import threading
+
+    got = threading.Event()
+
+    def second():
+        with folder_lock(tmp_path, wait=True):
+            got.set()
+
+    with caplog.at_level("WARNING", logger="tslip"):
+        with folder_lock(tmp_path):
+            t = threading.Thread(target=second)
+            t.start()
+            _wait_for(lambda: any("waiting for" in r.getMessage() for r in caplog.records),
+                      timeout=30)
+            assert not got.is_set()  # still held here
+        t.join(timeout=30)
+    assert got.is_set()
+    assert f"pid {os.getpid()}" in caplog.records[0].getMessage()
