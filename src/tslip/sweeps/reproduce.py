@@ -16,6 +16,8 @@ that Dask cluster instead.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import dataclasses
+import itertools
 import multiprocessing as mp
 import os
 import time
@@ -23,14 +25,24 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..gait import find_gait, floquet, robustness_report, stride_properties
+from ..gait.fixed_point import Gait, GaitProblem, newton_solve
+from ..gait.robustness import robustness
 from ..model.parameters import preset
+from ..simulation.options import IntegratorOptions
 from . import catalogue
 from .claims import ClaimResult, evaluate
 from .run import StudyResult, _init_worker, run_study
 from .spec import StudySpec
 
-__all__ = ["run_all", "run_catalogue", "single_figures", "table61"]
+__all__ = ["alphad_ref_forced", "pitch_rate_variants", "run_all", "run_catalogue",
+           "single_figures", "table61"]
+
+#: Table 6.1's printed values that do not reproduce (Section 6.1, CONVENTIONS.md).
+THESIS_ALPHAD_REF = 2.42
+THESIS_PITCH_RATE = -1.50
 
 #: ``progress(stage, name, seconds)`` after each study or figure.
 Progress = Callable[[str, str, float], None]
@@ -98,8 +110,59 @@ def _warm_up() -> None:
     robustness_report(g, n_steps=2, check=False)
 
 
-def table61() -> dict[str, float]:
-    """Table 6.1 gait: multipliers, robustness (Section 6.1), stride (Table 6.2)."""
+def pitch_rate_variants(gait: Gait) -> dict[str, float]:
+    """Table 6.1's pitch-rate limit under each placement, sign and setting tried.
+
+    The thesis prints -1.50 rad g^1/2 L^-1/2 and says only "the largest
+    disturbance from the periodic limit cycle which does not result in a
+    fall within 25 steps" (Section 3.1.3). The default (CONVENTIONS.md) is
+    the first label; the others change one choice each: where the change
+    is applied (:data:`tslip.gait.robustness.PLACEMENTS`), its sign, the
+    strides to survive (50) and the integrator tolerance (1e-12). Labels
+    read ``"<placement>, <sign>[, <setting>]"``.
+    """
+    out: dict[str, float] = {}
+    for placement in ("touchdown", "touchdown_hip", "liftoff", "apex"):
+        for sign, mark in ((-1, "-"), (1, "+")):
+            out[f"{placement}, {mark}"] = robustness(gait, "pitch_rate", sign=sign,
+                                                     placement=placement, check=False)
+    out["touchdown, -, 50 strides"] = robustness(gait, "pitch_rate", n_steps=50, check=False)
+    out["touchdown, -, tol 1e-12"] = robustness(gait, "pitch_rate", check=False,
+                                                options=IntegratorOptions.tight())
+    return out
+
+
+def alphad_ref_forced(gait: Gait, alphad_ref: float = THESIS_ALPHAD_REF) -> dict[str, float]:
+    """Force the local velocity controller's ``alphad_ref`` and solve the rest of the gait.
+
+    With ``alphad_ref`` fixed the search of Section 2.8 has four unknowns
+    (``delta, phi, phid, alpha_r``) for five periodicity equations, so it is
+    solved in the least-squares sense (:func:`tslip.gait.fixed_point.newton_solve`,
+    from the free gait and the automatic guesses). ``residual`` is the
+    max-norm of the periodicity residual left (as :attr:`Gait.residual`),
+    ``c1`` its eq. 2.20 cost (the thesis accepted ``C1 < 1e-4``); ``free``
+    is our solved ``alphad_ref``.
+    """
+    p = gait.params
+    forced = dataclasses.replace(p, controller=dataclasses.replace(p.controller,
+                                                                   alphad_ref=alphad_ref))
+    names = ("delta", "phi", "phid", "alpha_r")
+    prob = GaitProblem(params=forced, options=IntegratorOptions.tight(), names=names)
+    z0 = GaitProblem.from_params(p).encode(gait)[:4]
+    z, err, _ = newton_solve(prob.residual, itertools.chain([z0], prob.guesses()), tol=1e-10,
+                             max_starts=5)
+    c1 = float(np.sum(prob.residual(z) ** 2)) if z is not None else float("inf")
+    return {"alphad_ref": float(alphad_ref), "residual": float(err), "c1": c1,
+            "free": float(p.controller.alphad_ref)}
+
+
+def table61() -> dict[str, Any]:
+    """Table 6.1 gait: multipliers, robustness (Section 6.1), stride (Table 6.2).
+
+    Also the evidence for the two numbers that do not reproduce: the
+    pitch-rate limit under every variant tried (:func:`pitch_rate_variants`)
+    and the residual left with the thesis's ``alphad_ref`` (:func:`alphad_ref_forced`).
+    """
     g = find_gait(preset("table6.1"))
     fl = floquet(g)
     rr = robustness_report(g, check=False)
@@ -108,7 +171,9 @@ def table61() -> dict[str, float]:
             "step_down": rr.step_down, "push": rr.push, "pitch_rate": rr.pitch_rate,
             "stance_time": sp.stance_time, "flight_time": sp.flight_time,
             "duty_factor": sp.duty_factor, "step_frequency": sp.step_frequency,
-            "alphad_ref": g.params.controller.alphad_ref, "alpha_r": g.params.alpha_r}
+            "alphad_ref": g.params.controller.alphad_ref, "alpha_r": g.params.alpha_r,
+            "pitch_rate_variants": pitch_rate_variants(g),
+            "alphad_ref_forced": alphad_ref_forced(g)}
 
 
 def single_figures(quick: bool = False, progress: Progress | None = None) -> dict[str, Any]:
