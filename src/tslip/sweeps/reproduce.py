@@ -20,6 +20,7 @@ import dataclasses
 import itertools
 import multiprocessing as mp
 import os
+import pickle
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -27,6 +28,8 @@ from typing import Any
 
 import numpy as np
 
+from .._codehash import code_hash
+from .._io import atomic_write
 from ..gait import find_gait, floquet, robustness_report, stride_properties
 from ..gait.fixed_point import Gait, GaitProblem, newton_solve
 from ..gait.robustness import robustness
@@ -37,12 +40,22 @@ from .claims import ClaimResult, evaluate
 from .run import StudyResult, _init_worker, run_study
 from .spec import StudySpec
 
-__all__ = ["alphad_ref_forced", "pitch_rate_variants", "run_all", "run_catalogue",
-           "single_figures", "table61"]
+__all__ = ["alphad_ref_forced", "appendix_e_cached", "pitch_rate_variants", "run_all",
+           "run_catalogue", "single_figures", "table61"]
 
 #: Table 6.1's printed values that do not reproduce (Section 6.1, CONVENTIONS.md).
 THESIS_ALPHAD_REF = 2.42
 THESIS_PITCH_RATE = -1.50
+
+#: The modules that compute Appendix E's data: their code hash keys its cache.
+APPENDIX_E_MODULES: tuple[str, ...] = ("tslip.sweeps.appendix_e",)
+#: Appendix E settings per resolution (:func:`tslip.sweeps.appendix_e.fig_appendix_e`):
+#: the Table E.2 perturbations cost about 2 s each (the falling runs are stiff).
+APPENDIX_E_SETTINGS: dict[str, dict[str, Any]] = {
+    "tiny": {"n_strides": 4, "n_converged": 3, "n_random": 1, "one_at_a_time": False},
+    "quick": {"n_random": 10},
+    "full": {"n_random": 20},
+}
 
 #: ``progress(stage, name, seconds)`` after each study or figure.
 Progress = Callable[[str, str, float], None]
@@ -52,13 +65,14 @@ def _run_one(spec: StudySpec, out: str) -> StudyResult:
     return run_study(spec, out, workers=1)
 
 
-def run_catalogue(out_dir: str | Path, *, quick: bool = False, workers: int | None = None,
+def run_catalogue(out_dir: str | Path, *, quick: bool | str = False, workers: int | None = None,
                   scheduler: str | None = None, progress: Progress | None = None,
                   names: list[str] | None = None,
                   side_job: Callable[[], Any] | None = None) -> tuple[dict[str, StudyResult], Any]:
     """Run (or load from cache) the catalogue's studies; optionally a side job meanwhile.
 
-    Returns the results by study name and the side job's return value.
+    ``quick`` is True/False or a :data:`tslip.sweeps.catalogue.RESOLUTIONS`
+    name. Returns the results by study name and the side job's return value.
     """
     specs = catalogue.studies(quick)
     if names is not None:
@@ -176,19 +190,53 @@ def table61() -> dict[str, Any]:
             "alphad_ref_forced": alphad_ref_forced(g)}
 
 
-def single_figures(quick: bool = False, progress: Progress | None = None) -> dict[str, Any]:
-    """The single-gait analyses (Figures 4.1-4.7, 6.2, C.1, E.2-E.4) and Table 6.1's numbers."""
+def appendix_e_cached(out_dir: str | Path, resolution: str = "full") -> dict[str, Any]:
+    """Appendix E's data, from ``out_dir/figures/appendix_e-<resolution>.pkl`` if still valid.
+
+    The cache is keyed by :func:`tslip._codehash.code_hash` of
+    :data:`APPENDIX_E_MODULES` (their sources, everything they import from
+    tslip, and the numerical libraries' versions) and the settings: a rerun
+    reuses it, a change to the biped code recomputes it. Written atomically.
+    """
+    from .appendix_e import fig_appendix_e
+
+    settings = APPENDIX_E_SETTINGS[catalogue.resolution_name(resolution)]
+    key = f"{code_hash(*APPENDIX_E_MODULES)}:{sorted(settings.items())!r}"
+    path = Path(out_dir) / "figures" / f"appendix_e-{resolution}.pkl"
+    try:
+        cached = pickle.loads(path.read_bytes())
+        if isinstance(cached, dict) and cached.get("key") == key:
+            return cached["data"]
+    except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ImportError):
+        pass  # missing or unreadable: recompute
+    data = fig_appendix_e(**settings)
+    blob = pickle.dumps({"key": key, "data": data}, protocol=pickle.HIGHEST_PROTOCOL)
+    atomic_write(path, lambda tmp: Path(tmp).write_bytes(blob))
+    return data
+
+
+def single_figures(quick: bool | str = False, progress: Progress | None = None,
+                   out_dir: str | Path | None = None) -> dict[str, Any]:
+    """The single-gait analyses (Figures 4.1-4.7, 6.2, C.1, E.2-E.4) and Table 6.1's numbers.
+
+    ``quick`` is True/False or a :data:`tslip.sweeps.catalogue.RESOLUTIONS`
+    name; with ``out_dir`` Appendix E's data is cached there
+    (:func:`appendix_e_cached`).
+    """
+    res = catalogue.resolution_name(quick)
+    coarse = res != "full"
     jobs: dict[str, Callable[[], Any]] = {
         "4.1": catalogue.fig_impulse_linearisation,
         "4.2": lambda: catalogue.fig_pitch_disturbance("table2.1"),
         "4.3": lambda: catalogue.fig_pitch_disturbance("table2.1-global-pd"),
         "6.2": lambda: catalogue.fig_pitch_disturbance("table6.1"),
-        "4.4": lambda: catalogue.fig_height_change(quick),
+        "4.4": lambda: catalogue.fig_height_change(coarse),
         "4.5": catalogue.fig_step_down,
         "4.7": catalogue.fig_velocity_angle,
         "C.1": catalogue.fig_friction,
         "table6.1": table61,
-        "E": catalogue.fig_appendix_e,
+        "E": (lambda: appendix_e_cached(out_dir, res)) if out_dir is not None
+        else lambda: catalogue.fig_appendix_e(**APPENDIX_E_SETTINGS[res]),
     }
     out = {}
     for key, job in jobs.items():
@@ -200,8 +248,8 @@ def single_figures(quick: bool = False, progress: Progress | None = None) -> dic
 
 
 def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = None,
-            scheduler: str | None = None,
-            progress: Progress | None = None) -> tuple[dict[str, Any], list[ClaimResult], float]:
+            scheduler: str | None = None, progress: Progress | None = None,
+            resolution: str | None = None) -> tuple[dict[str, Any], list[ClaimResult], float]:
     """Run every thesis study and figure; return the data, the claims and the seconds.
 
     The report itself is written by :func:`tslip.plotting.report.reproduce`
@@ -210,7 +258,8 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
     Parameters
     ----------
     out_dir : path
-        Report folder; studies are cached in ``out_dir/studies/<name>/``.
+        Report folder; studies are cached in ``out_dir/studies/<name>/``,
+        Appendix E in ``out_dir/figures/``.
     quick : bool
         Coarse resolution (12 points a line, 6 x 6 grids) instead of the full
         one (50 points, 40 x 40).
@@ -220,12 +269,24 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
         Dask scheduler address for the studies.
     progress : callable, optional
         ``progress(stage, name, seconds)`` after each study and figure.
+    resolution : {"tiny", "quick", "full"}, optional
+        Overrides ``quick``; ``"tiny"`` (4 points a line, 3 x 3 grids, a
+        short Appendix E) tests the pipeline, its numbers are not meant to be read.
+
+    Returns
+    -------
+    data : dict
+        Study results and figure data by key, plus ``"quick"`` (not full
+        resolution) and ``"resolution"`` (its name).
+    claims : list of ClaimResult
+    seconds : float
     """
     t0 = time.perf_counter()
+    res = catalogue.resolution_name(quick if resolution is None else resolution)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    results, figures = run_catalogue(out, quick=quick, workers=workers, scheduler=scheduler,
+    results, figures = run_catalogue(out, quick=res, workers=workers, scheduler=scheduler,
                                      progress=progress,
-                                     side_job=lambda: single_figures(quick, progress))
-    data: dict[str, Any] = {**results, **figures}
+                                     side_job=lambda: single_figures(res, progress, out))
+    data: dict[str, Any] = {**results, **figures, "quick": res != "full", "resolution": res}
     return data, evaluate(data), time.perf_counter() - t0
