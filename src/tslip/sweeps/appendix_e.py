@@ -55,15 +55,16 @@ def table_e2_perturbations(n_random: int = 20, seed: int = 0,
     return np.array(rows).reshape(-1, len(y))
 
 
-def fig_appendix_e(n_strides: int = 20, n_converged: int = 50, n_random: int = 20,
-                   one_at_a_time: bool = True,
+def fig_appendix_e(n_strides: int = 20, n_converged: int = 50, n_random: int = 0,
+                   one_at_a_time: bool = False,
                    min_contact: float | None = None) -> dict[str, Any]:
     """Appendix E, the two-legged model: Figures E.2-E.4 and Section E.4's numbers.
 
     ``"e2"``: the run from Table E.2 (full strides until fall, of
     ``n_strides`` right contacts; ``strides_raw`` counts scuffs too), the
     counts from starts perturbed within Table E.2's rounding
-    (``strides_perturbed``, :func:`table_e2_perturbations`), the minimum
+    (``strides_perturbed``, :func:`table_e2_perturbations`; none by default:
+    each costs about 2 s, the falling runs being stiff), the minimum
     contact used (``min_contact`` [g^-1/2 L^1/2], default
     :func:`tslip.biped.simulate.default_min_contact`),
     its Floquet multipliers at that (non-periodic) start, and the tracking

@@ -57,7 +57,7 @@ QUICK_GRID, FULL_GRID = 6, 40
 #: Resolutions by name: (points per 1-D sweep, per grid axis). ``"tiny"`` is
 #: for testing the whole pipeline, not for reading numbers off.
 RESOLUTIONS: dict[str, tuple[int, int]] = {
-    "tiny": (4, 3), "quick": (QUICK_LINE, QUICK_GRID), "full": (FULL_LINE, FULL_GRID)}
+    "tiny": (3, 3), "quick": (QUICK_LINE, QUICK_GRID), "full": (FULL_LINE, FULL_GRID)}
 
 
 def resolution_name(resolution: bool | str) -> str:

@@ -53,8 +53,8 @@ APPENDIX_E_MODULES: tuple[str, ...] = ("tslip.sweeps.appendix_e",)
 #: the Table E.2 perturbations cost about 2 s each (the falling runs are stiff).
 APPENDIX_E_SETTINGS: dict[str, dict[str, Any]] = {
     "tiny": {"n_strides": 4, "n_converged": 3, "n_random": 1, "one_at_a_time": False},
-    "quick": {"n_random": 10},
-    "full": {"n_random": 20},
+    "quick": {"n_random": 10, "one_at_a_time": True},
+    "full": {"n_random": 20, "one_at_a_time": True},
 }
 
 #: ``progress(stage, name, seconds)`` after each study or figure.
@@ -270,7 +270,7 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
     progress : callable, optional
         ``progress(stage, name, seconds)`` after each study and figure.
     resolution : {"tiny", "quick", "full"}, optional
-        Overrides ``quick``; ``"tiny"`` (4 points a line, 3 x 3 grids, a
+        Overrides ``quick``; ``"tiny"`` (3 points a line, 3 x 3 grids, a
         short Appendix E) tests the pipeline, its numbers are not meant to be read.
 
     Returns
