@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
 import pytest
 
 from tslip.plotting.report import SECTIONS, write_report
@@ -132,3 +133,33 @@ def test_reproduce_end_to_end_tiny(tmp_path, monkeypatch) -> None:
     rows = json.loads((tmp_path / "claims.json").read_text())
     assert len(rows) == len(claims)
     assert all("verdict" in r and "evidence" in r for r in rows)
+
+
+#: Table E.2 as printed (positions, then velocities, STATE_FIELDS order).
+TABLE_E2_PRINTED = ("0.000", "0.514", "-0.290", "0.700", "0.300", "-0.351", "0.370", "0.300",
+                    "0.690", "1.898", "-0.079", "0.202", "-0.012", "-0.886", "1.6282", "-0.997",
+                    "-0.136", "-2.9350")
+
+
+def test_table_e2_perturbations_stay_within_the_printed_rounding() -> None:
+    from tslip.biped import BipedState
+    from tslip.sweeps.appendix_e import table_e2_perturbations
+
+    y = BipedState.thesis().to_array()
+    np.testing.assert_array_equal(y, [float(v) for v in TABLE_E2_PRINTED])
+    half = np.array([0.5 * 10.0 ** -len(v.split(".")[1]) for v in TABLE_E2_PRINTED])
+    rows = table_e2_perturbations(n_random=5, seed=1, one_at_a_time=True)
+    assert rows.shape == (2 * 17 + 5, 18)
+    d = rows - y
+    # one at a time: entry i (x_b excepted) moved by -half, then +half
+    for k in range(34):
+        i = 1 + k // 2
+        expected = np.zeros(18)
+        expected[i] = (-1 if k % 2 == 0 else 1) * half[i]
+        np.testing.assert_allclose(d[k], expected, atol=1e-15)
+    # corners: every entry but x_b at +-half, reproducible by seed
+    np.testing.assert_allclose(np.abs(d[34:, 1:]), np.broadcast_to(half[1:], (5, 17)),
+                               rtol=1e-9)
+    assert np.all(d[34:, 0] == 0)
+    np.testing.assert_array_equal(rows, table_e2_perturbations(5, seed=1))
+    assert table_e2_perturbations(0, one_at_a_time=False).shape == (0, 18)
