@@ -4,7 +4,16 @@
 cached under ``out_dir/studies/<name>/``, so a rerun is instant and an
 interrupted one resumes), computes the single-gait figures, evaluates
 :data:`tslip.sweeps.claims.CLAIMS`; :func:`tslip.plotting.report.reproduce`
-then writes ``out_dir/index.html``.
+then writes ``out_dir/index.html``. Appendix E (the biped, the slowest
+figure) is cached too, in ``out_dir/figures/``, keyed by the hash of the
+code that computes it (:func:`appendix_e_cached`).
+
+Where a thesis number does not reproduce, the data carry the evidence the
+package computes: Table 6.1's pitch-rate limit under every placement and
+setting tried (``data["table6.1"]["pitch_rate_variants"]``), the residual
+left with the thesis's ``alphad_ref`` forced (``["alphad_ref_forced"]``),
+and Appendix E's stride count for starts within Table E.2's rounding
+(``data["E"]["e2"]["strides_perturbed"]``).
 
 Parallelism: most studies are one continuation line, so the studies
 themselves are the unit of work: they run in spawned worker processes (one
