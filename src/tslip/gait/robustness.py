@@ -16,6 +16,28 @@ follows CONVENTIONS.md, "Disturbances for robustness"):
 ``"pitch_rate"`` (``dphid`` [rad g^1/2 L^-1/2])
     Added to the pitch rate of the same state, keeping the CoM velocity.
 
+Where the push or pitch-rate change is applied (``placement``): the thesis
+says only "from the periodic limit cycle"; the default ``"touchdown"`` is
+CONVENTIONS.md's. The others exist to show how much the limit depends on
+that choice (Table 6.1's pitch-rate limit does not reproduce):
+
+``"touchdown"``
+    Just after the touch-down that starts stride 0, keeping the CoM velocity.
+``"touchdown_hip"`` (pitch rate only)
+    Just after that touch-down, keeping the *hip* velocity instead: the CoM
+    velocity changes by ``r (cos phi, sin phi) dphid`` (eq. A.5 with the leg
+    rates held).
+``"liftoff"``
+    Just after stride 0's lift-off (its stance undisturbed); the flight is
+    ballistic with constant pitch rate, so the state reaches the next
+    touch-down by the kernels' own flight solution.
+``"apex"``
+    At the apex of stride 0's flight (``yd = 0``; at lift-off if the CoM
+    already falls there); the leg keeps its retraction schedule.
+
+For the two flight placements the runner must then survive ``n_steps``
+strides from the next touch-down; a fall in that flight is a failure.
+
 Signs follow the thesis: with ``sign=-1`` (default) the limits are negative
 (down, backward, negative pitch rate); ``sign=+1`` searches the opposite
 direction (step up, forward push, positive pitch rate).
@@ -51,16 +73,19 @@ from typing import Literal
 
 import numpy as np
 
+from ..model import _pack as pk
 from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..model.terrain import Terrain
-from ..simulation.integrate import BatchRun, run_batch
+from ..simulation import _kernels as kn
+from ..simulation.integrate import BatchRun, run_batch, step
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status
 from .fixed_point import Gait
 
 __all__ = [
     "KINDS",
+    "PLACEMENTS",
     "LimitSearch",
     "RobustnessLimit",
     "RobustnessResult",
@@ -76,6 +101,11 @@ Kind = Literal["step_down", "push", "pitch_rate"]
 #: The three disturbances of thesis Section 3.1.3, in the thesis's order.
 KINDS: tuple[Kind, ...] = ("step_down", "push", "pitch_rate")
 
+Placement = Literal["touchdown", "touchdown_hip", "liftoff", "apex"]
+
+#: Where a push or pitch-rate disturbance can be applied (see the module notes).
+PLACEMENTS: tuple[Placement, ...] = ("touchdown", "touchdown_hip", "liftoff", "apex")
+
 #: Unit of each disturbance (Table 3.1, dimensionless units).
 UNITS: dict[str, str] = {
     "step_down": "L",
@@ -84,6 +114,7 @@ UNITS: dict[str, str] = {
 }
 
 _SECTION_COLUMN = {"push": 2, "pitch_rate": 4}  # xd, phid in TouchdownState.as_array()
+_FLIGHT_COLUMN = {"push": 2, "pitch_rate": 5}  # xd, phid in the lift-off (x, y, xd, yd, phi, phid)
 
 
 # ---------------------------------------------------------------------------
@@ -245,6 +276,7 @@ def run_disturbed(
     *,
     n_steps: int = 25,
     options: IntegratorOptions | None = None,
+    placement: Placement = "touchdown",
 ) -> BatchRun:
     """Run ``n_steps`` strides after each disturbance, in one batch.
 
@@ -260,18 +292,29 @@ def run_disturbed(
         [rad g^1/2 L^-1/2].
     n_steps : int
     options : IntegratorOptions, optional
+    placement : {"touchdown", "touchdown_hip", "liftoff", "apex"}
+        Where a push or pitch-rate change is applied (module notes); a
+        step-down is always ``"touchdown"``.
 
     Returns
     -------
     BatchRun
-        Row ``i`` for ``values[i]``; the same runs as :func:`tslip.simulate`
-        with ``Disturbance(at_step=0, dh=|dxd=|dphid=values[i])``.
+        Row ``i`` for ``values[i]``; with ``"touchdown"`` the same runs as
+        :func:`tslip.simulate` with ``Disturbance(at_step=0, dh=|dxd=|dphid=values[i])``.
+        For the flight placements the rows start at the touch-down after the
+        disturbance; a fall in that flight has ``n_done = 0`` and its status.
     """
     _check_kind(kind)
+    _check_placement(kind, placement)
     d = np.asarray(values, dtype=float).reshape(-1)
     if not np.all(np.isfinite(d)):
         raise ValueError("disturbance values must be finite")
+    if placement in ("liftoff", "apex"):
+        return _run_flight_disturbed(params, state, kind, d, placement, n_steps, options)
     S = np.tile(state.as_array(), (len(d), 1))
+    if placement == "touchdown_hip":  # hip velocity xd - r cos(phi) phid, yd - r sin(phi) phid held
+        S[:, 2] += params.r * math.cos(state.phi) * d
+        S[:, 3] += params.r * math.sin(state.phi) * d
     terrain: list[Terrain] | None = None
     if kind == "step_down":
         xf = state.x + params.l0 * math.cos(state.beta) - params.r * math.sin(state.phi)
@@ -282,9 +325,58 @@ def run_disturbed(
     return run_batch(params, S, n_steps, terrain=terrain, options=options)
 
 
+def _run_flight_disturbed(params: Params, state: TouchdownState, kind: Kind, d: np.ndarray,
+                          placement: str, n_steps: int,
+                          options: IntegratorOptions | None) -> BatchRun:
+    """Stride 0 undisturbed; the change at lift-off or apex; flight; ``n_steps`` strides."""
+    s0 = step(params, state, options=options)
+    if not s0.ok:
+        raise ValueError(f"the undisturbed stride 0 ended: {s0.reason}")
+    lo = np.array([getattr(s0.liftoff, f) for f in ("x", "y", "xd", "yd", "phi", "phid")])
+    P = pk.pack_params(params)
+    O = (options or IntegratorOptions()).packed()  # noqa: E741 - kernels' name
+    fs = np.empty(10)
+    if placement == "apex":
+        t_a = min(max(lo[3], 0.0) / params.g, s0.flight_time)
+        kn.flight_state(P, lo, t_a, fs)
+        lo = fs[:6].copy()
+        P[pk.P_ALPHA] += P[pk.P_OMEGA] * t_a  # the leg's retraction clock keeps running
+    tx, th = Terrain.flat(state.h).arrays()
+    S = np.full((len(d), 7), np.nan)
+    st0 = np.zeros(len(d), dtype=np.int64)
+    res = np.empty(3)
+    for i, di in enumerate(d):
+        lo_i = lo.copy()
+        lo_i[_FLIGHT_COLUMN[kind]] += di
+        st0[i] = kn.find_touchdown(P, O, lo_i, tx, th, res)
+        if st0[i] == Status.OK:
+            kn.flight_state(P, lo_i, res[0], fs)
+            S[i] = (fs[6], fs[4], fs[2], fs[3], fs[5], fs[0], res[1])
+    n = len(d)
+    n_done = np.zeros(n, dtype=np.int64)
+    t_fall = np.full(n, np.nan)
+    hist = np.full((n, int(n_steps) + 1, 7), np.nan)
+    status = st0.copy()
+    ok = st0 == Status.OK
+    if ok.any():
+        run = run_batch(params, S[ok], n_steps, options=options)
+        n_done[ok], status[ok], t_fall[ok], hist[ok] = (run.n_done, run.status, run.t_fall,
+                                                        run.touchdowns)
+    return BatchRun(n_done, status, t_fall, hist)
+
+
 def _check_kind(kind: str) -> None:
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+
+
+def _check_placement(kind: str, placement: str) -> None:
+    if placement not in PLACEMENTS:
+        raise ValueError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
+    if placement != "touchdown" and kind == "step_down":
+        raise ValueError(f"placement must be 'touchdown' for a step-down, got {placement!r}")
+    if placement == "touchdown_hip" and kind != "pitch_rate":
+        raise ValueError(f"placement 'touchdown_hip' is for kind 'pitch_rate', got {kind!r}")
 
 
 def check_gait(gait: Gait) -> None:
@@ -434,6 +526,7 @@ def robustness(
     ladder: int = 8,
     k: int = 3,
     max_magnitude: float = 100.0,
+    placement: Placement = "touchdown",
 ) -> float:
     """Largest disturbance of one kind the gait survives for ``n_steps`` strides.
 
@@ -458,6 +551,8 @@ def robustness(
         Refuse unconverged or unstable gaits (see :func:`check_gait`).
     start, ladder, k, max_magnitude
         Search settings (:func:`limit_search`).
+    placement : {"touchdown", "touchdown_hip", "liftoff", "apex"}
+        Where a push or pitch-rate change is applied (module notes).
 
     Returns
     -------
@@ -483,10 +578,11 @@ def robustness(
     -0.12
     """
     _check_kind(kind)
+    _check_placement(kind, placement)
     if check:
         check_gait(gait)
     return _limit(gait, kind, sign, n_steps=n_steps, tol=tol, options=options, start=start,
-                  ladder=ladder, k=k, max_magnitude=max_magnitude).limit
+                  ladder=ladder, k=k, max_magnitude=max_magnitude, placement=placement).limit
 
 
 def robustness_report(
@@ -502,12 +598,14 @@ def robustness_report(
     ladder: int = 8,
     k: int = 3,
     max_magnitude: float = 100.0,
+    placement: Placement = "touchdown",
 ) -> RobustnessResult:
     """Robustness limits of a gait for several disturbances, with reasons.
 
     Parameters are those of :func:`robustness`; ``kinds`` selects the
     disturbances and ``both_signs`` adds the +1 direction (step up, forward
-    push, positive pitch rate) to the thesis's -1.
+    push, positive pitch rate) to the thesis's -1. ``placement`` applies to
+    the push and pitch-rate searches (a step-down is always at touch-down).
 
     Returns
     -------
@@ -523,12 +621,15 @@ def robustness_report(
     """
     for kind in kinds:
         _check_kind(kind)
+        if kind != "step_down":
+            _check_placement(kind, placement)
     if check:
         check_gait(gait)
     signs = (-1, 1) if both_signs else (-1,)
     limits = tuple(
         _limit(gait, kind, s, n_steps=n_steps, tol=tol, options=options, start=start,
-               ladder=ladder, k=k, max_magnitude=max_magnitude)
+               ladder=ladder, k=k, max_magnitude=max_magnitude,
+               placement="touchdown" if kind == "step_down" else placement)
         for kind in kinds for s in signs
     )
     return RobustnessResult(limits=limits, params=gait.params, state=gait.state,
@@ -538,7 +639,7 @@ def robustness_report(
 
 def _limit(gait: Gait, kind: Kind, sign: int, *, n_steps: int, tol: float,
            options: IntegratorOptions | None, start: float, ladder: int, k: int,
-           max_magnitude: float) -> RobustnessLimit:
+           max_magnitude: float, placement: Placement = "touchdown") -> RobustnessLimit:
     if sign not in (-1, 1):
         raise ValueError(f"sign must be -1 or +1, got {sign!r}")
     if not isinstance(n_steps, (int, np.integer)) or n_steps < 1:
@@ -549,7 +650,7 @@ def _limit(gait: Gait, kind: Kind, sign: int, *, n_steps: int, tol: float,
     def survives(m: np.ndarray) -> np.ndarray:
         nonlocal n_errors
         run = run_disturbed(gait.params, gait.state, kind, sign * m, n_steps=int(n_steps),
-                            options=options)
+                            options=options, placement=placement)
         for mi, st, nd in zip(m, run.status, run.n_done, strict=True):
             outcome[float(mi)] = (int(st), int(nd))
         n_errors += int(np.count_nonzero(run.status >= 10))

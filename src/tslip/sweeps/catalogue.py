@@ -45,7 +45,8 @@ from ..model.parameters import Params, preset
 from .spec import Axis, StudySpec
 
 __all__ = [
-    "Study", "STUDIES", "GLOBAL_PD_TOL", "GRID_SPEEDS", "studies", "study",
+    "Study", "STUDIES", "GLOBAL_PD_TOL", "GRID_SPEEDS", "RESOLUTIONS", "resolution_name",
+    "studies", "study",
     "fig_impulse_linearisation", "fig_pitch_disturbance", "fig_height_change",
     "fig_step_down", "fig_velocity_angle", "fig_friction",
 ]
@@ -57,6 +58,19 @@ GRID_SPEEDS = (2.0, 3.0, 4.0, 5.0)
 #: Points per 1-D sweep and per grid axis.
 QUICK_LINE, FULL_LINE = 12, 50
 QUICK_GRID, FULL_GRID = 6, 40
+#: Resolutions by name: (points per 1-D sweep, per grid axis). ``"tiny"`` is
+#: for testing the whole pipeline, not for reading numbers off.
+RESOLUTIONS: dict[str, tuple[int, int]] = {
+    "tiny": (3, 3), "quick": (QUICK_LINE, QUICK_GRID), "full": (FULL_LINE, FULL_GRID)}
+
+
+def resolution_name(resolution: bool | str) -> str:
+    """``"quick"``/``"full"`` for a bool (quick or not), else the checked name."""
+    if isinstance(resolution, bool):
+        return "quick" if resolution else "full"
+    if resolution not in RESOLUTIONS:
+        raise ValueError(f"resolution must be one of {sorted(RESOLUTIONS)}, got {resolution!r}")
+    return resolution
 ROB = ("floquet", "robustness")
 
 
@@ -68,13 +82,15 @@ class Study:
     figures: tuple[str, ...]
     spec: StudySpec
 
-    def at(self, quick: bool) -> StudySpec:
-        """The spec at quick or full resolution (an axis with one value is held, not swept)."""
+    def at(self, quick: bool | str) -> StudySpec:
+        """The spec at quick (True) or full (False) resolution, or one of :data:`RESOLUTIONS`.
+
+        An axis with one value is held, not swept.
+        """
+        line, grid = RESOLUTIONS[resolution_name(quick)]
         if sum(len(a.values) > 1 for a in self.spec.axes) == 1:
-            n = QUICK_LINE if quick else FULL_LINE
-            return self.spec.with_resolution([n] * len(self.spec.axes))
-        n = QUICK_GRID if quick else FULL_GRID
-        return self.spec.with_resolution([n, n])
+            return self.spec.with_resolution([line] * len(self.spec.axes))
+        return self.spec.with_resolution([grid, grid])
 
 
 def _p(name: str, **kw: Any) -> Params:
@@ -155,12 +171,12 @@ def _build() -> dict[str, Study]:
 STUDIES: dict[str, Study] = _build()
 
 
-def studies(quick: bool = False) -> dict[str, StudySpec]:
-    """All study specs at quick or full resolution, by name."""
+def studies(quick: bool | str = False) -> dict[str, StudySpec]:
+    """All study specs at quick or full resolution (or a :data:`RESOLUTIONS` name), by name."""
     return {name: s.at(quick) for name, s in STUDIES.items()}
 
 
-def study(name: str, quick: bool = False) -> StudySpec:
+def study(name: str, quick: bool | str = False) -> StudySpec:
     """One study spec by name."""
     try:
         return STUDIES[name].at(quick)
@@ -223,36 +239,11 @@ def fig_friction() -> dict[str, Any]:
     return out
 
 
-def fig_appendix_e(n_strides: int = 20, n_converged: int = 50) -> dict[str, Any]:
-    """Appendix E, the two-legged model: Figures E.2-E.4 and Section E.4's numbers.
+def fig_appendix_e(*args: Any, **kwargs: Any) -> dict[str, Any]:
+    """Appendix E, the two-legged model: see :func:`tslip.sweeps.appendix_e.fig_appendix_e`."""
+    from .appendix_e import fig_appendix_e as appendix_e
 
-    ``"e2"``: the run from Table E.2 (strides until fall, of ``n_strides``),
-    its Floquet multipliers at that (non-periodic) start, and the tracking
-    errors over its first stride (Figure E.2). ``"converged"``: the stored
-    periodic gait reached from there (:mod:`tslip.biped.stored`), its
-    residual, multipliers and strides until fall (of ``n_converged``), and
-    the metacentric test of Figure E.4 on it.
-    """
-    from ..biped import BipedParams, BipedState, simulate
-    from ..biped.gait import floquet, to_section, tracking_errors
-    from ..biped.metacentre import metacentric_test
-    from ..biped.stored import load_gait
-
-    p, s = BipedParams(), BipedState.thesis()
-    run = simulate(p, s, n_strides)
-    t1 = float(run.strides[0, 0]) if run.n_strides else float(run.time[-1])
-    fl = floquet(p, to_section(p, s.to_array(), 0.0))
-    pc, yc, tc, _ = load_gait("converged-e2")
-    flc = floquet(pc, to_section(pc, yc, tc))
-    runc = simulate(pc, yc, n_converged, t0=tc)
-    return {
-        "e2": {"run": run, "strides": run.n_strides, "of": n_strides,
-               "reason": run.status.reason, "largest": fl.largest, "residual": fl.residual,
-               "tracking": tracking_errors(run, 0, 0.0, t1)},
-        "converged": {"largest": flc.largest, "residual": flc.residual,
-                      "strides": runc.n_strides, "of": n_converged,
-                      "metacentric": metacentric_test(pc, BipedState.from_array(yc), tc)},
-    }
+    return appendix_e(*args, **kwargs)
 
 
 def replace_spec(spec: StudySpec, **changes: Any) -> StudySpec:
