@@ -152,7 +152,8 @@ def _sens_step(P, method, z, h, K, ztmp, Jf):
 
     A Runge-Kutta method commutes with linearisation, so this is the
     derivative of the computed step; the ``y`` part repeats the stride's
-    arithmetic exactly (:func:`._rk.stage_state` acts elementwise).
+    stage arithmetic (:func:`._rk.stage_state` acts elementwise), with the
+    step sizes recovered from the recorded times.
     """
     _aug_rhs(P, z, K[0], Jf)
     ns = _rk.n_stages(method)
