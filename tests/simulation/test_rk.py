@@ -42,9 +42,9 @@ def rk_step(m, y, h, K):
     ns = _rk.n_stages(m)
     f_osc(y, K[0])
     for s in range(1, ns):
-        _rk.stage_state(m, y, h, K, s, ytmp)
+        _rk.stage_state(m, 2, y, h, K, s, ytmp)
         f_osc(ytmp, K[s])
-    _rk.stage_state(m, y, h, K, ns, ynew)
+    _rk.stage_state(m, 2, y, h, K, ns, ynew)
     f_osc(ynew, K[ns])
     return ynew
 
@@ -53,7 +53,7 @@ def dense(m, y, ynew, h, K):
     ns = _rk.n_stages(m)
     ytmp = np.empty(2)
     for s in range(ns + 1, ns + 1 + _rk.n_extra(m)):
-        _rk.stage_state(m, y, h, K, s, ytmp)
+        _rk.stage_state(m, 2, y, h, K, s, ytmp)
         f_osc(ytmp, K[s])
     R = np.empty((_rk.NR, 2))
     _rk.dense_coeffs(m, y, ynew, h, K, R)
@@ -109,7 +109,7 @@ def test_error_estimate_and_dense_output_orders(name, order, hs):
     y0 = exact(0.3)
     for h in hs:
         y1 = rk_step(m, y0, h, K)
-        est.append(_rk.error_norm(m, y0, y1, h, K, 0.0, 1.0))
+        est.append(_rk.error_norm(m, 2, y0, y1, h, K, 0.0, 1.0))
         R = dense(m, y0, y1, h, K)
         out = np.empty(2)
         _rk.dense_eval(m, R, 0.5, out)
@@ -132,7 +132,7 @@ def test_event_located_on_dense_output(name):
     t, y, h = 0.0, exact(0.0), 0.05
     for _ in range(10_000):
         y1 = rk_step(m, y, h, K)
-        err = _rk.error_norm(m, y, y1, h, K, tol, tol)
+        err = _rk.error_norm(m, 2, y, y1, h, K, tol, tol)
         if err > 1.0:
             h *= _rk.step_factor(m, err, 10.0)
             continue

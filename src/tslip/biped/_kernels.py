@@ -410,9 +410,9 @@ def rk_step(P, method, t, y, h, K, ytmp, ynew, cs, ws, aux, t_end_eval):
     """
     ns = _rk.n_stages(method)
     for s in range(1, ns):
-        _rk.stage_state(method, y, h, K, s, ytmp)
+        _rk.stage_state(method, N, y, h, K, s, ytmp)
         rhs(P, _stage_time(method, s, t, h, t_end_eval), ytmp, cs, K[s], ws, aux)
-    _rk.stage_state(method, y, h, K, ns, ynew)
+    _rk.stage_state(method, N, y, h, K, ns, ynew)
     rhs(P, t_end_eval, ynew, cs, K[ns], ws, aux)
 
 
@@ -422,7 +422,7 @@ def dense_output(P, method, t, y, ynew, h, K, R, ytmp, cs, ws, aux, t_end_eval):
     ns = _rk.n_stages(method)
     ne = _rk.n_extra(method)
     for s in range(ns + 1, ns + 1 + ne):
-        _rk.stage_state(method, y, h, K, s, ytmp)
+        _rk.stage_state(method, N, y, h, K, s, ytmp)
         rhs(P, _stage_time(method, s, t, h, t_end_eval), ytmp, cs, K[s], ws, aux)
     _rk.dense_coeffs(method, y, ynew, h, K, R)
     return ne
@@ -573,7 +573,7 @@ def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
             t_eval = tb - 1e-12 * P[P_T]
         rk_step(P, method, t, y, hstep, K, ytmp, ynew, cs, ws, aux, t_eval)
         nfev += ns
-        err = _rk.error_norm(method, y, ynew, hstep, K, rtol, atol)
+        err = _rk.error_norm(method, N, y, ynew, hstep, K, rtol, atol)
         if not math.isfinite(err):
             err = 1e10
         if err > 1.0:

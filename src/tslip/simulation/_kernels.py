@@ -17,6 +17,8 @@ from numba import njit, prange
 
 from .._kernel_cache import check as _check_cache
 from ..model._pack import (
+    M_DOP853,
+    M_DOPRI5,
     NOUT,
     NREC,
     O_ATOL,
@@ -173,12 +175,23 @@ def rk_step(P, method, y, h, K, ytmp, ynew):
     """One step of size ``h`` from ``y`` with ``K[0] = f(y)`` (see :mod:`._rk`).
 
     Fills the stages ``K[1..ns]`` and ``ynew``; ``K[ns] = f(ynew)`` (FSAL).
+    The branch makes the method a compile-time constant of the inlined stage
+    loop, which the cheap stance right-hand side makes worth it (measurably
+    faster strides at the thesis tolerance, ``benchmarks/bench_rk.py``).
     """
+    if method == M_DOPRI5:
+        _rk_stages(P, M_DOPRI5, y, h, K, ytmp, ynew)
+    else:
+        _rk_stages(P, M_DOP853, y, h, K, ytmp, ynew)
+
+
+@njit(**dict(_JIT, inline="always"))
+def _rk_stages(P, method, y, h, K, ytmp, ynew):
     ns = _rk.n_stages(method)
     for s in range(1, ns):
-        _rk.stage_state(method, y, h, K, s, ytmp)
+        _rk.stage_state(method, NSTATE, y, h, K, s, ytmp)
         rhs(P, ytmp, K[s])
-    _rk.stage_state(method, y, h, K, ns, ynew)
+    _rk.stage_state(method, NSTATE, y, h, K, ns, ynew)
     rhs(P, ynew, K[ns])
 
 
@@ -187,7 +200,7 @@ def dense_output(P, method, y, ynew, h, K, R, ytmp):
     """Continuous extension of the step just taken (extra stages for dop853)."""
     ns = _rk.n_stages(method)
     for s in range(ns + 1, ns + 1 + _rk.n_extra(method)):
-        _rk.stage_state(method, y, h, K, s, ytmp)
+        _rk.stage_state(method, NSTATE, y, h, K, s, ytmp)
         rhs(P, ytmp, K[s])
     _rk.dense_coeffs(method, y, ynew, h, K, R)
 
@@ -281,7 +294,7 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
             status = ST_ERR_STEP_UNDERFLOW
             break
         rk_step(P, method, y, h, K, ytmp, ynew)
-        err = _rk.error_norm(method, y, ynew, h, K, rtol, atol)
+        err = _rk.error_norm(method, NSTATE, y, ynew, h, K, rtol, atol)
         if not math.isfinite(err):
             # a NaN/inf stage: shrink hard, give up below h_min
             h *= 0.1

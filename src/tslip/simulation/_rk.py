@@ -19,11 +19,11 @@ stages is here::
 
     ns = n_stages(method)
     for s in range(1, ns):                      # K[0] = f(t, y) on entry
-        stage_state(method, y, h, K, s, ytmp)
+        stage_state(method, n, y, h, K, s, ytmp)
         f(t + stage_c(method, s) * h, ytmp, K[s])
-    stage_state(method, y, h, K, ns, ynew)      # the solution (A[ns] = B)
+    stage_state(method, n, y, h, K, ns, ynew)   # the solution (A[ns] = B)
     f(t + h, ynew, K[ns])                       # FSAL: next step's K[0]
-    err = error_norm(method, y, ynew, h, K, rtol, atol)
+    err = error_norm(method, n, y, ynew, h, K, rtol, atol)
 
 Dense output likewise evaluates ``n_extra(method)`` stages ``ns + 1 ...`` with
 :func:`stage_state` before :func:`dense_coeffs`. Events are located on the
@@ -42,6 +42,10 @@ from .._kernel_cache import check as _check_cache
 from ..model._pack import M_DOP853, M_DOPRI5
 
 _JIT = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
+# the per-step helpers are inlined into the caller's stage loop (numba IR
+# inlining): with a constant method and state size, the loops over the
+# tableau compile like the hand-unrolled steppers this module replaced
+_INLINE = dict(_JIT, inline="always")
 
 #: rows of the stage array ``K`` and of the dense-output array ``R`` that fit both methods
 NK = 16
@@ -200,42 +204,41 @@ ORDER = np.array([5.0, 8.0])
 ERR_EXP = np.array([-0.2, -0.125])
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def n_stages(method):
     """Stages per step before the FSAL evaluation (6 or 12)."""
     return NSTAGES[method]
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def n_extra(method):
     """Extra right-hand sides the dense output needs (0 or 3)."""
     return NEXTRA[method]
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def stage_c(method, s):
     """Node ``c_s`` of stage ``s`` (the stage time is ``t + c_s h``)."""
     return C_TAB[method, s]
 
 
-@njit(**_JIT)
-def stage_state(method, y, h, K, s, out):
-    """``out = y + h sum_{j<s} a_sj K[j]``: the input of stage ``s``.
+@njit(**_INLINE)
+def stage_state(method, n, y, h, K, s, out):
+    """``out = y + h sum_{j<s} a_sj K[j]`` (``n`` components): the input of stage ``s``.
 
     With ``s = n_stages(method)`` (the FSAL row, whose coefficients are the
     weights ``b``) this is the new solution.
     """
     a = A_TAB[method, s]
-    for i in range(y.shape[0]):
+    for i in range(n):
         acc = 0.0
         for j in range(s):
-            if a[j] != 0.0:
-                acc += a[j] * K[j, i]
+            acc += a[j] * K[j, i]
         out[i] = y[i] + h * acc
 
 
-@njit(**_JIT)
-def error_norm(method, y, ynew, h, K, rtol, atol):
+@njit(**_INLINE)
+def error_norm(method, n, y, ynew, h, K, rtol, atol):
     """Error of the step in units of the tolerance (accept if <= 1).
 
     dopri5: Hairer's RMS norm of ``h sum (b_j - bhat_j) K[j]``. dop853: the
@@ -243,7 +246,6 @@ def error_norm(method, y, ynew, h, K, rtol, atol):
     with RMS-free sums ``err5``, ``err3`` of the 5th- and 3rd-order estimates.
     Scales ``atol + rtol max(|y|, |ynew|)``. ``K`` holds the FSAL row.
     """
-    n = y.shape[0]
     nk = NSTAGES[method] + 1
     e = E_TAB[method]
     if method == M_DOPRI5:
@@ -251,8 +253,7 @@ def error_norm(method, y, ynew, h, K, rtol, atol):
         for i in range(n):
             acc = 0.0
             for j in range(nk):
-                if e[j] != 0.0:
-                    acc += e[j] * K[j, i]
+                acc += e[j] * K[j, i]
             sk = atol + rtol * max(abs(y[i]), abs(ynew[i]))
             s += (h * acc / sk) ** 2
         return math.sqrt(s / n)
@@ -263,10 +264,8 @@ def error_norm(method, y, ynew, h, K, rtol, atol):
         a5 = 0.0
         a3 = 0.0
         for j in range(nk):
-            if e[j] != 0.0:
-                a5 += e[j] * K[j, i]
-            if e3[j] != 0.0:
-                a3 += e3[j] * K[j, i]
+            a5 += e[j] * K[j, i]
+            a3 += e3[j] * K[j, i]
         sk = atol + rtol * max(abs(y[i]), abs(ynew[i]))
         s5 += (a5 / sk) ** 2
         s3 += (a3 / sk) ** 2
@@ -276,7 +275,7 @@ def error_norm(method, y, ynew, h, K, rtol, atol):
     return abs(h) * s5 / math.sqrt(n * deno)
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def step_factor(method, err, fac_max):
     """Step-size factor ``0.9 err^(-1/(q+1))`` clipped to ``[0.2, fac_max]``."""
     if err <= 0.0:

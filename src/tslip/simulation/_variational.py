@@ -158,9 +158,9 @@ def _sens_step(P, method, z, h, K, ztmp, Jf):
     _aug_rhs(P, z, K[0], Jf)
     ns = _rk.n_stages(method)
     for s in range(1, ns):
-        _rk.stage_state(method, z, h, K, s, ztmp)
+        _rk.stage_state(method, NAUG, z, h, K, s, ztmp)
         _aug_rhs(P, ztmp, K[s], Jf)
-    _rk.stage_state(method, z, h, K, ns, ztmp)
+    _rk.stage_state(method, NAUG, z, h, K, ns, ztmp)
     for i in range(NAUG):
         z[i] = ztmp[i]
 
