@@ -30,7 +30,7 @@ _ROOT = Path(__file__).parent
 #: Package files whose code is compiled into the kernels (njit functions and
 #: the layout constants they read).
 SOURCES: tuple[str, ...] = (
-    "model/_pack.py", "simulation/_kernels.py", "simulation/_variational.py",
+    "model/_pack.py", "simulation/_rk.py", "simulation/_kernels.py", "simulation/_variational.py",
     "biped/_pack.py", "biped/_kernels.py",
 )
 

@@ -1,14 +1,13 @@
-"""Compiled biped kernels: TMT dynamics, contact, controller, DOPRI5 with events.
+"""Compiled biped kernels: TMT dynamics, contact, controller, Runge-Kutta with events.
 
 Private. Arguments are float64 arrays, floats and ints; results are arrays and
 an int status (codes in :mod:`._pack`). Everything also runs with
 ``NUMBA_DISABLE_JIT=1``.
 
-The Dormand-Prince tableau is imported from :mod:`tslip.simulation._kernels`;
-the stepper is restated here because that module's stepper is hard-wired to the
-6-state TSLIP right-hand side, and a generic stepper taking the right-hand side
-as a first-class function argument is not cacheable in numba 0.68 (the cache is
-keyed on the dispatcher type, which differs per process: every run recompiles).
+The integrator is the shared core :mod:`tslip.simulation._rk` (tableaus, error
+norm, dense output, event root finding); only its stage loop is written here,
+with this model's right-hand side (the core cannot take the right-hand side as
+an argument and stay cacheable, see there).
 """
 
 from __future__ import annotations
@@ -19,37 +18,7 @@ import numpy as np
 from numba import njit
 
 from .._kernel_cache import check as _check_cache
-from ..simulation._kernels import (
-    A21,
-    A31,
-    A32,
-    A41,
-    A42,
-    A43,
-    A51,
-    A52,
-    A53,
-    A54,
-    A61,
-    A62,
-    A63,
-    A64,
-    A65,
-    B1,
-    B3,
-    B4,
-    B5,
-    B6,
-    E1,
-    E3,
-    E4,
-    E5,
-    E6,
-    E7,
-    dense_coeffs,
-    dense_eval,
-    error_norm,
-)
+from ..simulation import _rk
 from ._pack import (
     CS_ON_L,
     CS_ON_R,
@@ -65,6 +34,7 @@ from ._pack import (
     O_HMAX,
     O_HMIN,
     O_MAXSTEPS,
+    O_METHOD,
     O_RTOL,
     O_TEND,
     O_TSTRIDE,
@@ -419,44 +389,43 @@ def energy(P, y):
 
 
 # ---------------------------------------------------------------------------
-# Dormand-Prince 5(4) with events
+# Runge-Kutta steps (tslip.simulation._rk) with events
 # ---------------------------------------------------------------------------
 
 
 @njit(**_JIT)
-def dopri_step(P, t, y, h, K, ytmp, ynew, cs, ws, aux, t_end_eval):
-    """One DOPRI5 step from ``(t, y)`` with ``K[0] = f(t, y)``; error into ``ytmp``.
+def _stage_time(method, s, t, h, t_end_eval):
+    """Time of stage ``s``: ``t + c_s h``, or ``t_end_eval`` for ``c_s = 1``."""
+    c = _rk.stage_c(method, s)
+    return t_end_eval if c == 1.0 else t + c * h
 
-    ``t_end_eval`` is the time at which ``K[6] = f(ynew)`` is evaluated (the
-    left limit when the step ends on a controller phase boundary).
+
+@njit(**_JIT)
+def rk_step(P, method, t, y, h, K, ytmp, ynew, cs, ws, aux, t_end_eval):
+    """One step from ``(t, y)`` with ``K[0] = f(t, y)``; ``K[ns] = f(ynew)``.
+
+    ``t_end_eval`` is the time at which the stages with ``c = 1`` (and the
+    FSAL row) are evaluated: the left limit when the step ends on a controller
+    phase boundary.
     """
-    for i in range(N):
-        ytmp[i] = y[i] + h * A21 * K[0, i]
-    rhs(P, t + 0.2 * h, ytmp, cs, K[1], ws, aux)
-    for i in range(N):
-        ytmp[i] = y[i] + h * (A31 * K[0, i] + A32 * K[1, i])
-    rhs(P, t + 0.3 * h, ytmp, cs, K[2], ws, aux)
-    for i in range(N):
-        ytmp[i] = y[i] + h * (A41 * K[0, i] + A42 * K[1, i] + A43 * K[2, i])
-    rhs(P, t + 0.8 * h, ytmp, cs, K[3], ws, aux)
-    for i in range(N):
-        ytmp[i] = y[i] + h * (A51 * K[0, i] + A52 * K[1, i] + A53 * K[2, i] + A54 * K[3, i])
-    rhs(P, t + h * 8.0 / 9.0, ytmp, cs, K[4], ws, aux)
-    for i in range(N):
-        ytmp[i] = y[i] + h * (
-            A61 * K[0, i] + A62 * K[1, i] + A63 * K[2, i] + A64 * K[3, i] + A65 * K[4, i]
-        )
-    rhs(P, t_end_eval, ytmp, cs, K[5], ws, aux)
-    for i in range(N):
-        ynew[i] = y[i] + h * (
-            B1 * K[0, i] + B3 * K[2, i] + B4 * K[3, i] + B5 * K[4, i] + B6 * K[5, i]
-        )
-    rhs(P, t_end_eval, ynew, cs, K[6], ws, aux)
-    for i in range(N):
-        ytmp[i] = h * (
-            E1 * K[0, i] + E3 * K[2, i] + E4 * K[3, i] + E5 * K[4, i] + E6 * K[5, i]
-            + E7 * K[6, i]
-        )
+    ns = _rk.n_stages(method)
+    for s in range(1, ns):
+        _rk.stage_state(method, N, y, h, K, s, ytmp)
+        rhs(P, _stage_time(method, s, t, h, t_end_eval), ytmp, cs, K[s], ws, aux)
+    _rk.stage_state(method, N, y, h, K, ns, ynew)
+    rhs(P, t_end_eval, ynew, cs, K[ns], ws, aux)
+
+
+@njit(**_JIT)
+def dense_output(P, method, t, y, ynew, h, K, R, ytmp, cs, ws, aux, t_end_eval):
+    """Continuous extension of the step just taken; returns the extra rhs calls."""
+    ns = _rk.n_stages(method)
+    ne = _rk.n_extra(method)
+    for s in range(ns + 1, ns + 1 + ne):
+        _rk.stage_state(method, N, y, h, K, s, ytmp)
+        rhs(P, _stage_time(method, s, t, h, t_end_eval), ytmp, cs, K[s], ws, aux)
+    _rk.dense_coeffs(method, y, ynew, h, K, R)
+    return ne
 
 
 @njit(**_JIT)
@@ -552,10 +521,13 @@ def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
     hmin = O[O_HMIN]
     maxsteps = int(O[O_MAXSTEPS])
     t_end = O[O_TEND]
+    method = int(O[O_METHOD])
+    ns = _rk.n_stages(method)
     ws = _make_ws()
     aux = np.empty(10)
-    K = np.empty((7, N))
-    R = np.empty((5, N))
+    K = np.empty((_rk.NK, N))
+    R = np.empty((_rk.NR, N))
+    st = np.empty(5)
     y = y0.copy()
     ytmp = np.empty(N)
     ynew = np.empty(N)
@@ -599,44 +571,44 @@ def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
         t_eval = t + hstep
         if clip:
             t_eval = tb - 1e-12 * P[P_T]
-        dopri_step(P, t, y, hstep, K, ytmp, ynew, cs, ws, aux, t_eval)
-        nfev += 6
-        err = error_norm(ytmp, y, ynew, rtol, atol)
+        rk_step(P, method, t, y, hstep, K, ytmp, ynew, cs, ws, aux, t_eval)
+        nfev += ns
+        err = _rk.error_norm(method, N, y, ynew, hstep, K, rtol, atol)
         if not math.isfinite(err):
             err = 1e10
         if err > 1.0:
             nrej += 1
-            h = hstep * max(0.2, 0.9 * err ** -0.2)
+            h = hstep * _rk.step_factor(method, err, 5.0)
             if h < hmin:
                 status = ST_ERR_UNDERFLOW if math.isfinite(ynew[0]) else ST_ERR_NONFINITE
                 break
             continue
-        # accepted: look for contact events inside the step
-        dense_coeffs(y, ynew, hstep, K, R)
+        # accepted: look for contact events inside the step (Illinois on the
+        # dense output, to 1e-13 in time)
         theta_ev = 2.0
         leg_ev = -1
+        have_dense = False
         for leg in range(2):
             if P[P_CONTACT] == 0.0:
                 break
             g_new = event_value(P, ynew, cs, leg)
             if g_old[leg] > 0.0 and g_new <= 0.0:
-                lo = 0.0
-                hi = 1.0
-                for _ in range(60):
-                    mid = 0.5 * (lo + hi)
-                    dense_eval(R, mid, yev)
-                    if event_value(P, yev, cs, leg) > 0.0:
-                        lo = mid
-                    else:
-                        hi = mid
-                    if (hi - lo) * hstep < 1e-13:
+                if not have_dense:
+                    nfev += dense_output(P, method, t, y, ynew, hstep, K, R, yev, cs, ws, aux,
+                                         t_eval)
+                    have_dense = True
+                _rk.root_start(st, g_old[leg], g_new)
+                for _ in range(100):
+                    c = _rk.root_guess(st)
+                    _rk.dense_eval(method, R, c, yev)
+                    if _rk.root_update(st, c, event_value(P, yev, cs, leg), 1e-13 / hstep):
                         break
-                if hi < theta_ev:
-                    theta_ev = hi
+                if st[1] < theta_ev:
+                    theta_ev = st[1]
                     leg_ev = leg
         nacc += 1
         if leg_ev >= 0:
-            dense_eval(R, theta_ev, ynew)
+            _rk.dense_eval(method, R, theta_ev, ynew)
             t = t + theta_ev * hstep
             for i in range(N):
                 y[i] = ynew[i]
@@ -680,7 +652,7 @@ def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
                 nfev += 1
             else:
                 for i in range(N):
-                    K[0, i] = K[6, i]
+                    K[0, i] = K[ns, i]
         if clip or leg_ev >= 0 or t >= tb:
             tb = next_boundary(P, t)
         for leg in range(2):
@@ -705,8 +677,7 @@ def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
             status = ST_TEND
             break
         # step-size control (Hairer)
-        fac = 0.9 * max(err, 1e-10) ** -0.2
-        h = hstep * min(5.0, max(0.2, fac))
+        h = hstep * _rk.step_factor(method, err, 5.0)
         if clip or leg_ev >= 0:
             h = max(h, 1e-3 * min(hmax, 1.0))
     if status >= 10 and status < 20 and nev < ev.shape[0]:

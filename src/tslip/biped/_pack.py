@@ -15,8 +15,9 @@ from .parameters import BIPED_PARAMETER_TABLE, BipedParams
 NP = 30
 
 # -- integrator options O ------------------------------------------------------------
-O_RTOL, O_ATOL, O_H0, O_HMAX, O_MAXSTEPS, O_TSTRIDE, O_TEND, O_FALLS, O_HMIN = range(9)
-NO = 9
+(O_RTOL, O_ATOL, O_H0, O_HMAX, O_MAXSTEPS, O_TSTRIDE, O_TEND, O_FALLS, O_HMIN,
+ O_METHOD) = range(10)  # O_METHOD: a code of tslip.model._pack.METHODS (0: dopri5)
+NO = 10
 
 # -- contact state CS: flags and touch-down anchors (eqs E.23-E.24) --------------------
 CS_ON_R, CS_ON_L, CS_XR, CS_ZR, CS_XL, CS_ZL = range(6)

@@ -17,8 +17,12 @@ P_C0 = 11  # tau = P[P_C0] + P[P_C0+1] phi + P[P_C0+2] betad + P[P_C0+3] phid
 NP = 15
 
 # -- integrator options O ----------------------------------------------------
-O_RTOL, O_ATOL, O_H0, O_MAXSTEPS, O_TMAX_STANCE, O_TMAX_FLIGHT, O_HMIN = range(7)
-NO = 7
+O_RTOL, O_ATOL, O_H0, O_MAXSTEPS, O_TMAX_STANCE, O_TMAX_FLIGHT, O_HMIN, O_METHOD = range(8)
+NO = 8
+
+# -- Runge-Kutta pair codes (O[O_METHOD]; also the biped's options) -----------
+M_DOPRI5, M_DOP853 = 0, 1
+METHODS = ("dopri5", "dop853")  # name of each code
 
 # -- touch-down state TD (7) -------------------------------------------------
 TD_BETA, TD_PHI, TD_XD, TD_YD, TD_PHID, TD_X, TD_H = range(7)

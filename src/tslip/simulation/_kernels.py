@@ -1,4 +1,4 @@
-"""Compiled kernels: stance dynamics, Dormand-Prince 5(4), events, closed-form flight.
+"""Compiled kernels: stance dynamics, its Runge-Kutta stepper and events, closed-form flight.
 
 Private. Arguments are float64 arrays, floats and ints; results are arrays plus
 an int status (codes in :mod:`tslip.model._pack`). Nothing here prints or
@@ -17,12 +17,15 @@ from numba import njit, prange
 
 from .._kernel_cache import check as _check_cache
 from ..model._pack import (
+    M_DOP853,
+    M_DOPRI5,
     NOUT,
     NREC,
     O_ATOL,
     O_H0,
     O_HMIN,
     O_MAXSTEPS,
+    O_METHOD,
     O_RTOL,
     O_TMAX_FLIGHT,
     O_TMAX_STANCE,
@@ -60,6 +63,7 @@ from ..model._pack import (
     ST_FALL_TRIP,
     ST_OK,
 )
+from . import _rk
 
 _JIT = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
 
@@ -161,155 +165,65 @@ def event_values(P, y, gv):
 
 
 # ---------------------------------------------------------------------------
-# Dormand-Prince 5(4) (Dormand & Prince 1980; Hairer, Norsett & Wanner, dopri5)
+# The stance stepper: the stage loop of tslip.simulation._rk with this rhs
 # ---------------------------------------------------------------------------
-A21 = 1.0 / 5.0
-A31, A32 = 3.0 / 40.0, 9.0 / 40.0
-A41, A42, A43 = 44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0
-A51, A52, A53, A54 = 19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0
-A61, A62, A63, A64, A65 = (
-    9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0,
-)
-B1, B3, B4, B5, B6 = 35.0 / 384.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0
-E1, E3, E4, E5, E6, E7 = (
-    71.0 / 57600.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0,
-)
-D1, D3, D4, D5, D6, D7 = (
-    -12715105075.0 / 11282082432.0, 87487479700.0 / 32700410799.0,
-    -10690763975.0 / 1880347072.0, 701980252875.0 / 199316789632.0,
-    -1453857185.0 / 822651844.0, 69997945.0 / 29380423.0,
-)
 NSTATE = 6
 
 
 @njit(**_JIT)
-def dopri_step(P, y, h, K, ytmp, ynew):
-    """One Dormand-Prince step of size ``h`` from ``y`` with ``K[0] = f(y)``.
+def rk_step(P, method, y, h, K, ytmp, ynew):
+    """One step of size ``h`` from ``y`` with ``K[0] = f(y)`` (see :mod:`._rk`).
 
-    Fills ``K[1..6]`` and ``ynew`` (5th-order solution; ``K[6] = f(ynew)``)
-    and returns the scaled error estimate vector in ``ytmp``.
+    Fills the stages ``K[1..ns]`` and ``ynew``; ``K[ns] = f(ynew)`` (FSAL).
+    The branch makes the method a compile-time constant of the inlined stage
+    loop, which the cheap stance right-hand side makes worth it (measurably
+    faster strides at the thesis tolerance, ``benchmarks/bench_rk.py``).
     """
-    n = NSTATE
-    for i in range(n):
-        ytmp[i] = y[i] + h * A21 * K[0, i]
-    rhs(P, ytmp, K[1])
-    for i in range(n):
-        ytmp[i] = y[i] + h * (A31 * K[0, i] + A32 * K[1, i])
-    rhs(P, ytmp, K[2])
-    for i in range(n):
-        ytmp[i] = y[i] + h * (A41 * K[0, i] + A42 * K[1, i] + A43 * K[2, i])
-    rhs(P, ytmp, K[3])
-    for i in range(n):
-        ytmp[i] = y[i] + h * (A51 * K[0, i] + A52 * K[1, i] + A53 * K[2, i] + A54 * K[3, i])
-    rhs(P, ytmp, K[4])
-    for i in range(n):
-        ytmp[i] = y[i] + h * (
-            A61 * K[0, i] + A62 * K[1, i] + A63 * K[2, i] + A64 * K[3, i] + A65 * K[4, i]
-        )
-    rhs(P, ytmp, K[5])
-    for i in range(n):
-        ynew[i] = y[i] + h * (
-            B1 * K[0, i] + B3 * K[2, i] + B4 * K[3, i] + B5 * K[4, i] + B6 * K[5, i]
-        )
-    rhs(P, ynew, K[6])
-    for i in range(n):
-        ytmp[i] = h * (
-            E1 * K[0, i] + E3 * K[2, i] + E4 * K[3, i] + E5 * K[4, i] + E6 * K[5, i]
-            + E7 * K[6, i]
-        )
+    if method == M_DOPRI5:
+        _rk_stages(P, M_DOPRI5, y, h, K, ytmp, ynew)
+    else:
+        _rk_stages(P, M_DOP853, y, h, K, ytmp, ynew)
+
+
+@njit(**dict(_JIT, inline="always"))
+def _rk_stages(P, method, y, h, K, ytmp, ynew):
+    ns = _rk.n_stages(method)
+    for s in range(1, ns):
+        _rk.stage_state(method, NSTATE, y, h, K, s, ytmp)
+        rhs(P, ytmp, K[s])
+    _rk.stage_state(method, NSTATE, y, h, K, ns, ynew)
+    rhs(P, ynew, K[ns])
 
 
 @njit(**_JIT)
-def error_norm(err, y, ynew, rtol, atol):
-    """Hairer's RMS error norm, in units of the tolerance (accept if <= 1).
-
-    Generic in the state size, like :func:`dense_coeffs` and :func:`dense_eval`
-    (the biped's integrator uses them too).
-    """
-    n = y.shape[0]
-    s = 0.0
-    for i in range(n):
-        sk = atol + rtol * max(abs(y[i]), abs(ynew[i]))
-        s += (err[i] / sk) ** 2
-    return math.sqrt(s / n)
+def dense_output(P, method, y, ynew, h, K, R, ytmp):
+    """Continuous extension of the step just taken (extra stages for dop853)."""
+    ns = _rk.n_stages(method)
+    for s in range(ns + 1, ns + 1 + _rk.n_extra(method)):
+        _rk.stage_state(method, NSTATE, y, h, K, s, ytmp)
+        rhs(P, ytmp, K[s])
+    _rk.dense_coeffs(method, y, ynew, h, K, R)
 
 
 @njit(**_JIT)
-def dense_coeffs(y, ynew, h, K, R):
-    """Coefficients of the 4th-order continuous extension (dopri5 ``contd5``)."""
-    for i in range(y.shape[0]):
-        ydiff = ynew[i] - y[i]
-        bspl = h * K[0, i] - ydiff
-        R[0, i] = y[i]
-        R[1, i] = ydiff
-        R[2, i] = bspl
-        R[3, i] = ydiff - h * K[6, i] - bspl
-        R[4, i] = h * (
-            D1 * K[0, i] + D3 * K[2, i] + D4 * K[3, i] + D5 * K[4, i] + D6 * K[5, i]
-            + D7 * K[6, i]
-        )
-
-
-@njit(**_JIT)
-def dense_eval(R, theta, out):
-    """Evaluate the continuous extension at ``theta`` in [0, 1] of the step."""
-    t1 = 1.0 - theta
-    for i in range(out.shape[0]):
-        out[i] = R[0, i] + theta * (R[1, i] + t1 * (R[2, i] + theta * (R[3, i] + t1 * R[4, i])))
-
-
-@njit(**_JIT)
-def initial_step(P, y, f0, rtol, atol, ytmp, f1):
+def initial_step(P, method, y, f0, rtol, atol, ytmp, f1):
     """Starting step size (Hairer, Norsett & Wanner, II.4)."""
-    d0 = 0.0
-    d1 = 0.0
-    for i in range(NSTATE):
-        sk = atol + rtol * abs(y[i])
-        d0 += (y[i] / sk) ** 2
-        d1 += (f0[i] / sk) ** 2
-    d0 = math.sqrt(d0 / NSTATE)
-    d1 = math.sqrt(d1 / NSTATE)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    for i in range(NSTATE):
-        ytmp[i] = y[i] + h0 * f0[i]
+    h0, d1 = _rk.initial_probe(y, f0, rtol, atol, ytmp)
     rhs(P, ytmp, f1)
-    d2 = 0.0
-    for i in range(NSTATE):
-        sk = atol + rtol * abs(y[i])
-        d2 += ((f1[i] - f0[i]) / sk) ** 2
-    d2 = math.sqrt(d2 / NSTATE) / h0
-    dm = max(d1, d2)
-    h1 = max(1e-6, h0 * 1e-3) if dm <= 1e-15 else (0.01 / dm) ** 0.2
-    return min(100.0 * h0, h1)
+    return _rk.initial_step(method, y, f0, f1, h0, d1, rtol, atol)
 
 
 @njit(**_JIT)
-def _event_root(P, R, ev, g_lo, g_hi, ytmp, gv):
+def _event_root(P, method, R, ev, g_lo, g_hi, ytmp, gv, st):
     """Root in theta of event ``ev`` on the dense output (Illinois method)."""
-    a, b = 0.0, 1.0
-    fa, fb = g_lo, g_hi
-    side = 0
-    c = 1.0
+    _rk.root_start(st, g_lo, g_hi)
     for _ in range(100):
-        c = (a * fb - b * fa) / (fb - fa) if fb != fa else 0.5 * (a + b)
-        if not (a < c < b):
-            c = 0.5 * (a + b)
-        dense_eval(R, c, ytmp)
+        c = _rk.root_guess(st)
+        _rk.dense_eval(method, R, c, ytmp)
         event_values(P, ytmp, gv)
-        fc = gv[ev]
-        if fc > 0.0:
-            a, fa = c, fc
-            if side == -1:
-                fb *= 0.5
-            side = -1
-        else:
-            b, fb = c, fc
-            if side == 1:
-                fa *= 0.5
-            side = 1
-        if b - a < 1e-15:
+        if _rk.root_update(st, c, gv[ev], 1e-15):
             break
-    return b  # the earliest theta known to be at or past the crossing
+    return st[1]  # the earliest theta known to be at or past the crossing
 
 
 @njit(**_JIT)
@@ -327,8 +241,11 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
     max_steps = int(O[O_MAXSTEPS])
     t_max = O[O_TMAX_STANCE]
     h_min = O[O_HMIN]
-    K = np.empty((7, NSTATE))
-    R = np.empty((5, NSTATE))
+    method = int(O[O_METHOD])
+    ns = _rk.n_stages(method)
+    K = np.empty((_rk.NK, NSTATE))
+    R = np.empty((_rk.NR, NSTATE))
+    st = np.empty(5)
     y = np.empty(NSTATE)
     ynew = np.empty(NSTATE)
     ytmp = np.empty(NSTATE)
@@ -361,7 +278,7 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
         return ST_FALL_HIP_GROUND if gv_old[1] <= 0.0 else ST_FALL_BACKWARD
     h = O[O_H0]
     if h <= 0.0:
-        h = initial_step(P, y, K[0], rtol, atol, ytmp, K[1])
+        h = initial_step(P, method, y, K[0], rtol, atol, ytmp, K[1])
     n_acc = 0
     n_rej = 0
     last_rejected = False
@@ -376,8 +293,8 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
         if h < h_min:
             status = ST_ERR_STEP_UNDERFLOW
             break
-        dopri_step(P, y, h, K, ytmp, ynew)
-        err = error_norm(ytmp, y, ynew, rtol, atol)
+        rk_step(P, method, y, h, K, ytmp, ynew)
+        err = _rk.error_norm(method, NSTATE, y, ynew, h, K, rtol, atol)
         if not math.isfinite(err):
             # a NaN/inf stage: shrink hard, give up below h_min
             h *= 0.1
@@ -385,7 +302,7 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
             last_rejected = True
             continue
         if err > 1.0:
-            h *= max(0.2, 0.9 * err ** -0.2)
+            h *= _rk.step_factor(method, err, 10.0)
             n_rej += 1
             last_rejected = True
             continue
@@ -401,30 +318,30 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
             ev = (1, 2, 0)[j]
             if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
                 if not have_dense:
-                    dense_coeffs(y, ynew, h, K, R)
+                    dense_output(P, method, y, ynew, h, K, R, ytmp)
                     have_dense = True
-                th = _event_root(P, R, ev, gv_old[ev], gv_new[ev], ytmp, gv_tmp)
+                th = _event_root(P, method, R, ev, gv_old[ev], gv_new[ev], ytmp, gv_tmp, st)
                 if th < theta_ev - 1e-9:
                     theta_ev = th
                     first_ev = ev
         if rec_dt > 0.0 and nrec_max > 0:
             if not have_dense:
-                dense_coeffs(y, ynew, h, K, R)
+                dense_output(P, method, y, ynew, h, K, R, ytmp)
                 have_dense = True
             t_stop = t + h * min(theta_ev, 1.0)
             while t_next_rec <= t_stop:
                 if nrec >= nrec_max:
                     overflow = 1.0
                     break
-                dense_eval(R, (t_next_rec - t) / h, ytmp)
+                _rk.dense_eval(method, R, (t_next_rec - t) / h, ytmp)
                 _record(P, rec, nrec, t_next_rec, ytmp)
                 nrec += 1
                 t_next_rec += rec_dt
         if first_ev >= 0:
-            # exact step to the event time for a 5th-order event state
+            # exact step to the event time for a full-order event state
             h_ev = theta_ev * h
             if h_ev > 0.0:
-                dopri_step(P, y, h_ev, K, ytmp, ynew)
+                rk_step(P, method, y, h_ev, K, ytmp, ynew)
             else:
                 for i in range(NSTATE):
                     ynew[i] = y[i]
@@ -442,11 +359,10 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
             t += h
             for i in range(NSTATE):
                 y[i] = ynew[i]
-                K[0, i] = K[6, i]  # FSAL
+                K[0, i] = K[ns, i]  # FSAL
             for i in range(3):
                 gv_old[i] = gv_new[i]
-            fac = 0.9 * err ** -0.2 if err > 0.0 else 10.0
-            fac = min(10.0, max(0.2, fac))
+            fac = _rk.step_factor(method, err, 10.0)
             if last_rejected:
                 fac = min(1.0, fac)
             h *= fac

@@ -5,7 +5,7 @@ chain; each link is differentiated exactly:
 
 1. touch-down state -> stance state ``y0`` (eq. A.5 inverted), analytic;
 2. the stance flow, by *internal numerical differentiation*: the same
-   Dormand-Prince step sequence is replayed with each stage's sensitivity
+   Runge-Kutta step sequence is replayed with each stage's sensitivity
    ``dK_i = Df(Y_i) dY_i``, which is the variational equation integrated by the
    same Runge-Kutta scheme (so it is the derivative of the computed map);
 3. the lift-off event ``F_y = 0`` by the saltation (event-time) correction
@@ -29,6 +29,7 @@ from numba import njit
 from .._kernel_cache import check as _check_cache
 from ..model._pack import (
     NREC,
+    O_METHOD,
     OUT_LO,
     OUT_TF,
     P_C0,
@@ -42,6 +43,7 @@ from ..model._pack import (
     P_R,
     ST_OK,
 )
+from . import _rk
 from ._kernels import (
     _JIT,
     NSTATE,
@@ -52,15 +54,6 @@ from ._kernels import (
     stance_initial,
     stride,
 )
-
-# Dormand-Prince 5(4) tableau as arrays (same numbers as _kernels)
-_A = np.zeros((7, 7))
-_A[1, 0] = 1.0 / 5.0
-_A[2, :2] = (3.0 / 40.0, 9.0 / 40.0)
-_A[3, :3] = (44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0)
-_A[4, :4] = (19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0)
-_A[5, :5] = (9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0)
-_B = np.array([35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0])
 
 
 @njit(**_JIT)
@@ -136,41 +129,40 @@ def fy_gradient(P, y, gr):
     gr[5] = P[P_C0 + 3] * cb / l
 
 
+NAUG = NSTATE + NSTATE * NSTATE  # y and the sensitivity Phi, row-major
+
+
 @njit(**_JIT)
-def _sens_step(P, y, h, Phi, Ys, K, dK, Jf, tmp):
-    """One Dormand-Prince step of ``y`` and its sensitivity ``Phi`` (in place)."""
-    n = NSTATE
-    for s in range(6):
-        # stage state and its sensitivity
-        for i in range(n):
-            acc = y[i]
-            for j in range(s):
-                acc += h * _A[s, j] * K[j, i]
-            Ys[i] = acc
-        rhs(P, Ys, K[s])
-        rhs_jacobian(P, Ys, Jf)
-        for i in range(n):
-            for c in range(n):
-                acc = Phi[i, c]
-                for j in range(s):
-                    acc += h * _A[s, j] * dK[j, i, c]
-                tmp[i, c] = acc
-        for i in range(n):
-            for c in range(n):
-                acc = 0.0
-                for q in range(n):
-                    acc += Jf[i, q] * tmp[q, c]
-                dK[s, i, c] = acc
-    for i in range(n):
-        acc = y[i]
-        for s in range(6):
-            acc += h * _B[s] * K[s, i]
-        y[i] = acc
-        for c in range(n):
-            acc = Phi[i, c]
-            for s in range(6):
-                acc += h * _B[s] * dK[s, i, c]
-            Phi[i, c] = acc
+def _aug_rhs(P, z, out, Jf):
+    """Right-hand side of ``(y, Phi)``: ``(f(y), Df(y) Phi)``, the variational equation."""
+    y = z[:NSTATE]
+    rhs(P, y, out[:NSTATE])
+    rhs_jacobian(P, y, Jf)
+    for i in range(NSTATE):
+        for c in range(NSTATE):
+            acc = 0.0
+            for q in range(NSTATE):
+                acc += Jf[i, q] * z[NSTATE + q * NSTATE + c]
+            out[NSTATE + i * NSTATE + c] = acc
+
+
+@njit(**_JIT)
+def _sens_step(P, method, z, h, K, ztmp, Jf):
+    """One step of ``(y, Phi)`` (in place) with the Runge-Kutta pair of the stride.
+
+    A Runge-Kutta method commutes with linearisation, so this is the
+    derivative of the computed step; the ``y`` part repeats the stride's
+    stage arithmetic (:func:`._rk.stage_state` acts elementwise), with the
+    step sizes recovered from the recorded times.
+    """
+    _aug_rhs(P, z, K[0], Jf)
+    ns = _rk.n_stages(method)
+    for s in range(1, ns):
+        _rk.stage_state(method, NAUG, z, h, K, s, ztmp)
+        _aug_rhs(P, ztmp, K[s], Jf)
+    _rk.stage_state(method, NAUG, z, h, K, ns, ztmp)
+    for i in range(NAUG):
+        z[i] = ztmp[i]
 
 
 @njit(**_JIT)
@@ -210,16 +202,21 @@ def stride_jacobian(P, O, td, tx, th, Jq, out):
     D0[3, 0] += u * sb + w * cb
     D0[4, 0] += (u * cb - w * sb) / l0
     # 2. replay the accepted steps with sensitivities
-    Phi = np.eye(NSTATE)
-    Ys = np.empty(NSTATE)
-    K = np.empty((7, NSTATE))
-    dK = np.empty((6, NSTATE, NSTATE))
+    method = int(O[O_METHOD])
+    z = np.zeros(NAUG)
+    for i in range(NSTATE):
+        z[i] = y[i]
+        z[NSTATE + i * NSTATE + i] = 1.0
+    K = np.empty((_rk.NK, NAUG))
+    ztmp = np.empty(NAUG)
     Jf = np.empty((NSTATE, NSTATE))
-    tmp = np.empty((NSTATE, NSTATE))
     for k in range(1, nrec):
         h = rec[k, 0] - rec[k - 1, 0]
         if h > 0.0:
-            _sens_step(P, y, h, Phi, Ys, K, dK, Jf, tmp)
+            _sens_step(P, method, z, h, K, ztmp, Jf)
+    for i in range(NSTATE):
+        y[i] = z[i]
+    Phi = z[NSTATE:].copy().reshape((NSTATE, NSTATE))
     # 3. saltation at lift-off: dt_LO = -(grad Fy . Phi) / (grad Fy . f)
     f = np.empty(NSTATE)
     rhs(P, y, f)
