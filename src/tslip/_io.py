@@ -20,17 +20,22 @@ def atomic_write(path: str | Path, write: Callable[[str], None]) -> Path:
     is atomic) and gets the usual permissions (``0666 & ~umask``).
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
-    os.close(fd)
+    tmp = ""
     try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+        os.close(fd)
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
         write(tmp)
         os.replace(tmp, path)
+    except OSError as exc:  # name the user's file, never the temporary one
+        if tmp and exc.filename not in (None, tmp, str(path)) and str(tmp) not in str(exc):
+            raise
+        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
     finally:
-        if os.path.exists(tmp):
+        if tmp and os.path.exists(tmp):
             os.unlink(tmp)
     return path
 

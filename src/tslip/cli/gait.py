@@ -119,7 +119,7 @@ def _print_report(rep: dict[str, Any]) -> None:
 
 @app.command("gait")
 def gait_cmd(
-    preset_name: PresetOpt = "table2.1",
+    preset_name: PresetOpt = None,
     sets: SetOpt = None,
     params_file: ParamsOpt = None,
     method: Annotated[
@@ -170,7 +170,7 @@ def continue_cmd(
     start: Annotated[float, typer.Option("--from", help="First value.")],
     stop: Annotated[float, typer.Option("--to", help="Last value.")],
     points: Annotated[int, typer.Option("--points", "-n", help="Number of values.")] = 50,
-    preset_name: PresetOpt = "table2.1",
+    preset_name: PresetOpt = None,
     sets: SetOpt = None,
     params_file: ParamsOpt = None,
     out: Annotated[
