@@ -22,7 +22,9 @@ __all__ = ["check_number", "parse_number", "check_fits", "available_memory", "ch
 
 
 def _range(lower: float, upper: float, lower_open: bool, upper_open: bool) -> str:
-    return f"{'(' if lower_open else '['}{lower:g}, {upper:g}{')' if upper_open else ']'}"
+    left = "(" if lower_open or lower == -math.inf else "["
+    right = ")" if upper_open or upper == math.inf else "]"
+    return f"{left}{lower:g}, {upper:g}{right}"
 
 
 def check_number(

@@ -157,8 +157,6 @@ def _track(video: Path, out: Path, fps: float | None, scale: float | None,
     if (scale is None) != (ground is None):
         raise ValueError("give both --scale and --ground, or neither (measured from the frame)")
     check_output(out, "--out", _DATA_SUFFIXES)
-    if not video.exists():
-        raise ValueError(f"video {str(video)!r} does not exist")
     if fps is not None:
         check_number(fps, "--fps", unit="Hz", lower=0.0, upper=1e5, lower_open=True)
     if scale is not None:
@@ -313,7 +311,7 @@ def experiment_cmd(
     """Run track -> process -> fit and write everything into one folder."""
     with _errors():
         t0 = time.perf_counter()
-        out_dir.mkdir(parents=True, exist_ok=True)
+        check_output(out_dir / "tracks.csv", "--out-dir")  # the files make the folder
         _track(video, out_dir / "tracks.csv", fps, scale, ground, None)
         data = _process(out_dir / "tracks.csv", out_dir / "steps.csv")
         _fit(out_dir / "steps.csv", out_dir, data)

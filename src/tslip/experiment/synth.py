@@ -174,6 +174,14 @@ class RenderOptions:
     swing_lift: float = 0.2
     seed: int = 0
 
+    def __post_init__(self) -> None:
+        for name, unit, lo, hi in (("noise", "grey levels", 0.0, 255.0),
+                                   ("exposure", "-", 0.0, 1.0), ("flicker", "-", 0.0, 0.5),
+                                   ("swing_lift", "m", 0.0, 1.0)):
+            object.__setattr__(self, name, check_number(getattr(self, name), name, unit=unit,
+                                                        lower=lo, upper=hi))
+        check_number(self.seed, "seed", lower=0, integer=True)
+
 
 @dataclass(frozen=True)
 class SyntheticRun:
