@@ -530,7 +530,7 @@ def run_batch(
     n_steps = int(check_number(n_steps, "n_steps", lower=1, integer=True))
     Ps, S, TX, TH = _batch_inputs(params, states, terrain)
     n = len(S)
-    check_fits(n_steps + 1, n * 7 * 8.0, "n_steps", f"the touch-downs of {n} runs")
+    check_fits(n_steps, n * 7 * 8.0, "n_steps", f"the touch-downs of {n} runs")
     hist = np.full((n, int(n_steps) + 1, 7), np.nan)
     status = np.empty(n, dtype=np.int64)
     n_done = np.empty(n, dtype=np.int64)
