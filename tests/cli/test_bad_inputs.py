@@ -320,3 +320,23 @@ def test_bad_input_is_one_line_error(inputs, tmp_path, argv, expected):
     assert "Traceback" not in result.output
     assert list(out.iterdir()) == [], "an output file was left behind"
     assert sorted(p.name for p in inputs.iterdir()) == before
+
+
+
+@pytest.mark.parametrize("argv, expected", [
+    ("simulate --steps abc", "Invalid value for '--steps'"),
+    ("simulate --bogus", "No such option: --bogus"),
+    ("nosuchcmd", "No such command 'nosuchcmd'"),
+    ("animate", "Missing option '--out'"),
+    ("biped simulate --strides x", "Invalid value for '--strides'"),
+])
+def test_option_parser_errors_are_one_line_too(argv, expected, monkeypatch, capsys):
+    """The console script's entry point turns typer's usage errors into one line."""
+    from tslip.cli.main import main
+
+    monkeypatch.setattr("sys.argv", ["tslip", *argv.split()])
+    with pytest.raises(SystemExit) as info:
+        main()
+    assert info.value.code == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and expected in lines[0], lines

@@ -114,8 +114,12 @@ def _errors() -> Iterator[None]:
         _fail(f"{exc.strerror or exc}: {exc.filename}" if exc.filename else str(exc), 1)
 
 
-def _fail(message: str, code: int) -> None:
+def _echo_error(message: str) -> None:
     typer.echo("error: " + " ".join(message.split()), err=True)
+
+
+def _fail(message: str, code: int) -> None:
+    _echo_error(message)
     raise typer.Exit(code=code)
 
 
@@ -585,5 +589,28 @@ from . import studies as _study_commands  # noqa: E402, F401  (study, reproduce)
 
 
 def main() -> None:
-    """Entry point of the ``tslip`` console script."""
-    app(prog_name="tslip")
+    """Entry point of the ``tslip`` console script.
+
+    Usage errors found by the option parser (``--steps abc``, an unknown
+    option) print one line ``error: ...`` like every other bad input.
+    """
+    import sys
+
+    # typer's (vendored) click exceptions live beside BadParameter
+    exc_mod = sys.modules[typer.BadParameter.__module__]
+    try:
+        code = app(prog_name="tslip", standalone_mode=False)
+    except exc_mod.NoArgsIsHelpError as exc:
+        exc.show()
+        sys.exit(exc.exit_code)
+    except exc_mod.UsageError as exc:
+        command = exc.ctx.command_path if exc.ctx is not None else "tslip"
+        _echo_error(f"{exc.format_message()} (see `{command} --help`)")
+        sys.exit(exc.exit_code)
+    except exc_mod.ClickException as exc:
+        _echo_error(exc.format_message())
+        sys.exit(exc.exit_code)
+    except typer.Abort:
+        _echo_error("interrupted")
+        sys.exit(130)
+    sys.exit(code if isinstance(code, int) else 0)
