@@ -24,7 +24,13 @@ __all__ = ["check_number", "parse_number", "check_fits", "available_memory", "ch
 def _range(lower: float, upper: float, lower_open: bool, upper_open: bool) -> str:
     left = "(" if lower_open or lower == -math.inf else "["
     right = ")" if upper_open or upper == math.inf else "]"
-    return f"{left}{lower:g}, {upper:g}{right}"
+    return f"{left}{_num(lower)}, {_num(upper)}{right}"
+
+
+def _num(x: float) -> str:
+    """A bound as text: whole numbers in full (4294967295, not 4.29497e+09)."""
+    return str(int(x)) if math.isfinite(x) and float(x).is_integer() and abs(x) < 1e16 \
+        else f"{x:g}"
 
 
 def check_number(

@@ -76,6 +76,10 @@ def read_toml(path: str | Path, what: str) -> dict:
             return tomllib.load(fh)
     except FileNotFoundError:
         raise ValueError(f"{what} {str(path)!r} does not exist") from None
+    except IsADirectoryError:
+        raise ValueError(f"{what} {str(path)!r} is a directory; give a .toml file") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"{what} {str(path)!r} is not valid TOML (not UTF-8 text)") from None
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"{what} {str(path)!r} is not valid TOML: {exc}") from None
 

@@ -172,6 +172,10 @@ CASES: list[tuple[str, str]] = [
     ("demo --out-dir /sys/demo", "--out-dir '/sys/demo/run.csv': cannot write in '/sys'"),
     # gait and continue
     ("gait --method foo", "--method must be 'newton' or 'cma'"),
+    ("gait --method cma --seed -1", "--seed must be an integer in [0, 4294967295]"),
+    (f"{SIM} --params {{d}}", "parameter file '{d}' is a directory"),
+    (f"{SIM} --params {{d}}/bad.parquet", "is not valid TOML"),
+    ("biped search --out {o}/s.json --seed -1", "--seed must be an integer in [0"),
     ("gait --params {d}/kbool.toml", "k [MgL^-1] must be a number"),
     ("gait --preset table2.1 --params {d}/preset61.toml", "preset = 'table6.1'"),
     ("gait --set beta0=0.2", "periodic gait"),

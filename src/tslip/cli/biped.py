@@ -171,6 +171,7 @@ def search_cmd(
         check_number(cma_evals, "--cma-evals", lower=0, upper=10**7, integer=True)
         check_number(sigma0, "--sigma0", lower=0.0, upper=1.0, lower_open=True)
         check_number(max_iter, "--max-iter", lower=1, upper=10**5, integer=True)
+        check_number(seed, "--seed", lower=0, upper=2**32 - 1, integer=True)
         p, y, t0 = _start(sets, gait, from_tslip)
         z0 = to_section(p, y, t0)
         free = tuple(free_param) if free_param else ("T", "theta_f", "theta_s", "Kp_h", "Kd_h")

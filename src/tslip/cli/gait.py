@@ -144,6 +144,7 @@ def gait_cmd(
     with _errors():
         if method not in ("newton", "cma"):
             raise ValueError(f"--method must be 'newton' or 'cma', got {method!r}")
+        check_number(seed, "--seed", lower=0, upper=2**32 - 1, integer=True)
         if plot is not None:
             check_output(plot / "friction.png", "--plot")
         params = _build_params(preset_name, sets, params_file)
