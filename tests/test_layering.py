@@ -16,7 +16,8 @@ ALLOWED = {
     "biped": {"model", "simulation", "gait"},
     "plotting": {"model", "simulation", "gait", "sweeps", "experiment", "biped"},
 }
-TOP = {"_io", "_kernel_cache", "_codehash", "__init__", "__main__", "_typing", "__version__"}
+TOP = {"_io", "_checks", "_kernel_cache", "_codehash", "__init__", "__main__", "_typing",
+       "__version__"}
 
 
 def _imports(path: Path) -> set[str]:

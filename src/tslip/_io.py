@@ -1,16 +1,17 @@
-"""Atomic file writes: a crash never leaves a half-written result."""
+"""Atomic file writes: a crash never leaves a half-written result (tables, JSON, MP4)."""
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import tempfile
 import tomllib
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-__all__ = ["atomic_write", "git_hash", "read_toml", "write_json", "write_table"]
+__all__ = ["atomic_write", "git_hash", "read_toml", "write_json", "write_mp4", "write_table"]
 
 
 def atomic_write(path: str | Path, write: Callable[[str], None]) -> Path:
@@ -20,17 +21,23 @@ def atomic_write(path: str | Path, write: Callable[[str], None]) -> Path:
     is atomic) and gets the usual permissions (``0666 & ~umask``).
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
-    os.close(fd)
+    tmp = ""
     try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+        os.close(fd)
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
         write(tmp)
         os.replace(tmp, path)
+    except OSError as exc:  # name the user's file, never the temporary one
+        name = exc.filename
+        if name is None or not Path(name).name.startswith(f".{path.name}."):
+            raise
+        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
     finally:
-        if os.path.exists(tmp):
+        if tmp and os.path.exists(tmp):
             os.unlink(tmp)
     return path
 
@@ -69,6 +76,10 @@ def read_toml(path: str | Path, what: str) -> dict:
             return tomllib.load(fh)
     except FileNotFoundError:
         raise ValueError(f"{what} {str(path)!r} does not exist") from None
+    except IsADirectoryError:
+        raise ValueError(f"{what} {str(path)!r} is a directory; give a .toml file") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"{what} {str(path)!r} is not valid TOML (not UTF-8 text)") from None
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"{what} {str(path)!r} is not valid TOML: {exc}") from None
 
@@ -83,3 +94,72 @@ def git_hash() -> str | None:
     except (OSError, subprocess.SubprocessError):
         return None
     return out.stdout.strip() or None if out.returncode == 0 else None
+
+
+def write_mp4(
+    path: str | Path,
+    frames: Iterable[Any],
+    fps: float,
+    *,
+    crf: int = 23,
+    preset: str = "medium",
+    progress: Callable[[int, int], None] | None = None,
+    total: int = 0,
+) -> Path:
+    """Encode RGB ``uint8`` frames (height, width, 3) to an H.264 ``.mp4``, atomically.
+
+    The one place that runs ffmpeg (the binary of imageio-ffmpeg). libx264 with
+    yuv420p needs an even width and height: other sizes are refused before
+    ffmpeg starts. ffmpeg's exit status and the size of its output are checked:
+    a failed or empty encode raises ``OSError`` naming ``path`` and ffmpeg's
+    last message, and leaves no file behind.
+    """
+    import subprocess
+
+    import imageio_ffmpeg
+
+    path = Path(path)
+    it = iter(frames)
+    first = next(it, None)
+    if first is None:
+        raise ValueError(f"no frames to write to {str(path)!r}")
+    height, width = first.shape[:2]
+    if first.ndim != 3 or first.shape[2] != 3 or first.dtype.name != "uint8":
+        raise ValueError(f"frames must be uint8 arrays of shape (height, width, 3), got "
+                         f"{first.dtype} {first.shape}")
+    if width % 2 or height % 2:
+        raise ValueError(f"an .mp4 (libx264, yuv420p) needs an even frame width and height, "
+                         f"got {width} x {height} px")
+
+    def encode(tmp: str) -> None:
+        cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-y", "-loglevel", "error", "-f", "rawvideo",
+               "-pix_fmt", "rgb24", "-s", f"{width}x{height}", "-r", f"{fps:.10g}", "-i", "-",
+               "-an", "-c:v", "libx264", "-pix_fmt", "yuv420p", "-crf", str(crf),
+               "-preset", preset, "-f", "mp4", tmp]
+        with tempfile.TemporaryFile() as log:
+            proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                                    stderr=log)
+            assert proc.stdin is not None
+            try:
+                for k, frame in enumerate(itertools.chain([first], it)):
+                    if frame.shape != first.shape or frame.dtype != first.dtype:
+                        raise ValueError(f"frame {k} has shape {frame.shape}, expected "
+                                         f"{first.shape}")
+                    proc.stdin.write(frame.tobytes())
+                    if progress is not None:
+                        progress(k + 1, total)
+            except BrokenPipeError:
+                pass  # ffmpeg stopped: its status and message are reported below
+            finally:
+                try:
+                    proc.stdin.close()
+                except BrokenPipeError:
+                    pass
+                code = proc.wait()
+            log.seek(0)
+            lines = log.read().decode(errors="replace").strip().splitlines()
+        if code != 0 or os.path.getsize(tmp) == 0:
+            why = lines[-1].strip() if lines else f"exit status {code}"
+            raise OSError(f"ffmpeg could not encode {str(path)!r}: {why}")
+
+    return atomic_write(path, encode)

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import check_number
 from .gait import refine_periodic_gait, section_multipliers
 from .parameters import BipedParams
 
@@ -140,6 +141,16 @@ def stable_gait_search(base: BipedParams, z0: NDArray[np.float64], *,
     """
     import cma
 
+    check_number(budget_s, "budget_s", unit="s", lower=0.0, lower_open=True)
+    check_number(max_evals, "max_evals", lower=1, integer=True)
+    check_number(popsize, "popsize", lower=2, integer=True)
+    check_number(sigma0, "sigma0", lower=0.0, upper=1.0, lower_open=True)
+    check_number(seed, "seed", lower=0, integer=True)
+    check_number(processes, "processes", lower=1, upper=256, integer=True)
+    unknown = sorted(set(names) - set(DESIGN_BOUNDS))
+    if unknown or not names:
+        raise ValueError(f"names must be design variables from {sorted(DESIGN_BOUNDS)}, got "
+                         f"{list(names)!r}")
     lo = np.array([DESIGN_BOUNDS[n][0] for n in names])
     hi = np.array([DESIGN_BOUNDS[n][1] for n in names])
 

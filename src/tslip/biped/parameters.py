@@ -19,6 +19,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import check_number
 from ..model.controllers import check_finite_fields
 
 __all__ = [
@@ -196,10 +197,11 @@ class BipedParams:
 
     def __post_init__(self) -> None:
         for row in BIPED_PARAMETER_TABLE:
-            value = getattr(self, row.name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
-                raise ValueError(f"{row.name} [{row.unit}] must be a number, got {value!r}")
-            object.__setattr__(self, row.name, float(value))
+            value = check_number(
+                getattr(self, row.name), row.name, unit=row.unit, lower=row.lower,
+                upper=row.upper, lower_open=row.lower_open, upper_open=row.upper_open,
+            )
+            object.__setattr__(self, row.name, value)
         check_finite_fields(self)  # the table's ranges, as for the TSLIP's Params
         for name in ("actuated", "contact"):
             if not isinstance(getattr(self, name), (bool, np.bool_)):

@@ -13,6 +13,7 @@ from typing import Annotated, Any
 import numpy as np
 import typer
 
+from .._checks import check_number, check_output, parse_number
 from .._io import write_json
 from ..biped import BipedOptions, BipedParams, BipedState, simulate
 from ..biped.gait import (
@@ -48,17 +49,22 @@ def _params(sets: list[str] | None, base: BipedParams | None = None) -> BipedPar
     changes: dict[str, Any] = {}
     for item in sets or []:
         key, sep, value = item.partition("=")
-        if not sep:
-            raise ValueError(f"--set expects key=value, got {item!r}")
         key = key.strip()
+        if not sep or not key or not value.strip():
+            raise ValueError(f"--set expects key=value, got {item!r}")
+        if key in changes:
+            raise ValueError(f"--set {key} is given twice; give it once")
         if value.strip().lower() in ("true", "false"):
             changes[key] = value.strip().lower() == "true"
             continue
-        try:
-            changes[key] = float(value)
-        except ValueError:
-            raise ValueError(f"{key} must be a number, got {value!r}") from None
+        changes[key] = parse_number(value, f"--set {key}")
     return BipedParams.from_dict(changes, base)
+
+
+def _check_strides(strides: int, tol: float | None = None) -> None:
+    check_number(strides, "--strides", lower=1, upper=100_000, integer=True)
+    if tol is not None:
+        check_number(tol, "--tol", lower=0.0, upper=1.0, lower_open=True, upper_open=True)
 
 
 def _start(sets: list[str] | None, gait: Path | None,
@@ -96,9 +102,10 @@ def simulate_cmd(
 ) -> None:
     """Run the biped from Table E.2 (or a gait) and report strides and tracking."""
     with _errors():
+        _check_strides(strides, tol)
+        if out is not None:
+            check_output(out, "--out", (".csv", ".parquet"))
         p, y, t0 = _start(sets, gait, from_tslip)
-        if strides < 1:
-            raise ValueError(f"--strides must be >= 1, got {strides}")
         tr = simulate(p, y, strides, t0=t0, options=BipedOptions(rtol=tol, atol=tol))
         c = _console()
         c.print(f"{tr.n_strides} strides, {tr.status.reason} (t = {tr.stats['t_end']:.3f})")
@@ -108,7 +115,9 @@ def simulate_cmd(
                 c.print(f"{name} leg, stride 1: thigh RMS error {te.thigh_rms:.2e} L, "
                         f"hip RMS error {te.hip_rms:.3f} rad")
         if out is not None:
-            tr.to_dataframe().to_csv(out, index=False)
+            from .._io import write_table
+
+            write_table(tr.to_dataframe(), out)
             c.print(f"wrote {out}")
 
 
@@ -157,6 +166,12 @@ def search_cmd(
     from ..biped.gait import refine_periodic_gait
 
     with _errors():
+        check_output(out, "--out", (".json",))
+        _check_strides(strides, tol)
+        check_number(cma_evals, "--cma-evals", lower=0, upper=10**7, integer=True)
+        check_number(sigma0, "--sigma0", lower=0.0, upper=1.0, lower_open=True)
+        check_number(max_iter, "--max-iter", lower=1, upper=10**5, integer=True)
+        check_number(seed, "--seed", lower=0, upper=2**32 - 1, integer=True)
         p, y, t0 = _start(sets, gait, from_tslip)
         z0 = to_section(p, y, t0)
         free = tuple(free_param) if free_param else ("T", "theta_f", "theta_s", "Kp_h", "Kd_h")
@@ -200,8 +215,9 @@ def animate_cmd(
     from ..plotting.biped import animate_biped
 
     with _errors():
-        if out.suffix.lower() not in (".gif", ".mp4"):
-            raise ValueError(f"--out must end in .gif or .mp4, got {str(out)!r}")
+        check_output(out, "--out", (".gif", ".mp4"))
+        _check_strides(strides)
+        check_number(fps, "--fps", lower=1, upper=1000, integer=True)
         p, y, t0 = _start(sets, gait, from_tslip)
         tr = simulate(p, y, strides, t0=t0)
         animate_biped(tr, out, fps=fps)
@@ -226,6 +242,8 @@ def report_cmd(
     from ..plotting.biped import plot_foot_path, plot_metacentric, plot_tracking
 
     with _errors():
+        check_output(out_dir / "multipliers.csv", "--out-dir")
+        _check_strides(strides)
         p, y, t0 = _start(sets, gait, from_tslip)
         out_dir.mkdir(parents=True, exist_ok=True)
         tr = simulate(p, y, strides, t0=t0)
@@ -282,6 +300,13 @@ def optimise_cmd(
     from ..biped.gait import section_multipliers
 
     with _errors():
+        check_output(out, "--out", (".json",))
+        check_number(budget, "--budget", unit="s", lower=0.0, lower_open=True)
+        check_number(max_evals, "--max-evals", lower=1, integer=True)
+        check_number(popsize, "--popsize", lower=2, integer=True)
+        check_number(sigma0, "--sigma0", lower=0.0, upper=1.0, lower_open=True)
+        check_number(seed, "--seed", lower=0, integer=True)
+        check_number(processes, "--processes", lower=1, upper=256, integer=True)
         p, y, t0 = _start(None, gait)
         z0 = to_section(p, y, t0)
         c = _console()

@@ -18,8 +18,9 @@ import pandas as pd
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
+from .._checks import check_number, check_output
 from .._io import atomic_write, write_json, write_table
-from .main import PresetOpt, SetOpt, _build_params, _console, _errors, _fail, app
+from .main import _DATA_SUFFIXES, PresetOpt, SetOpt, _build_params, _console, _errors, _fail, app
 
 __all__ = ["synth_video_cmd", "track_cmd", "process_cmd", "fit_cmd", "experiment_cmd"]
 
@@ -33,14 +34,33 @@ def _bar(label: str) -> Progress:
                     console=_console(stderr=True), transient=True)
 
 
-def _read_table(path: Path) -> pd.DataFrame:
-    if not path.exists():
-        raise ValueError(f"file not found: {str(path)!r}")
-    if path.suffix.lower() == ".parquet":
-        return pd.read_parquet(path)
-    if path.suffix.lower() != ".csv":
-        raise ValueError(f"expected a .csv or .parquet table, got {str(path)!r}")
-    return pd.read_csv(path)
+#: Columns `tslip process` reads from a tracks table (written by `tslip track`).
+_TRACK_COLUMNS = ("t", "body_q", "front_x_m", "front_y_m", "rear_x_m", "rear_y_m",
+                  "foot1_x_m", "foot1_y_m", "foot1_q", "foot2_x_m", "foot2_y_m", "foot2_q")
+#: Columns `tslip fit` reads from a steps table (written by `tslip process`).
+_STEP_COLUMNS = ("step", "tau", "stance_time", "flight_time", "y", "l", "beta", "phi", "xd",
+                 "yd", "ld", "betad", "phid")
+
+
+def _read_table(path: Path, columns: tuple[str, ...], what: str) -> pd.DataFrame:
+    """Read a .csv/.parquet table that must have numeric ``columns`` (one-line errors)."""
+    if path.suffix.lower() not in _DATA_SUFFIXES:
+        raise ValueError(f"{what} must be a .csv or .parquet table, got {str(path)!r}")
+    if not path.is_file():
+        raise ValueError(f"{what} {str(path)!r} does not exist")
+    try:
+        table = pd.read_parquet(path) if path.suffix.lower() == ".parquet" else pd.read_csv(path)
+    except Exception as exc:  # pandas and pyarrow raise many kinds for a broken file
+        why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ValueError(f"{what} {str(path)!r} cannot be read: {why}") from None
+    missing = [c for c in columns if c not in table.columns]
+    if missing:
+        raise ValueError(f"{what} {str(path)!r} lacks column {missing[0]!r}; it needs "
+                         f"{', '.join(columns)}")
+    bad = [c for c in columns if not pd.api.types.is_numeric_dtype(table[c])]
+    if bad:
+        raise ValueError(f"{what} {str(path)!r}: column {bad[0]!r} must hold numbers")
+    return table
 
 
 @app.command("synth-video")
@@ -69,12 +89,27 @@ def synth_video_cmd(
     model of Appendix E (--preset is then unused).
     """
     with _errors():
-        from ..experiment.render import write_video
-        from ..experiment.synth import Camera, RenderOptions, synthesize, synthesize_biped
+        from ..experiment.render import check_mp4_size, write_video
+        from ..experiment.synth import (
+            Camera,
+            RenderOptions,
+            check_recording,
+            synthesize,
+            synthesize_biped,
+        )
         from ..gait import find_gait
 
         cam = Camera(width=width, height=height, fps=fps, field_width=field_width)
         render = RenderOptions(noise=noise, seed=seed)
+        check_recording(duration, cam)
+        if out.suffix.lower() == ".mp4":
+            check_mp4_size(width, height)
+            check_output(out, "--out")
+        elif out.suffix:
+            raise ValueError(f"--out must be an .mp4 file or a folder (no suffix), got "
+                             f"{str(out)!r}")
+        else:
+            check_output(out / "frame_000000.png", "--out")
         if biped_gait is not None:
             if sets:
                 raise ValueError("--set changes the TSLIP preset; it cannot be combined with "
@@ -121,6 +156,14 @@ def _track(video: Path, out: Path, fps: float | None, scale: float | None,
 
     if (scale is None) != (ground is None):
         raise ValueError("give both --scale and --ground, or neither (measured from the frame)")
+    check_output(out, "--out", _DATA_SUFFIXES)
+    if fps is not None:
+        check_number(fps, "--fps", unit="Hz", lower=0.0, upper=1e5, lower_open=True)
+    if scale is not None:
+        check_number(scale, "--scale", unit="px/m", lower=0.0, lower_open=True)
+        check_number(ground, "--ground", unit="px", lower=0.0)
+    if max_frames is not None:
+        check_number(max_frames, "--max-frames", lower=1, integer=True)
     if scale is None:
         frames, _, _ = open_video(video)
         first = next(frames, None)
@@ -172,10 +215,15 @@ def track_cmd(
 def _process(tracks_path: Path, out: Path) -> Any:
     from ..experiment.signals import process_tracks
 
-    tracks = _read_table(tracks_path)
+    check_output(out, "--out", _DATA_SUFFIXES)
+    tracks = _read_table(tracks_path, _TRACK_COLUMNS, "tracks table")
     if len(tracks) < 2:
         raise ValueError(f"too few frames in {str(tracks_path)!r}: {len(tracks)}")
-    fps = 1.0 / float(np.median(np.diff(tracks["t"].to_numpy())))
+    dt = float(np.median(np.diff(tracks["t"].to_numpy(float))))
+    if not (math.isfinite(dt) and dt > 0):
+        raise ValueError(f"tracks table {str(tracks_path)!r}: column 't' must increase "
+                         "(frame times in s)")
+    fps = 1.0 / dt
     data = process_tracks(tracks, fps)
     table = data.samples.merge(data.steps[["step", "stance_time", "flight_time"]], on="step")
     write_table(table, out)
@@ -209,7 +257,8 @@ def _fit(steps_path: Path, out_dir: Path, frames: Any = None) -> Any:
     from ..experiment.signals import average_steps
     from ..plotting.experiment import plot_foot_trajectory, plot_step_average
 
-    table = _read_table(steps_path)
+    check_output(out_dir / "fit.json", "--out-dir")
+    table = _read_table(steps_path, _STEP_COLUMNS, "steps table")
     steps = table.groupby("step")[["stance_time", "flight_time"]].first().reset_index()
     avg = average_steps(table, steps)
     if avg.n_steps < 2:
@@ -262,7 +311,7 @@ def experiment_cmd(
     """Run track -> process -> fit and write everything into one folder."""
     with _errors():
         t0 = time.perf_counter()
-        out_dir.mkdir(parents=True, exist_ok=True)
+        check_output(out_dir / "tracks.csv", "--out-dir")  # the files make the folder
         _track(video, out_dir / "tracks.csv", fps, scale, ground, None)
         data = _process(out_dir / "tracks.csv", out_dir / "steps.csv")
         _fit(out_dir / "steps.csv", out_dir, data)

@@ -14,6 +14,7 @@ from rich import box
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
+from .._checks import check_fits, check_number, check_output
 from .._io import atomic_write, write_table
 from ..gait import analyse, continue_gait, find_gait, get_param, impulse_linearisation
 from ..gait import pitch_disturbance_response as pitch_response
@@ -24,6 +25,7 @@ from .main import (
     PresetOpt,
     SetOpt,
     _build_params,
+    _check_plot_suffix,
     _check_suffix,
     _console,
     _errors,
@@ -33,6 +35,9 @@ from .main import (
 )
 
 __all__ = ["gait_cmd", "continue_cmd"]
+
+#: Memory one branch point holds at least: its gait, multipliers and table row.
+_POINT_BYTES = 2000.0
 
 
 def _fmt(x: Any, digits: int = 4) -> str:
@@ -119,7 +124,7 @@ def _print_report(rep: dict[str, Any]) -> None:
 
 @app.command("gait")
 def gait_cmd(
-    preset_name: PresetOpt = "table2.1",
+    preset_name: PresetOpt = None,
     sets: SetOpt = None,
     params_file: ParamsOpt = None,
     method: Annotated[
@@ -139,6 +144,9 @@ def gait_cmd(
     with _errors():
         if method not in ("newton", "cma"):
             raise ValueError(f"--method must be 'newton' or 'cma', got {method!r}")
+        check_number(seed, "--seed", lower=0, upper=2**32 - 1, integer=True)
+        if plot is not None:
+            check_output(plot / "friction.png", "--plot")
         params = _build_params(preset_name, sets, params_file)
         gait = find_gait(params, method=method, seed=seed)
         if not gait.converged:
@@ -170,7 +178,7 @@ def continue_cmd(
     start: Annotated[float, typer.Option("--from", help="First value.")],
     stop: Annotated[float, typer.Option("--to", help="Last value.")],
     points: Annotated[int, typer.Option("--points", "-n", help="Number of values.")] = 50,
-    preset_name: PresetOpt = "table2.1",
+    preset_name: PresetOpt = None,
     sets: SetOpt = None,
     params_file: ParamsOpt = None,
     out: Annotated[
@@ -182,11 +190,12 @@ def continue_cmd(
 ) -> None:
     """Follow the periodic gait along a parameter; print and save the branch."""
     with _errors():
-        if points < 2:
-            raise ValueError(f"--points must be an integer >= 2, got {points}")
+        check_number(points, "--points", lower=2, integer=True)
+        check_fits(points, _POINT_BYTES, "--points", "the branch")
         if not (math.isfinite(start) and math.isfinite(stop) and start < stop):
             raise ValueError(f"--from must be below --to (both finite), got {start}, {stop}")
         _check_suffix(out, _DATA_SUFFIXES, "--out")
+        _check_plot_suffix(plot)
         params = _build_params(preset_name, sets, params_file)
         get_param(params, param)  # validates the name
         values = np.linspace(start, stop, points)

@@ -23,10 +23,19 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
 from .. import __version__
+from .._checks import check_number, check_output, parse_number
 from ..gait import Gait, find_gait
-from ..model.parameters import PARAMETER_TABLE, Params, preset, preset_description, presets
+from ..model.parameters import (
+    PARAMETER_TABLE,
+    Params,
+    preset,
+    preset_description,
+    presets,
+    read_params_file,
+)
 from ..model.state import TouchdownState
 from ..simulation import IntegratorOptions, Status, Trajectory, simulate
+from ..simulation.integrate import check_simulation_size
 
 __all__ = ["app", "main"]
 
@@ -46,7 +55,12 @@ _ANIM_SUFFIXES = (".gif", ".mp4")
 # -- shared options -------------------------------------------------------------
 
 PresetOpt = Annotated[
-    str, typer.Option("--preset", "-p", help="Base parameter set (see `tslip presets`).")
+    str | None,
+    typer.Option(
+        "--preset", "-p",
+        help="Base parameter set (see `tslip presets`); default: the --params file's preset, "
+        "else table2.1.",
+    ),
 ]
 SetOpt = Annotated[
     list[str] | None,
@@ -92,14 +106,20 @@ def _errors() -> Iterator[None]:
     """Turn ValueError (bad input) into ``error: ...`` and exit code 2."""
     try:
         yield
+    except _GaitFailed as exc:
+        _fail(str(exc), 1)
     except ValueError as exc:
         _fail(str(exc), 2)
     except OSError as exc:  # e.g. an output directory that cannot be written
         _fail(f"{exc.strerror or exc}: {exc.filename}" if exc.filename else str(exc), 1)
 
 
-def _fail(message: str, code: int) -> None:
+def _echo_error(message: str) -> None:
     typer.echo("error: " + " ".join(message.split()), err=True)
+
+
+def _fail(message: str, code: int) -> None:
+    _echo_error(message)
     raise typer.Exit(code=code)
 
 
@@ -107,25 +127,22 @@ def _parse_sets(items: list[str] | None, base: Params) -> dict[str, Any]:
     """``["k=30", "controller.Kd=0.4"]`` -> overrides for :meth:`Params.from_dict`."""
     out: dict[str, Any] = {}
     gains: dict[str, float] = {}
+    seen: set[str] = set()
     for item in items or []:
         key, sep, value = item.partition("=")
         key, value = key.strip(), value.strip()
         if not sep or not key or not value:
             raise ValueError(f"--set expects key=value, got {item!r}")
+        if key in seen:
+            raise ValueError(f"--set {key} is given twice; give it once")
+        seen.add(key)
         if key.startswith("controller."):
-            name = key.split(".", 1)[1]
-            try:
-                gains[name] = float(value)
-            except ValueError:
-                raise ValueError(f"{key} must be a number, got {value!r}") from None
+            gains[key.split(".", 1)[1]] = parse_number(value, f"--set {key}")
         elif key in _STRING_KEYS:
             out[key] = value
         elif key in _TABLE or key == "omega_r_bar":
-            try:
-                out[key] = float(value)
-            except ValueError:
-                unit = f" [{_TABLE[key].unit}]" if key in _TABLE else ""
-                raise ValueError(f"{key}{unit} must be a number, got {value!r}") from None
+            unit = _TABLE[key].unit if key in _TABLE else "-"
+            out[key] = parse_number(value, f"--set {key} [{unit}]")
         else:
             raise ValueError(
                 f"unknown parameter {key!r} in --set; allowed: {sorted(_TABLE)} plus "
@@ -141,19 +158,50 @@ def _parse_sets(items: list[str] | None, base: Params) -> dict[str, Any]:
     return out
 
 
-def _build_params(preset_name: str, sets: list[str] | None, params_file: Path | None) -> Params:
-    params = preset(preset_name)
-    if params_file is not None:
-        params = Params.from_toml(params_file, base=params)
+def _build_params(
+    preset_name: str | None, sets: list[str] | None, params_file: Path | None
+) -> Params:
+    """Parameters from the preset, then the ``--params`` file, then ``--set``."""
+    return _build(preset_name, sets, params_file)[0]
+
+
+def _build(
+    preset_name: str | None, sets: list[str] | None, params_file: Path | None
+) -> tuple[Params, str]:
+    """:func:`_build_params` and the name of the preset actually used.
+
+    The preset comes from ``--preset`` or the file's ``preset`` key (default
+    table2.1); both given with different values is an error naming both.
+    """
+    data = {} if params_file is None else read_params_file(params_file)
+    file_preset = data.pop("preset", None)
+    if file_preset is not None:
+        if not isinstance(file_preset, str):
+            raise ValueError(f"parameter file {str(params_file)!r}: preset must be one of "
+                             f"{presets()}, got {file_preset!r}")
+        preset(file_preset)  # validates the name
+        if preset_name is not None and preset_name.strip().lower() != file_preset.strip().lower():
+            raise ValueError(
+                f"--preset {preset_name!r} and preset = {file_preset!r} in "
+                f"{str(params_file)!r} differ; give one of them"
+            )
+    name = preset_name or file_preset or "table2.1"
+    params = preset(name)
+    if data:
+        try:
+            params = Params.from_dict(data, base=params)
+        except ValueError as exc:
+            raise ValueError(f"parameter file {str(params_file)!r}: {exc}") from None
     overrides = _parse_sets(sets, params)
     if overrides:
         params = Params.from_dict(overrides, base=params)
-    return params
+    return params, name.strip().lower()
 
 
 def _check_suffix(path: Path | None, allowed: tuple[str, ...], option: str) -> None:
-    if path is not None and path.suffix.lower() not in allowed:
-        raise ValueError(f"{option} must end in {' or '.join(allowed)}, got {str(path)!r}")
+    """Check an output file before the work: suffix allowed, directory writable."""
+    if path is not None:
+        check_output(path, option, allowed)
 
 
 def _check_plot_suffix(path: Path | None) -> None:
@@ -177,6 +225,9 @@ def _start(
         return params, state, None
     gait = find_gait(params)
     console.print(f"gait: {gait.message}", style="green" if gait.converged else "yellow")
+    if not gait.converged:
+        raise _GaitFailed(f"no periodic gait found ({gait.message}); --no-gait starts from "
+                          "v0, beta0 instead")
     console.print(
         f"      delta = {gait.state.delta:+.6f}, phi = {gait.state.phi:+.6f}, "
         f"phid = {gait.state.phid:+.6f}, alpha_r = {gait.params.alpha_r:.6f}"
@@ -184,13 +235,19 @@ def _start(
     return gait.params, gait.state, gait
 
 
-def _check_run_options(steps: int, dt: float, rtol: float, atol: float) -> None:
-    """Validate run options before the (slower) gait search."""
-    if steps < 1:
-        raise ValueError(f"--steps must be an integer >= 1, got {steps}")
-    if not (math.isfinite(dt) and dt > 0):
-        raise ValueError(f"--dt [g^-1/2 L^1/2] must be a finite number > 0, got {dt!r}")
-    IntegratorOptions(rtol=rtol, atol=atol)
+class _GaitFailed(Exception):
+    """The gait search did not converge: exit code 1, not 2 (the input was valid)."""
+
+
+def _check_run_options(steps: int, dt: float, rtol: float, atol: float,
+                       params: Params | None = None) -> None:
+    """Validate run options before the (slower) gait search; with ``params``, the size too."""
+    check_number(steps, "--steps", lower=1, integer=True)
+    check_number(dt, "--dt", unit="g^-1/2 L^1/2", lower=0.0, lower_open=True)
+    check_number(rtol, "--rtol", lower=0.0, upper=1.0, lower_open=True, upper_open=True)
+    check_number(atol, "--atol", lower=0.0, upper=1.0, lower_open=True, upper_open=True)
+    if params is not None:
+        check_simulation_size(params, steps, dt, "--steps")
 
 
 def _run(
@@ -386,7 +443,7 @@ def _preset_detail(name: str) -> Table:
 
 @app.command("simulate")
 def simulate_cmd(
-    preset_name: PresetOpt = "table2.1",
+    preset_name: PresetOpt = None,
     steps: StepsOpt = 20,
     sets: SetOpt = None,
     params_file: ParamsOpt = None,
@@ -409,7 +466,8 @@ def simulate_cmd(
         _check_suffix(out, _DATA_SUFFIXES, "--out")
         _check_plot_suffix(plot)
         console = _console()
-        params = _build_params(preset_name, sets, params_file)
+        params, preset_used = _build(preset_name, sets, params_file)
+        _check_run_options(steps, dt, rtol, atol, params)
         params, state, gait = _start(params, no_gait, console)
         traj = _run(
             params,
@@ -420,7 +478,7 @@ def simulate_cmd(
             atol,
             {
                 "command": "simulate",
-                "preset": preset_name,
+                "preset": preset_used,
                 "set": list(sets or []),
                 "params_file": None if params_file is None else str(params_file),
                 "gait": _gait_meta(gait),
@@ -441,7 +499,7 @@ def simulate_cmd(
 @app.command("animate")
 def animate_cmd(
     out: Annotated[Path, typer.Option("--out", "-o", help="Animation file (.gif or .mp4).")],
-    preset_name: PresetOpt = "table2.1",
+    preset_name: PresetOpt = None,
     steps: StepsOpt = 10,
     sets: SetOpt = None,
     params_file: ParamsOpt = None,
@@ -459,8 +517,12 @@ def animate_cmd(
     with _errors():
         _check_run_options(steps, dt, rtol, atol)
         _check_suffix(out, _ANIM_SUFFIXES, "--out")
+        check_number(fps, "--fps", lower=0.0, upper=1000.0, lower_open=True)
+        check_number(speed, "--speed", lower=0.0, upper=100.0, lower_open=True)
+        check_number(dpi, "--dpi", lower=10.0, upper=1000.0)
         console = _console()
         params = _build_params(preset_name, sets, params_file)
+        _check_run_options(steps, dt, rtol, atol, params)
         params, state, gait = _start(params, no_gait, console)
         traj = _run(params, state, steps, dt, rtol, atol, {"command": "animate"})
         console.print(_status_line(traj))
@@ -477,7 +539,8 @@ def demo_cmd(
 ) -> None:
     """Solve the Table 2.1 passive gait, simulate it, write data, plot and animation."""
     with _errors():
-        _check_run_options(steps, 0.01, 1e-8, 1e-8)
+        _check_run_options(steps, 0.01, 1e-8, 1e-8, preset("table2.1"))
+        check_output(out_dir / "run.csv", "--out-dir")
         console = _console()
         t_start = time.perf_counter()
         name = "table2.1"
@@ -526,5 +589,28 @@ from . import studies as _study_commands  # noqa: E402, F401  (study, reproduce)
 
 
 def main() -> None:
-    """Entry point of the ``tslip`` console script."""
-    app(prog_name="tslip")
+    """Entry point of the ``tslip`` console script.
+
+    Usage errors found by the option parser (``--steps abc``, an unknown
+    option) print one line ``error: ...`` like every other bad input.
+    """
+    import sys
+
+    # typer's (vendored) click exceptions live beside BadParameter
+    exc_mod = sys.modules[typer.BadParameter.__module__]
+    try:
+        code = app(prog_name="tslip", standalone_mode=False)
+    except exc_mod.NoArgsIsHelpError as exc:
+        exc.show()
+        sys.exit(exc.exit_code)
+    except exc_mod.UsageError as exc:
+        command = exc.ctx.command_path if exc.ctx is not None else "tslip"
+        _echo_error(f"{exc.format_message()} (see `{command} --help`)")
+        sys.exit(exc.exit_code)
+    except exc_mod.ClickException as exc:
+        _echo_error(exc.format_message())
+        sys.exit(exc.exit_code)
+    except typer.Abort:
+        _echo_error("interrupted")
+        sys.exit(130)
+    sys.exit(code if isinstance(code, int) else 0)

@@ -16,7 +16,14 @@ import numpy as np
 
 from .synth import Camera, SyntheticRun, _body_corners
 
-__all__ = ["render_frames", "write_video", "FOOT_BGR"]
+__all__ = ["render_frames", "write_video", "check_mp4_size", "FOOT_BGR"]
+
+
+def check_mp4_size(width: int, height: int) -> None:
+    """Refuse a frame size libx264 / yuv420p cannot encode (odd width or height)."""
+    if width % 2 or height % 2:
+        raise ValueError(f"--width and --height must be even for an .mp4 (libx264, yuv420p), "
+                         f"got {width} x {height} px; use even sizes or a folder of PNGs")
 
 #: Foot marker colour (B, G, R): a saturated magenta found nowhere else in the scene.
 FOOT_BGR = (200, 40, 230)
@@ -171,25 +178,15 @@ def write_video(run: SyntheticRun, path: str | Path, *, quality: int = 16,
     """
     import imageio.v2 as iio
 
-    from .._io import atomic_write
+    from .._io import write_mp4
 
     path = Path(path)
     n = run.n_frames
     if path.suffix.lower() == ".mp4":
-        def write(tmp: str) -> None:
-            w = iio.get_writer(tmp, format="FFMPEG", mode="I", fps=run.camera.fps,
-                               codec="libx264", quality=None, macro_block_size=1,
-                               pixelformat="yuv420p", ffmpeg_log_level="error",
-                               output_params=["-crf", str(quality), "-preset", "veryfast"])
-            try:
-                for k, frame in enumerate(render_frames(run)):
-                    w.append_data(frame[:, :, ::-1])
-                    if progress is not None:
-                        progress(k + 1, n)
-            finally:
-                w.close()
-
-        return atomic_write(path, write)
+        check_mp4_size(run.camera.width, run.camera.height)
+        frames = (f[:, :, ::-1] for f in render_frames(run))  # BGR -> RGB
+        return write_mp4(path, frames, run.camera.fps, crf=quality, preset="veryfast",
+                         progress=progress, total=n)
     if path.suffix:
         raise ValueError(f"video output must be a .mp4 file or a directory, got {str(path)!r}")
     path.mkdir(parents=True, exist_ok=True)

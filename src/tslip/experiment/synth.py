@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
+from .._checks import check_fits, check_number
 from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..model.units import ROBOT_SCALING, Scaling
@@ -72,13 +73,13 @@ class Camera:
     hip_x: float | None = None
 
     def __post_init__(self) -> None:
-        if self.width < 64 or self.height < 64:
-            raise ValueError(f"frame size must be at least 64 x 64 px, got {self.width} x "
-                             f"{self.height}")
-        if not (math.isfinite(self.fps) and self.fps > 0):
-            raise ValueError(f"fps [Hz] must be > 0, got {self.fps!r}")
-        if not (math.isfinite(self.field_width) and self.field_width > 0):
-            raise ValueError(f"field_width [m] must be > 0, got {self.field_width!r}")
+        for name in ("width", "height"):
+            check_number(getattr(self, name), name, unit="px", lower=64, upper=8192,
+                         integer=True)
+        object.__setattr__(self, "fps", check_number(self.fps, "fps", unit="Hz", lower=0.0,
+                                                     upper=1e5, lower_open=True))
+        object.__setattr__(self, "field_width", check_number(
+            self.field_width, "field_width", unit="m", lower=0.0, lower_open=True))
 
     @property
     def px_per_m(self) -> float:
@@ -172,6 +173,14 @@ class RenderOptions:
     flicker: float = 0.03
     swing_lift: float = 0.2
     seed: int = 0
+
+    def __post_init__(self) -> None:
+        for name, unit, lo, hi in (("noise", "grey levels", 0.0, 255.0),
+                                   ("exposure", "-", 0.0, 1.0), ("flicker", "-", 0.0, 0.5),
+                                   ("swing_lift", "m", 0.0, 1.0)):
+            object.__setattr__(self, name, check_number(getattr(self, name), name, unit=unit,
+                                                        lower=lo, upper=hi))
+        check_number(self.seed, "seed", lower=0, integer=True)
 
 
 @dataclass(frozen=True)
@@ -268,7 +277,7 @@ def synthesize(params: Params, state: TouchdownState, duration: float, *,
     camera = camera or Camera()
     geometry = geometry or BodyGeometry(r=params.r * scaling.L)
     options = options or RenderOptions()
-    _check_duration(duration)
+    _check_duration(duration, camera)
     motion = _tslip_motion(params, state, duration, camera, options, scaling)
     return _layout(motion, duration, camera, geometry, options, scaling)
 
@@ -329,7 +338,7 @@ def synthesize_biped(params: BipedParams, state: BipedState | np.ndarray, durati
     camera = camera or Camera()
     geometry = geometry or BodyGeometry(r=params.r_1 * scaling.L)
     options = options or RenderOptions()
-    _check_duration(duration)
+    _check_duration(duration, camera)
     if not math.isfinite(t0):
         raise ValueError(f"t0 [g^-1/2 L^1/2] must be finite, got {t0!r}")
     motion = _biped_motion(params, state, duration, t0, camera, scaling, biped_options)
@@ -364,9 +373,20 @@ class _Motion:
     flight_time: float
 
 
-def _check_duration(duration: float) -> None:
-    if not (math.isfinite(duration) and duration > 0):
-        raise ValueError(f"duration [s] must be > 0, got {duration!r}")
+#: Memory a recorded frame holds before rendering: its ground truth row and the
+#: marker poses (about 100 numbers), plus the simulation sampled at a quarter frame.
+_FRAME_BYTES = 2000.0
+
+
+def check_recording(duration: float, camera: Camera) -> None:
+    """Refuse a recording that is not positive or whose frames cannot fit in memory."""
+    check_number(duration, "duration", unit="s", lower=0.0, lower_open=True)
+    check_fits(int(math.ceil(duration * camera.fps)), _FRAME_BYTES,
+               f"duration {duration:g} s at {camera.fps:g} Hz: frames", "the recording")
+
+
+def _check_duration(duration: float, camera: Camera | None = None) -> None:
+    check_recording(duration, camera or Camera())
 
 
 def _tslip_motion(params: Params, state: TouchdownState, duration: float, camera: Camera,

@@ -19,6 +19,7 @@ functions), so ``import tslip`` stays fast.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,6 +27,10 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+
+# libav's own messages (e.g. "moov atom not found") would go straight to stderr beside
+# our one-line error; OpenCV reads this before it first opens a file.
+os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
 
 __all__ = [
     "Calibration", "TrackerOptions", "TrackResult", "VideoError", "open_video",

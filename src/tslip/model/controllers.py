@@ -20,6 +20,8 @@ import math
 from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
+from .._checks import check_number
+
 __all__ = [
     "Controller",
     "Passive",
@@ -167,4 +169,4 @@ def controller_from_dict(data: dict[str, Any] | str) -> Controller:
         raise ValueError(
             f"controller {kind!r} has no field {sorted(unknown)[0]!r}; allowed: {sorted(allowed)}"
         )
-    return cls(**{k: float(v) for k, v in data.items()})
+    return cls(**{k: check_number(v, f"controller.{k}") for k, v in data.items()})

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, NamedTuple
 
+from .._checks import check_number
 from .._io import read_toml
 from .controllers import (
     ConstantTorque,
@@ -35,6 +36,7 @@ __all__ = [
     "preset",
     "presets",
     "LegReset",
+    "read_params_file",
 ]
 
 LegReset = Literal["local", "global"]
@@ -158,11 +160,11 @@ class Params:
 
     def __post_init__(self) -> None:
         for row in PARAMETER_TABLE:
-            value = getattr(self, row.name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ValueError(f"{row.name} [{row.unit}] must be a number, got {value!r}")
-            if isinstance(value, int):
-                object.__setattr__(self, row.name, float(value))
+            value = check_number(
+                getattr(self, row.name), row.name, unit=row.unit, lower=row.lower,
+                upper=row.upper, lower_open=row.lower_open, upper_open=row.upper_open,
+            )
+            object.__setattr__(self, row.name, value)
         check_finite_fields(self)
         if not isinstance(self.controller, Controller):
             raise ValueError(
@@ -202,44 +204,88 @@ class Params:
         """Build from a dict of overrides on ``base`` (default: Table 2.1).
 
         Accepts the field names, ``omega_r_bar`` (eq. 2.18), ``preset`` (a
-        base preset name) and ``controller`` (a name or a table).
+        base preset name) and ``controller`` (a name or a table). Values are
+        typed strictly (see :func:`tslip._checks.check_number`); a ``preset``
+        that differs from a given ``base``, or both ``omega_r`` and
+        ``omega_r_bar``, is an error rather than a silent choice.
         """
         data = dict(data)
         if "preset" in data:
-            base = preset(str(data.pop("preset")))
+            name = data.pop("preset")
+            if not isinstance(name, str):
+                raise ValueError(f"preset must be one of {presets()}, got {name!r}")
+            named = preset(name)
+            if base is not None and base != named:
+                raise ValueError(
+                    f"preset {name!r} conflicts with the base parameters given; give one"
+                )
+            base = named
         base = base or cls()
+        if "omega_r" in data and "omega_r_bar" in data:
+            raise ValueError("give omega_r or omega_r_bar (eq. 2.18), not both")
         changes: dict[str, Any] = {}
         omega_r_bar = data.pop("omega_r_bar", None)
         if "controller" in data:
             changes["controller"] = controller_from_dict(data.pop("controller"))
         if "leg_reset" in data:
-            changes["leg_reset"] = str(data.pop("leg_reset"))
+            leg_reset = data.pop("leg_reset")
+            if leg_reset not in ("local", "global"):
+                raise ValueError(f"leg_reset must be 'local' or 'global', got {leg_reset!r}")
+            changes["leg_reset"] = leg_reset
         for key, value in data.items():
             if key not in _TABLE:
                 raise ValueError(
                     f"unknown parameter {key!r}; allowed: {sorted(_TABLE)} "
                     "plus omega_r_bar, controller, leg_reset, preset"
                 )
-            try:
-                changes[key] = float(value)
-            except (TypeError, ValueError):
-                raise ValueError(
-                    f"{key} [{_TABLE[key].unit}] must be a number, got {value!r}"
-                ) from None
+            row = _TABLE[key]
+            changes[key] = check_number(
+                value, key, unit=row.unit, lower=row.lower, upper=row.upper,
+                lower_open=row.lower_open, upper_open=row.upper_open,
+            )
         out = dataclasses.replace(base, **changes)
         if omega_r_bar is not None:
-            try:
-                omega_r_bar = float(omega_r_bar)
-            except (TypeError, ValueError):
-                raise ValueError(f"omega_r_bar [-] must be a number, got {omega_r_bar!r}") from None
-            out = out.with_omega_r_bar(omega_r_bar)
+            out = out.with_omega_r_bar(check_number(omega_r_bar, "omega_r_bar", unit="-"))
         return out
 
     @classmethod
     def from_toml(cls, path: str | Path, base: Params | None = None) -> Params:
-        """Read parameters from a TOML file (see :meth:`from_dict`)."""
-        data = read_toml(path, "parameter file")
-        return cls.from_dict(data.get("params", data), base=base)
+        """Read parameters from a TOML file (see :func:`read_params_file`, :meth:`from_dict`)."""
+        data = read_params_file(path)
+        try:
+            return cls.from_dict(data, base=base)
+        except ValueError as exc:
+            raise ValueError(f"parameter file {str(path)!r}: {exc}") from None
+
+
+def read_params_file(path: str | Path) -> dict[str, Any]:
+    """The parameter entries of a TOML file: its ``[params]`` table or its top-level keys.
+
+    A file with a ``[params]`` table may have nothing else at the top level
+    except ``preset``: a stray top-level key (e.g. ``k = 30`` above
+    ``[params]``) would otherwise be ignored, so it is an error.
+    """
+    data = read_toml(path, "parameter file")
+    if "params" not in data:
+        return data
+    table = data["params"]
+    if not isinstance(table, dict):
+        raise ValueError(f"parameter file {str(path)!r}: params must be a table [params]")
+    stray = sorted(set(data) - {"params", "preset"})
+    if stray:
+        raise ValueError(
+            f"parameter file {str(path)!r}: top-level key {stray[0]!r} beside the [params] "
+            "table; put it inside [params]"
+        )
+    out = dict(table)
+    if "preset" in data:
+        if "preset" in out and out["preset"] != data["preset"]:
+            raise ValueError(
+                f"parameter file {str(path)!r}: preset given twice ({data['preset']!r} and "
+                f"{out['preset']!r} in [params])"
+            )
+        out["preset"] = data["preset"]
+    return out
 
 
 # -- presets ----------------------------------------------------------------

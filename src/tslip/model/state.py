@@ -13,6 +13,8 @@ from dataclasses import astuple, dataclass
 
 import numpy as np
 
+from .._checks import check_number
+
 __all__ = ["TouchdownState", "SECTION_NAMES"]
 
 #: Names of the 5-D Poincare-section vector, in order.
@@ -49,11 +51,7 @@ class TouchdownState:
 
     def __post_init__(self) -> None:
         for name, value in zip(("beta", "phi", "xd", "yd", "phid", "x", "h"), astuple(self)):
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)):
-                raise ValueError(f"TouchdownState.{name} must be a number, got {value!r}")
-            if not math.isfinite(value):
-                raise ValueError(f"TouchdownState.{name} must be finite, got {value!r}")
-            object.__setattr__(self, name, float(value))
+            object.__setattr__(self, name, check_number(value, f"TouchdownState.{name}"))
 
     @classmethod
     def from_velocity(

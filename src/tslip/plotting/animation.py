@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -19,6 +18,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Ellipse, FancyArrowPatch
 
+from .._io import atomic_write, write_mp4
 from ..simulation.result import TRAJECTORY_COLUMNS
 from .trajectories import ground_profile
 
@@ -336,19 +336,10 @@ def animate(
         traj, t_frames, size=size, dpi=dpi, terrain=terrain, view_width=view_width
     )
     total = len(t_frames)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=suffix)
-    os.close(fd)
-    os.unlink(tmp)  # the writers create the file themselves
-    try:
-        if suffix == ".gif":
-            _write_gif(tmp, frames, 10 * delay_cs, total, progress)
-        else:
-            _write_mp4(tmp, frames, fps, total, progress)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    if suffix == ".gif":
+        atomic_write(path, lambda tmp: _write_gif(tmp, frames, 10 * delay_cs, total, progress))
+    else:
+        write_mp4(path, frames, fps, progress=progress, total=total)
     return path
 
 
@@ -381,30 +372,3 @@ def _write_gif(
         disposal=1,
     )
 
-
-def _write_mp4(
-    path: str,
-    frames: Iterable[np.ndarray],
-    fps: float,
-    total: int,
-    progress: Callable[[int, int], None] | None,
-) -> None:
-    import imageio.v2 as iio2
-
-    writer = iio2.get_writer(
-        path,
-        format="FFMPEG",
-        mode="I",
-        fps=fps,
-        codec="libx264",
-        macro_block_size=8,
-        pixelformat="yuv420p",
-        ffmpeg_log_level="error",
-    )
-    try:
-        for i, frame in enumerate(frames):
-            writer.append_data(frame)
-            if progress is not None:
-                progress(i + 1, total)
-    finally:
-        writer.close()

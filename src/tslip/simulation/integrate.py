@@ -14,6 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .._checks import check_fits, check_number
 from ..model import _pack as pk
 from ..model.parameters import Params
 from ..model.state import TouchdownState
@@ -63,11 +64,10 @@ class Disturbance:
     dphid: float = 0.0
 
     def __post_init__(self) -> None:
-        if not isinstance(self.at_step, int) or self.at_step < 0:
-            raise ValueError(f"Disturbance.at_step must be an integer >= 0, got {self.at_step!r}")
+        object.__setattr__(self, "at_step",
+                           check_number(self.at_step, "Disturbance.at_step", lower=0, integer=True))
         for name in ("dh", "dxd", "dphid"):
-            if not math.isfinite(getattr(self, name)):
-                raise ValueError(f"Disturbance.{name} must be finite, got {getattr(self, name)!r}")
+            object.__setattr__(self, name, check_number(getattr(self, name), f"Disturbance.{name}"))
 
 
 def _options(options: IntegratorOptions | None) -> np.ndarray:
@@ -85,6 +85,43 @@ def _as_state(state: TouchdownState | Sequence[float] | np.ndarray) -> Touchdown
     raise ValueError(
         f"state must be a TouchdownState or have 5 or 7 entries, got shape {arr.shape}"
     )
+
+
+def _section(q: Sequence[float] | np.ndarray, h: float) -> np.ndarray:
+    """The touch-down vector ``(beta, phi, xd, yd, phid, x=0, h)`` of a checked section."""
+    qa = np.asarray(q, dtype=float)
+    if qa.shape != (5,):
+        raise ValueError(f"q (beta, phi, xd, yd, phid) must have 5 entries, got shape {qa.shape}")
+    if not np.all(np.isfinite(qa)):
+        raise ValueError(f"q (beta, phi, xd, yd, phid) must be finite, got {qa.tolist()}")
+    td = np.zeros(pk.NTD)
+    td[:5] = qa
+    td[6] = check_number(h, "h", unit="L")
+    return td
+
+
+#: Bytes a recorded stride holds per sample row (the table, its stance record and
+#: the copies made while stacking) and per stride (result objects); measured with
+#: tracemalloc for Table 2.1 and 6.1 (tests/simulation/test_input_checks.py).
+_ROW_BYTES = 480.0
+_STRIDE_BYTES = 2000.0
+
+
+def trajectory_bytes_per_stride(params: Params, dt: float) -> float:
+    """Memory one stride of :func:`simulate` needs at sample interval ``dt``, estimated.
+
+    Rows come from the stance time ``t_s ~ 2 l0 cos(beta0) / v0`` (the foot
+    sweeps about ``2 l0 cos(beta0)`` at speed ``v0``; cf. eq. 3.10) sampled
+    every ``dt``; flight is left out, so this errs low and never refuses a run
+    that fits.
+    """
+    t_s = 2.0 * params.l0 * math.cos(params.beta0) / params.v0
+    return _STRIDE_BYTES + _ROW_BYTES * (t_s / dt + 2.0)
+
+
+def check_simulation_size(params: Params, n_steps: int, dt: float, name: str = "n_steps") -> None:
+    """Refuse a :func:`simulate` run whose trajectory cannot fit in memory (before any work)."""
+    check_fits(n_steps, trajectory_bytes_per_stride(params, dt), name, "the trajectory")
 
 
 def _check_params(params: Params) -> Params:
@@ -202,10 +239,7 @@ def step_map(
     tight loops.
     """
     P = pk.pack_params(params) if packed is None else packed
-    td = np.empty(pk.NTD)
-    td[:5] = q
-    td[5] = 0.0
-    td[6] = h
+    td = _section(q, h)
     out = np.empty(pk.NOUT)
     tx, th = _FLAT.arrays()
     th = th + h
@@ -234,9 +268,7 @@ def step_jacobian(
     from . import _variational as va
 
     P = pk.pack_params(params)
-    td = np.zeros(pk.NTD)
-    td[:5] = q
-    td[6] = h
+    td = _section(q, h)
     out = np.empty(pk.NOUT)
     J = np.empty((5, 5))
     tx, th = _FLAT.arrays()
@@ -272,10 +304,9 @@ def simulate(
     3
     """
     params = _check_params(params)
-    if not isinstance(n_steps, (int, np.integer)) or n_steps < 1:
-        raise ValueError(f"n_steps must be an integer >= 1, got {n_steps!r}")
-    if not (math.isfinite(dt) and dt > 0):
-        raise ValueError(f"dt [g^-1/2 L^1/2] must be in (0, inf), got {dt!r}")
+    n_steps = int(check_number(n_steps, "n_steps", lower=1, integer=True))
+    dt = float(check_number(dt, "dt", unit="g^-1/2 L^1/2", lower=0.0, lower_open=True))
+    check_simulation_size(params, n_steps, dt)
     terrain = terrain or _FLAT
     td = _as_state(state)
     P = pk.pack_params(params)
@@ -496,10 +527,10 @@ def run_batch(
     Terrain may differ per row (e.g. one step-down height per row), which is
     how robustness searches evaluate many disturbances at once.
     """
-    if not isinstance(n_steps, (int, np.integer)) or n_steps < 1:
-        raise ValueError(f"n_steps must be an integer >= 1, got {n_steps!r}")
+    n_steps = int(check_number(n_steps, "n_steps", lower=1, integer=True))
     Ps, S, TX, TH = _batch_inputs(params, states, terrain)
     n = len(S)
+    check_fits(n_steps, n * 7 * 8.0, "n_steps", f"the touch-downs of {n} runs")
     hist = np.full((n, int(n_steps) + 1, 7), np.nan)
     status = np.empty(n, dtype=np.int64)
     n_done = np.empty(n, dtype=np.int64)

@@ -22,7 +22,6 @@ the last axis per value of the first). Specs come from code or from TOML::
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import check_fits, check_number
 from .._io import read_toml
 from ..gait.continuation import get_param, set_param
 from ..model.parameters import Params, preset
@@ -38,6 +38,9 @@ __all__ = ["Axis", "StudySpec", "ANALYSES"]
 
 #: Analyses a study can run at each point. ``floquet`` is always run.
 ANALYSES = ("floquet", "robustness", "stride")
+#: Memory one study point holds at least: its value and one result row (about 20 numbers
+#: and their labels in a table).
+_POINT_BYTES = 1000.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -50,10 +53,10 @@ class Axis:
     @classmethod
     def linspace(cls, param: str, start: float, stop: float, points: int) -> Axis:
         """``points`` evenly spaced values from ``start`` to ``stop``."""
-        if not isinstance(points, int) or points < 1:
-            raise ValueError(f"axis {param}: points must be an integer >= 1, got {points!r}")
-        if not (math.isfinite(start) and math.isfinite(stop)):
-            raise ValueError(f"axis {param}: from and to must be finite, got {start}, {stop}")
+        points = int(check_number(points, f"axis {param}: points", lower=1, integer=True))
+        start = float(check_number(start, f"axis {param}: from"))
+        stop = float(check_number(stop, f"axis {param}: to"))
+        check_fits(points, _POINT_BYTES, f"axis {param}: points", "the study's results")
         if points > 1 and not start < stop:
             raise ValueError(f"axis {param}: empty range, from ({start:g}) must be below "
                              f"to ({stop:g})")
@@ -71,18 +74,15 @@ class Axis:
                 raise ValueError(f"axis {param}: give values or from/to/points, not both")
             if not isinstance(vals, list) or not vals:
                 raise ValueError(f"axis {param}: empty range, values must be a non-empty list")
-            try:
-                values = tuple(sorted(float(v) for v in vals))
-            except (TypeError, ValueError):
-                raise ValueError(f"axis {param}: values must be numbers, got {vals!r}") from None
+            values = tuple(sorted(float(check_number(v, f"axis {param}: values entry"))
+                                  for v in vals))
             return cls(param, values)
         unknown = set(data) - {"from", "to", "points"}
         if unknown:
             raise ValueError(f"axis {param}: unknown key {sorted(unknown)[0]!r}; use from, to, "
                              "points or values")
         try:
-            return cls.linspace(param, float(data["from"]), float(data["to"]),
-                                int(data.get("points", 50)))
+            return cls.linspace(param, data["from"], data["to"], data.get("points", 50))
         except KeyError as exc:
             raise ValueError(f"axis {param}: missing {exc.args[0]!r}") from None
 
@@ -128,9 +128,8 @@ class StudySpec:
         if bad:
             raise ValueError(f"study {self.name}: unknown analysis {sorted(bad)[0]!r}; "
                              f"allowed: {list(ANALYSES)}")
-        if not isinstance(self.n_steps, int) or self.n_steps < 1:
-            raise ValueError(f"study {self.name}: n_steps must be an integer >= 1, got "
-                             f"{self.n_steps!r}")
+        check_number(self.n_steps, f"study {self.name}: n_steps", lower=1, integer=True)
+        check_fits(self.n_points, _POINT_BYTES, f"study {self.name}: points", "its results")
         for axis in self.axes:
             if not axis.values:
                 raise ValueError(f"axis {axis.param}: empty range")
@@ -196,10 +195,15 @@ class StudySpec:
             raise ValueError(f"unknown study key {sorted(unknown)[0]!r}; allowed: "
                              f"{sorted(allowed)}")
         name = data.get("name", "study")
-        base = preset(str(data.get("preset", "table2.1")))
+        for key in ("name", "preset", "description"):
+            if key in data and not isinstance(data[key], str):
+                raise ValueError(f"study {key} must be a string, got {data[key]!r}")
+        base = preset(data.get("preset", "table2.1"))
         overrides = data.get("params", {})
         if not isinstance(overrides, dict):
             raise ValueError("study [params] must be a table")
+        if "preset" in overrides:
+            raise ValueError(f"study {name}: give preset at the top level, not in [params]")
         base = Params.from_dict(overrides, base=base)
         axes_data = data.get("axis")
         if not isinstance(axes_data, list) or not axes_data:
@@ -208,8 +212,11 @@ class StudySpec:
         analyses = data.get("analyses", ["floquet"])
         if isinstance(analyses, str):
             analyses = [analyses]
+        if not isinstance(analyses, list) or not all(isinstance(a, str) for a in analyses):
+            raise ValueError(f"study {name}: analyses must be a list of names from "
+                             f"{list(ANALYSES)}, got {analyses!r}")
         return cls(name=str(name), base=base, axes=axes, analyses=tuple(analyses),
-                   n_steps=int(data.get("n_steps", 25)),
+                   n_steps=data.get("n_steps", 25),
                    description=str(data.get("description", "")))
 
     @classmethod
