@@ -35,7 +35,7 @@ def test_table_e2_plus_entries_follow_from_the_table61_gait(table61):
 
 
 def test_tslip_geometry_is_kept(table61):
-    """Same hip, foot and CoM offset as the TSLIP touch-down (CONVENTIONS.md)."""
+    """Same hip, foot and CoM offset as the TSLIP touch-down (docs/conventions.md)."""
     p = BipedParams()
     s = table61.state
     q = tslip_start(s, p).q

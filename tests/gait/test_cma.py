@@ -80,7 +80,7 @@ def test_unpolished_result_reports_the_near_fixed_point():
 
 
 def test_global_pd_meets_the_thesis_criterion_without_an_exact_fixed_point():
-    """CONVENTIONS: global PD has no exact fixed point; the thesis accepted C1 < 1e-4."""
+    """docs/conventions.md: global PD has no exact fixed point; the thesis accepted C1 < 1e-4."""
     g = find_gait(tslip.preset("table2.1-global-pd"), method="cma", seed=2, max_evals=BUDGET)
     assert g.cma.c1 < C1_THRESHOLD
     assert not g.converged and g.residual > 1e-6

@@ -58,7 +58,7 @@ def test_mass_offset_threshold_near_0_86(r_branch):
     """Section 4.5.1: stable for a mass below the hip, unstable over about 0.86 L.
 
     Measured with the exact fixed points: the complex pair leaves the unit circle at
-    r = 0.849 (CONVENTIONS reports an independent reproduction near 0.86).
+    r = 0.849 (docs/conventions.md reports an independent reproduction near 0.86).
     """
     b = r_branch
     assert b.converged.all() and np.all(b.residual < 1e-10)

@@ -15,7 +15,7 @@ from tslip.gait.robustness import (
     run_disturbed,
 )
 
-TOL = 1e-4  # thesis search accuracy (CONVENTIONS.md)
+TOL = 1e-4  # thesis search accuracy (docs/conventions.md)
 FIELD = {"step_down": "dh", "push": "dxd", "pitch_rate": "dphid"}
 
 
@@ -43,7 +43,7 @@ def test_table_6_1_step_down_and_push_limits(report):
 def test_table_6_1_pitch_rate_limit_measured(report):
     """Pitch-rate limit: measured -0.7330 rad g^1/2 L^-1/2; the thesis reports -1.50.
 
-    CONVENTIONS.md lists -1.50 among the numbers an independent implementation
+    docs/conventions.md lists -1.50 among the numbers an independent implementation
     did not reproduce. Here the first failing disturbance (-0.7330) ends in
     the first flight (stride 0) with the hip reaching the ground before the
     foot; the value is the same for n_steps from 1 to 50 and at tolerance

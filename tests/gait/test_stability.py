@@ -54,7 +54,7 @@ def test_table_2_1_passive_is_neutral_with_one_energy_multiplier(gaits):
     lam = f.multipliers[f.trivial][0]
     assert abs(lam - 1.0) < 1e-6
     assert np.all(np.abs(f.multipliers[~f.trivial]) < 1.0)
-    # its left eigenvector is the energy gradient (CONVENTIONS.md)
+    # its left eigenvector is the energy gradient (docs/conventions.md)
     w, V = np.linalg.eig(f.jacobian.T)
     v = np.real(V[:, np.argmin(np.abs(w - 1.0))])
     (grad,) = conserved_gradients(g.params, g.state.section())

@@ -104,7 +104,7 @@ def test_bad_simulate_input(gait):
 
 def test_fy_negative_at_touchdown_is_flagged():
     """With a large hip torque F_y starts negative; the stance continues until F_y
-    crosses zero from above (CONVENTIONS.md)."""
+    crosses zero from above (docs/conventions.md)."""
     p = dataclasses.replace(tslip.preset("table2.1"),
                             controller=tslip.ConstantTorque(tau_c=-3.0, c_h=0.0))
     s = tslip.TouchdownState.from_velocity(v=5.0, delta=-0.2, beta=1.05)

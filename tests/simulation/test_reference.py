@@ -1,7 +1,7 @@
 """Independent reference implementation of one TSLIP stride, compared with tslip.
 
 The reference below is written from the thesis (Section 2, Appendix A) and
-CONVENTIONS.md only; it shares no code with ``tslip.simulation``. It uses a
+docs/conventions.md only; it shares no code with ``tslip.simulation``. It uses a
 different formulation from the thesis's minimal coordinates: the stance is
 integrated in Cartesian body coordinates ``(x, y, phi)`` with Newton-Euler
 equations, where the leg is a massless strut whose force follows from its
@@ -198,7 +198,7 @@ def ref_flight_end(p: tslip.Params, lo: np.ndarray, h: float) -> tuple[str, floa
     """End of the flight: ``("touchdown", t)`` or ``("no_touchdown", t)``.
 
     Touch-down is the first downward zero of the foot height after the foot
-    has been above the ground (CONVENTIONS.md); the runner falls if the hip
+    has been above the ground (docs/conventions.md); the runner falls if the hip
     reaches the ground first (eq. 2.11).
     """
     y, yd = lo[1], lo[4]
@@ -271,7 +271,7 @@ BASES = {
 @cache
 def base_gait(name: str):
     g = find_gait(BASES[name]())
-    # global PD has no exact fixed point (CONVENTIONS.md); a near one is enough
+    # global PD has no exact fixed point (docs/conventions.md); a near one is enough
     assert g.residual < 1e-2, g.message
     return g.params, g.state
 
@@ -528,7 +528,7 @@ def test_reset_foot_below_ground_must_rise_before_touchdown(depth):
 
     The reset angle puts the foot ``depth`` below the ground at lift-off;
     the CoM still rises, so the foot comes up through the ground and the
-    touch-down is its next *downward* crossing (CONVENTIONS.md, Events).
+    touch-down is its next *downward* crossing (docs/conventions.md, Events).
     """
     p, s = base_gait("passive")
     _, lo, _, _ = ref_stance(p, s)

@@ -6,7 +6,7 @@ entries of Table E.2 marked "based on a fixed point from the TSLIP model"
 right hip angle) follow from the TSLIP touch-down state; the rest were found
 by the periodic-gait search. :func:`tslip_start` makes that map.
 
-Geometry (CONVENTIONS.md for the TSLIP, eqs E.2-E.8 for the biped): the
+Geometry (docs/conventions.md for the TSLIP, eqs E.2-E.8 for the biped): the
 TSLIP CoM is ``hip + r (sin phi, -cos phi)`` and its foot ``hip + l0 (cos
 beta, -sin beta)``; the biped CoM is ``hip - r_1 (sin theta_b, cos
 theta_b)`` and its foot ``hip - (l_t + l_s) (sin gamma, cos gamma)`` with

@@ -494,7 +494,7 @@ def section_multipliers(params: BipedParams, z: NDArray[np.float64], *,
     return _sorted_eigvals(A)
 
 
-#: Disturbances of the robustness search (CONVENTIONS.md, "Disturbances for
+#: Disturbances of the robustness search (docs/conventions.md, "Disturbances for
 #: robustness", adapted to the biped): magnitudes are signed by ``sign``.
 DISTURBANCES: tuple[str, ...] = ("step_down", "push", "pitch_rate")
 

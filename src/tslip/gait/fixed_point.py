@@ -1,6 +1,6 @@
 """Periodic gaits: fixed points of the touch-down map (thesis Section 2.8).
 
-Unknowns (CONVENTIONS.md): the touch-down velocity angle ``delta``, pitch
+Unknowns (docs/conventions.md): the touch-down velocity angle ``delta``, pitch
 ``phi``, pitch rate ``phid`` and the leg reset angle ``alpha_r``, plus
 ``alphad_ref`` (local velocity control) or ``tau_c`` (constant torque with
 damping); ``v0`` and ``beta0`` are fixed. The residual is the next
@@ -349,7 +349,7 @@ class GaitProblem:
         [-pi/2, pi/2], ``phid`` in [-10, 10] rad g^1/2 L^-1/2, ``alpha_r`` in
         [-2 pi, 2 pi] (long flights retract the leg by more than pi),
         ``alphad_ref`` in [0, 5 v0/l0 + 10] rad g^1/2 L^-1/2 (positive in
-        stance, CONVENTIONS.md; the nominal hip rate is about ``v0/l0``),
+        stance, docs/conventions.md; the nominal hip rate is about ``v0/l0``),
         ``|tau_c| <= 10 + 2 (c_l + c_h) v0 / l0`` MgL (the torque balances the
         dampers, about ``c_h v0 / l0`` at the hip). They span every gait found
         over the thesis's parameter ranges (Sections 3.4-3.7) and keep CMA-ES
@@ -731,7 +731,7 @@ def find_gait(
 
     References
     ----------
-    Thesis Section 2.8, eqs 2.19-2.24; CONVENTIONS.md "Poincare section and
+    Thesis Section 2.8, eqs 2.19-2.24; docs/conventions.md "Poincare section and
     periodic gaits".
 
     Examples

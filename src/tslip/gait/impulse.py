@@ -24,7 +24,7 @@ at ``dt = 1e-2``, 7e-11 at ``dt = 1e-3`` (the default) and 1e-12 at
 ``dt = 3e-4`` with :meth:`IntegratorOptions.tight`; with the default
 tolerances ``rtol = atol = 1e-8`` the integrator limits it to about 1e-8.
 
-Sign conventions (CONVENTIONS.md)
+Sign conventions (docs/conventions.md)
 ---------------------------------
 x forward, y up, moments counter-clockwise positive, i.e. in the direction
 of positive pitch ``phi``. A pitch disturbance ``dphi > 0`` swings the CoM

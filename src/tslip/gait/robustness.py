@@ -3,7 +3,7 @@
 Robustness is "the largest disturbance from the periodic limit cycle which
 does not result in a fall within 25 steps", found by a search over three
 disturbances (thesis Section 3.1.3; where and with which sign each is applied
-follows CONVENTIONS.md, "Disturbances for robustness"):
+follows docs/conventions.md, "Disturbances for robustness"):
 
 ``"step_down"`` (``dh`` [L])
     The first stance starts on the original ground; every later touch-down is
@@ -18,7 +18,7 @@ follows CONVENTIONS.md, "Disturbances for robustness"):
 
 Where the push or pitch-rate change is applied (``placement``): the thesis
 says only "from the periodic limit cycle"; the default ``"touchdown"`` is
-CONVENTIONS.md's. The others exist to show how much the limit depends on
+docs/conventions.md's. The others exist to show how much the limit depends on
 that choice (Table 6.1's pitch-rate limit does not reproduce):
 
 ``"touchdown"``

@@ -14,7 +14,7 @@ A conservative model (passive without damping) keeps its energy, so ``A`` has
 the multiplier 1 with the energy gradient as left eigenvector: a structural
 ("trivial") multiplier, excluded from the largest multiplier as in eq. 2.21.
 With ``r = 0`` and no hip torque the pitch rate is conserved too, giving a
-second one (CONVENTIONS.md).
+second one (docs/conventions.md).
 """
 
 from __future__ import annotations

@@ -124,7 +124,7 @@ class Params:
         Leg damping [M g^1/2 L^-1/2] (eq. 2.1).
     omega_r : float
         Swing-leg retraction rate [rad g^1/2 L^-1/2] (eq. 2.17, sign of
-        CONVENTIONS.md: ``alpha(t) = alpha_r + omega_r (t - t_LO)``).
+        docs/conventions.md: ``alpha(t) = alpha_r + omega_r (t - t_LO)``).
     alpha_r : float
         Leg angle set at lift-off [rad].
     controller : Controller

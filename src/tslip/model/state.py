@@ -1,4 +1,4 @@
-"""The state just after touch-down: the Poincare section (CONVENTIONS.md).
+"""The state just after touch-down: the Poincare section (docs/conventions.md).
 
 At touch-down the leg has its rest length ``l0`` and the foot is on the ground,
 so the configuration is fixed by ``(beta, phi)`` plus the ground height ``h``

@@ -184,7 +184,7 @@ class _Scene:
         spring = _spring(hip, foot, self.l0)
         self.leg.set_data(spring[:, 0], spring[:, 1])
         # trunk: an ellipse along the axis through hip and CoM,
-        # hip = CoM + r (-sin phi, cos phi) (CONVENTIONS.md)
+        # hip = CoM + r (-sin phi, cos phi) (docs/conventions.md)
         up = np.array([-math.sin(phi), math.cos(phi)])
         centre = 0.5 * (hip + np.array([x, y]))
         self.body.set_center(tuple(centre))

@@ -266,7 +266,7 @@ def _table6(data: Mapping[str, Any]) -> str:
           "<tr><th>quantity</th><th>thesis</th><th>ours</th></tr>")
     s += "".join(f"<tr><td>{a}</td><td>{b:.2f}</td><td>{t[k]:.3f}</td></tr>"
                  for a, b, k in rob) + "</table>"
-    s += ("<p class='note'>CONVENTIONS.md lists the pitch-rate limit -1.50 and the controller "
+    s += ("<p class='note'>docs/conventions.md lists the pitch-rate limit -1.50 and the controller "
           "reference 2.42 as known not to reproduce with the model's equations.</p>")
     return s
 

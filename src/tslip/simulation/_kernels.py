@@ -406,7 +406,7 @@ def _record(P, rec, row, t, y):
 
 
 # ---------------------------------------------------------------------------
-# Flight in closed form (eqs 2.7, 2.17 with the sign of CONVENTIONS.md)
+# Flight in closed form (eqs 2.7, 2.17 with the sign of docs/conventions.md)
 # ---------------------------------------------------------------------------
 
 
@@ -486,7 +486,7 @@ def find_touchdown(P, O, lo, tx, th, res):
     derivative, a step of ``_safe_dt`` cannot skip a zero, so the first
     downward crossing is never missed; near the root the step is Newton-like.
     The foot must first be above the ground (a reset foot that starts below
-    it has to rise, CONVENTIONS.md). Terrain: heights ``th[k]`` between
+    it has to rise, docs/conventions.md). Terrain: heights ``th[k]`` between
     breakpoints ``tx`` (``len(th) == len(tx) + 1``).
 
     ``res`` receives ``(t_td, ground_h, clearance_at_reset)``.

@@ -55,7 +55,7 @@ class Disturbance:
     ``dxd`` (push) and ``dphid`` (pitch rate) change the touch-down state,
     keeping the other CoM velocity components; the leg rates follow from the
     kinematics (eq. A.5). ``dh`` changes the ground height of every later
-    touch-down (dh < 0: a step down), as in CONVENTIONS.md.
+    touch-down (dh < 0: a step down), as in docs/conventions.md.
     """
 
     at_step: int = 0

@@ -52,7 +52,7 @@ from .spec import StudySpec
 __all__ = ["alphad_ref_forced", "appendix_e_cached", "pitch_rate_variants", "run_all",
            "run_catalogue", "single_figures", "table61"]
 
-#: Table 6.1's printed values that do not reproduce (Section 6.1, CONVENTIONS.md).
+#: Table 6.1's printed values that do not reproduce (Section 6.1, docs/conventions.md).
 THESIS_ALPHAD_REF = 2.42
 THESIS_PITCH_RATE = -1.50
 
@@ -138,7 +138,7 @@ def pitch_rate_variants(gait: Gait) -> dict[str, float]:
 
     The thesis prints -1.50 rad g^1/2 L^-1/2 and says only "the largest
     disturbance from the periodic limit cycle which does not result in a
-    fall within 25 steps" (Section 3.1.3). The default (CONVENTIONS.md) is
+    fall within 25 steps" (Section 3.1.3). The default (docs/conventions.md) is
     the first label; the others change one choice each: where the change
     is applied (:data:`tslip.gait.robustness.PLACEMENTS`), its sign, the
     strides to survive (50) and the integrator tolerance (1e-12). Labels
