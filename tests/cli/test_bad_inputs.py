@@ -61,6 +61,7 @@ FILES = {
     "study_pointsfloat.toml": '[[axis]]\nparam = "r"\nfrom = 0.1\nto = 0.5\npoints = 2.7\n',
     "study_pointsbig.toml": '[[axis]]\nparam = "r"\nfrom = 0.1\nto = 0.5\n'
                             "points = 1000000000\n",
+    "study_ok.toml": '[[axis]]\nparam = "r"\nfrom = 0.1\nto = 0.5\npoints = 3\n',
     "study_nsteps.toml": 'n_steps = true\n[[axis]]\nparam = "r"\nvalues = [0.1]\n',
     "study_from.toml": '[[axis]]\nparam = "r"\nfrom = "a"\nto = 0.5\n',
     "study_values.toml": '[[axis]]\nparam = "r"\nvalues = [true]\n',
@@ -287,6 +288,9 @@ CASES: list[tuple[str, str]] = [
     ("study {d}/study_noaxis.toml --out {o}/s", "needs at least one [[axis]]"),
     ("study {d}/study_badparam.toml --out {o}/s", "nope"),
     ("study {d}/study_kbool.toml --out {o}/s", "k [MgL^-1] must be a number"),
+    ("study {d}/study_ok.toml --out /sys/s", "--out '/sys/s/run.json': cannot write in '/sys'"),
+    ("reproduce --quick --out /sys/report",
+     "--out '/sys/report/index.html': cannot write in '/sys'"),
     ("study {d}/study_empty_range.toml --out {o}/s", "empty range"),
     ("study {d}/study_analysis.toml --out {o}/s", "unknown analysis 'nope'"),
     ("study {d}/missing.toml --out {o}/s", "study file '{d}/missing.toml' does not exist"),

@@ -20,6 +20,7 @@ from rich.progress import (
 )
 from rich.table import Table
 
+from .._checks import check_output
 from .main import _console, _errors, app
 
 __all__ = ["study_cmd", "reproduce_cmd"]
@@ -91,6 +92,7 @@ def study_cmd(
     with _errors(), _interruptible():
         spec = StudySpec.from_toml(spec_path)
         out_dir = out if out is not None else Path("studies") / spec.name
+        check_output(out_dir / "run.json", "--out")  # before any work, naming the user's path
         with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                       _Rate(), TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(),
                       console=_console(stderr=True), transient=False) as bar:
@@ -141,6 +143,7 @@ def reproduce_cmd(
             console.print(f"[{el:6.1f} s] figure {name} ({seconds:.1f} s)")
 
     with _errors(), _interruptible():
+        check_output(out / "index.html", "--out")  # before any work, naming the user's path
         try:
             path = reproduce(out, quick=quick, workers=workers, scheduler=scheduler,
                              progress=progress)
@@ -157,7 +160,7 @@ def reproduce_cmd(
              Verdict.FAILS: "bold red"}
     for c in claims:
         v = Verdict(c["verdict"])
-        t.add_row(c["figure"], c["claim"], Text(v.value, style=style[v]))
+        t.add_row(Text(c["figure"]), Text(c["claim"]), Text(v.value, style=style[v]))
     console.print(t)
     counts = ", ".join(f"{v.value}: {sum(c['verdict'] == v for c in claims)}" for v in Verdict)
     console.print(f"{len(claims)} claims; {counts}; {time.perf_counter() - t0:.1f} s")
