@@ -98,3 +98,34 @@ def test_run_json_records_the_preset_and_values_that_ran(tmp_path):
     assert meta["params"]["k"] == 9.0
     assert meta["params"]["v0"] == tslip.preset("table6.1").v0
     assert meta["params"]["controller"]["type"] == "local_velocity"
+
+
+@pytest.fixture(scope="module")
+def biped_run():
+    from tslip.biped import BipedParams, BipedState, simulate
+
+    return simulate(BipedParams(), BipedState.thesis(), n_strides=1)
+
+
+@pytest.mark.parametrize("suffix", [".mp4", ".gif"])
+def test_biped_animation_has_one_frame_per_time_step(tmp_path, biped_run, suffix):
+    import imageio.v3 as iio
+
+    from tslip.plotting.biped import animate_biped
+
+    out = animate_biped(biped_run, tmp_path / f"b{suffix}", fps=20, speed=1.0)
+    frames = iio.imread(out, index=None)
+    duration = biped_run.time[-1] - biped_run.time[0]
+    assert len(frames) == len(np.arange(biped_run.time[0], biped_run.time[-1], 1.0 / 20))
+    assert len(frames) == pytest.approx(duration * 20, abs=1)
+    assert frames.shape[1:3] == (240, 480)  # 6 x 3 in at 80 dpi
+    assert [p.name for p in tmp_path.iterdir()] == [out.name]
+
+
+def test_biped_animation_reports_a_failed_encode(tmp_path, monkeypatch, biped_run):
+    from tslip.plotting.biped import animate_biped
+
+    monkeypatch.setattr(imageio_ffmpeg, "get_ffmpeg_exe", lambda: "/bin/false")
+    with pytest.raises(OSError, match="ffmpeg could not encode"):
+        animate_biped(biped_run, tmp_path / "b.mp4", fps=20, speed=1.0)
+    assert list(tmp_path.iterdir()) == []

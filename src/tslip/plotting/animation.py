@@ -327,20 +327,36 @@ def animate(
     if not (math.isfinite(fps) and fps > 0):
         raise ValueError(f"fps must be a finite number > 0, got {fps!r}")
     if suffix == ".gif":
-        delay_cs = max(2, round(100.0 / fps))  # browsers treat < 2 cs as 10 cs
-        fps = 100.0 / delay_cs
+        fps = gif_fps(fps)
     elif size[0] % 8 or size[1] % 8:
         raise ValueError(f"size must be multiples of 8 pixels for .mp4, got {size!r}")
     t_frames = frame_times(traj, fps, speed, time_unit)
     frames = render_frames(
         traj, t_frames, size=size, dpi=dpi, terrain=terrain, view_width=view_width
     )
-    total = len(t_frames)
-    if suffix == ".gif":
-        atomic_write(path, lambda tmp: _write_gif(tmp, frames, 10 * delay_cs, total, progress))
-    else:
-        write_mp4(path, frames, fps, progress=progress, total=total)
-    return path
+    return write_frames(path, frames, fps, total=len(t_frames), progress=progress)
+
+
+def gif_fps(fps: float) -> float:
+    """The frame rate a GIF can show: a whole number of centiseconds a frame, at least 2."""
+    return 100.0 / max(2, round(100.0 / fps))  # browsers treat < 2 cs as 10 cs
+
+
+def write_frames(
+    path: str | Path,
+    frames: Iterable[np.ndarray],
+    fps: float,
+    *,
+    total: int = 0,
+    progress: Callable[[int, int], None] | None = None,
+) -> Path:
+    """Write RGB frames to ``.gif`` (Pillow) or ``.mp4`` (:func:`tslip._io.write_mp4`)."""
+    path = Path(path)
+    if path.suffix.lower() == ".gif":
+        delay_ms = 10 * max(2, round(100.0 / fps))
+        atomic_write(path, lambda tmp: _write_gif(tmp, frames, delay_ms, total, progress))
+        return path
+    return write_mp4(path, frames, fps, progress=progress, total=total)
 
 
 def _write_gif(

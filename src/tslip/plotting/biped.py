@@ -5,6 +5,7 @@ Functions take results and an optional axes, return the Figure, never show.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -137,16 +138,27 @@ def draw_biped(ax: Any, params: Any, y: np.ndarray) -> None:
 
 def animate_biped(tr: BipedTrajectory, path: str | Path, fps: int = 30,
                   speed: float = 0.5) -> Path:
-    """Write a GIF or MP4 of the run with both legs drawn (right red, left blue)."""
-    from matplotlib.animation import FFMpegWriter, PillowWriter
+    """Write a GIF or MP4 of the run with both legs drawn (right red, left blue).
+
+    Frames are encoded by :func:`tslip.plotting.animation.write_frames`: atomically,
+    with ffmpeg's exit status and output checked for ``.mp4``.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from .animation import gif_fps, write_frames
 
     path = Path(path)
+    if path.suffix.lower() not in (".gif", ".mp4"):
+        raise ValueError(f"animation file must end in .gif or .mp4, got {str(path)!r}")
+    if path.suffix.lower() == ".gif":
+        fps = gif_fps(fps)
     t_frames = np.arange(tr.time[0], tr.time[-1], speed / fps)
     idx = np.searchsorted(tr.time, t_frames).clip(0, tr.time.size - 1)
-    fig = Figure(figsize=(6, 3), layout="constrained")
+    fig = Figure(figsize=(6, 3), dpi=80, layout="constrained")  # 480 x 240 pixels
+    canvas = FigureCanvasAgg(fig)
     ax = fig.subplots()
-    writer = PillowWriter(fps=fps) if path.suffix.lower() == ".gif" else FFMpegWriter(fps=fps)
-    with writer.saving(fig, str(path), dpi=80):
+
+    def frames() -> Iterator[np.ndarray]:
         for i in idx:
             ax.clear()
             y = tr.data[i, 1:19]
@@ -156,5 +168,7 @@ def animate_biped(tr: BipedTrajectory, path: str | Path, fps: int = 30,
             ax.set_ylim(-0.1, 1.4)
             ax.set_aspect("equal")
             ax.set_title(f"t = {tr.time[i]:.2f}")
-            writer.grab_frame()
-    return path
+            canvas.draw()
+            yield np.asarray(canvas.buffer_rgba())[..., :3].copy()
+
+    return write_frames(path, frames(), fps, total=len(idx))
