@@ -70,8 +70,12 @@ class Disturbance:
             object.__setattr__(self, name, check_number(getattr(self, name), f"Disturbance.{name}"))
 
 
+#: The default options, built (and validated) once: ``step_map`` runs once a stride.
+_DEFAULT_OPTIONS = IntegratorOptions()
+
+
 def _options(options: IntegratorOptions | None) -> np.ndarray:
-    return (options or IntegratorOptions()).packed()
+    return (options or _DEFAULT_OPTIONS).packed()
 
 
 def _as_state(state: TouchdownState | Sequence[float] | np.ndarray) -> TouchdownState:
@@ -92,11 +96,12 @@ def _section(q: Sequence[float] | np.ndarray, h: float) -> np.ndarray:
     qa = np.asarray(q, dtype=float)
     if qa.shape != (5,):
         raise ValueError(f"q (beta, phi, xd, yd, phid) must have 5 entries, got shape {qa.shape}")
-    if not np.all(np.isfinite(qa)):
+    # plain floats: this runs once a stride in every analysis, where NumPy's ufuncs cost more
+    if not all(map(math.isfinite, qa.tolist())):
         raise ValueError(f"q (beta, phi, xd, yd, phid) must be finite, got {qa.tolist()}")
     td = np.zeros(pk.NTD)
     td[:5] = qa
-    td[6] = check_number(h, "h", unit="L")
+    td[6] = h if type(h) is float and math.isfinite(h) else check_number(h, "h", unit="L")
     return td
 
 
@@ -358,7 +363,7 @@ def simulate(
     meta = {
         "dt": dt,
         "start": dataclasses.asdict(_as_state(state)),
-        "options": dataclasses.asdict(options or IntegratorOptions()),
+        "options": dataclasses.asdict(options or _DEFAULT_OPTIONS),
         "disturbance": None if disturbance is None else dataclasses.asdict(disturbance),
     }
     return Trajectory(data=data, steps=steps, events=events, status=status, params=params,
