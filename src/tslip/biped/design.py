@@ -36,7 +36,8 @@ from .._checks import check_number
 from .gait import refine_periodic_gait, section_multipliers
 from .parameters import BipedParams
 
-__all__ = ["DESIGN_BOUNDS", "apply_design", "design_objective", "stable_gait_search"]
+__all__ = ["DESIGN_BOUNDS", "SEARCH_SETTINGS", "apply_design", "check_search_settings",
+           "design_objective", "stable_gait_search"]
 
 #: Design variable -> (lower, upper); see the module docstring.
 DESIGN_BOUNDS: dict[str, tuple[float, float]] = {
@@ -116,6 +117,23 @@ def _eval(args: tuple[BipedParams, NDArray[np.float64], dict[str, float]]) -> di
     return design_objective(*args)
 
 
+#: Allowed ranges of :func:`stable_gait_search`'s settings (``check_number`` bounds).
+SEARCH_SETTINGS: dict[str, dict[str, Any]] = {
+    "budget_s": {"unit": "s", "lower": 0.0, "lower_open": True},
+    "max_evals": {"lower": 1, "integer": True},
+    "popsize": {"lower": 2, "integer": True},
+    "sigma0": {"lower": 0.0, "upper": 1.0, "lower_open": True},
+    "seed": {"lower": 0, "integer": True},
+    "processes": {"lower": 1, "upper": 256, "integer": True},
+}
+
+
+def check_search_settings(names: dict[str, str] | None = None, **values: Any) -> None:
+    """Check :func:`stable_gait_search`'s settings; errors use ``names`` (e.g. CLI options)."""
+    for key, value in values.items():
+        check_number(value, (names or {}).get(key, key), **SEARCH_SETTINGS[key])
+
+
 def stable_gait_search(base: BipedParams, z0: NDArray[np.float64], *,
                        names: tuple[str, ...] = tuple(DESIGN_BOUNDS),
                        budget_s: float = 600.0, max_evals: int = 400, popsize: int = 8,
@@ -141,12 +159,8 @@ def stable_gait_search(base: BipedParams, z0: NDArray[np.float64], *,
     """
     import cma
 
-    check_number(budget_s, "budget_s", unit="s", lower=0.0, lower_open=True)
-    check_number(max_evals, "max_evals", lower=1, integer=True)
-    check_number(popsize, "popsize", lower=2, integer=True)
-    check_number(sigma0, "sigma0", lower=0.0, upper=1.0, lower_open=True)
-    check_number(seed, "seed", lower=0, integer=True)
-    check_number(processes, "processes", lower=1, upper=256, integer=True)
+    check_search_settings(budget_s=budget_s, max_evals=max_evals, popsize=popsize,
+                          sigma0=sigma0, seed=seed, processes=processes)
     unknown = sorted(set(names) - set(DESIGN_BOUNDS))
     if unknown or not names:
         raise ValueError(f"names must be design variables from {sorted(DESIGN_BOUNDS)}, got "

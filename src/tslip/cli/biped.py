@@ -296,17 +296,16 @@ def optimise_cmd(
     The best gait is written to --out at every improvement; Ctrl-C stops
     with the best so far, and --gait OUT continues from it.
     """
-    from ..biped.design import DESIGN_BOUNDS, stable_gait_search
+    from ..biped.design import DESIGN_BOUNDS, check_search_settings, stable_gait_search
     from ..biped.gait import section_multipliers
 
     with _errors():
         check_output(out, "--out", (".json",))
-        check_number(budget, "--budget", unit="s", lower=0.0, lower_open=True)
-        check_number(max_evals, "--max-evals", lower=1, integer=True)
-        check_number(popsize, "--popsize", lower=2, integer=True)
-        check_number(sigma0, "--sigma0", lower=0.0, upper=1.0, lower_open=True)
-        check_number(seed, "--seed", lower=0, integer=True)
-        check_number(processes, "--processes", lower=1, upper=256, integer=True)
+        check_search_settings(
+            {"budget_s": "--budget", "max_evals": "--max-evals", "popsize": "--popsize",
+             "sigma0": "--sigma0", "seed": "--seed", "processes": "--processes"},
+            budget_s=budget, max_evals=max_evals, popsize=popsize, sigma0=sigma0, seed=seed,
+            processes=processes)
         p, y, t0 = _start(None, gait)
         z0 = to_section(p, y, t0)
         c = _console()
