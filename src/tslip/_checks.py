@@ -5,6 +5,7 @@ names the field and what is allowed:
 
 * :func:`check_number` - a number field: bool and text rejected, NumPy
   scalars accepted, finite, in range, integer where an integer is meant;
+* :func:`check_fields` - every numeric field of a parameter dataclass, by its metadata;
 * :func:`parse_number` - the same for text from the command line (``--set``);
 * :func:`check_fits` - a size against the memory available, before the work;
 * :func:`check_output` - an output path: suffix allowed, directory writable.
@@ -12,13 +13,16 @@ names the field and what is allowed:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
 import os
 import tempfile
 from pathlib import Path
+from typing import Any
 
-__all__ = ["check_number", "parse_number", "check_fits", "available_memory", "check_output"]
+__all__ = ["check_number", "check_fields", "parse_number", "check_fits", "available_memory",
+           "check_output"]
 
 
 def _range(lower: float, upper: float, lower_open: bool, upper_open: bool) -> str:
@@ -75,6 +79,27 @@ def check_number(
     if bad_lo or bad_hi:
         raise ValueError(f"{label} must be {kind}{where}, got {value!r}")
     return out
+
+
+def check_fields(obj: Any, prefix: str = "") -> None:
+    """Check every numeric field of a frozen dataclass with :func:`check_number`.
+
+    A field is numeric when its metadata carries a ``lower`` bound; its
+    ``upper``, ``lower_open``, ``upper_open`` and ``unit`` set the rest, and an
+    ``int`` annotation makes it an integer field. The checked value (a plain
+    ``float`` or ``int``, so NumPy scalars are accepted) is written back.
+    """
+    for f in dataclasses.fields(obj):
+        md = f.metadata
+        if "lower" not in md:
+            continue
+        value = check_number(
+            getattr(obj, f.name), f"{prefix}{f.name}", unit=md.get("unit", ""),
+            lower=md["lower"], upper=md.get("upper", math.inf),
+            lower_open=md.get("lower_open", False), upper_open=md.get("upper_open", False),
+            integer=f.type in (int, "int"),
+        )
+        object.__setattr__(obj, f.name, value)
 
 
 def parse_number(text: str, name: str, **bounds: object) -> float | int:

@@ -19,8 +19,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from .._checks import check_number
-from ..model.controllers import check_finite_fields
+from .._checks import check_fields
 
 __all__ = [
     "BipedParameterInfo",
@@ -196,13 +195,7 @@ class BipedParams:
     contact: bool = field(default=True, metadata={"unit": "-", "description": "ground on"})
 
     def __post_init__(self) -> None:
-        for row in BIPED_PARAMETER_TABLE:
-            value = check_number(
-                getattr(self, row.name), row.name, unit=row.unit, lower=row.lower,
-                upper=row.upper, lower_open=row.lower_open, upper_open=row.upper_open,
-            )
-            object.__setattr__(self, row.name, value)
-        check_finite_fields(self)  # the table's ranges, as for the TSLIP's Params
+        check_fields(self)  # the table's ranges, as for the TSLIP's Params
         for name in ("actuated", "contact"):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
                 raise ValueError(f"{name} must be True or False, got {getattr(self, name)!r}")

@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
-from .._checks import check_number
+from .._checks import check_fields, check_number
 
 __all__ = [
     "Controller",
@@ -40,32 +40,6 @@ def _meta(symbol: str, unit: str, description: str, lower: float = -math.inf) ->
     return {"symbol": symbol, "unit": unit, "description": description, "lower": lower}
 
 
-def check_finite_fields(obj: Any, prefix: str = "") -> None:
-    """Raise ``ValueError`` for a field that is NaN, infinite or below its bound.
-
-    Each dataclass field's metadata may carry ``lower`` (inclusive) and
-    ``lower_open`` (exclusive) / ``upper_open`` bounds.
-    """
-    for f in fields(obj):
-        value = getattr(obj, f.name)
-        if not isinstance(value, (int, float)) or isinstance(value, bool):
-            continue
-        name = f"{prefix}{f.name}"
-        unit = f.metadata.get("unit", "")
-        unit_txt = f" [{unit}]" if unit else ""
-        lo = f.metadata.get("lower", -math.inf)
-        lo_open = f.metadata.get("lower_open", False)
-        hi = f.metadata.get("upper", math.inf)
-        hi_open = f.metadata.get("upper_open", False)
-        rng = f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
-        if not math.isfinite(value):
-            raise ValueError(f"{name}{unit_txt} must be a finite number in {rng}, got {value!r}")
-        bad_lo = value <= lo if lo_open else value < lo
-        bad_hi = value >= hi if hi_open else value > hi
-        if bad_lo or bad_hi:
-            raise ValueError(f"{name}{unit_txt} must be in {rng}, got {value!r}")
-
-
 @dataclass(frozen=True, slots=True)
 class Controller:
     """Base class: a hip controller packed to a code and four numbers."""
@@ -74,7 +48,7 @@ class Controller:
     name: ClassVar[str] = ""
 
     def __post_init__(self) -> None:
-        check_finite_fields(self, prefix=f"{type(self).__name__}.")
+        check_fields(self, prefix=f"{type(self).__name__}.")
 
     def torque_coefficients(self) -> tuple[float, float, float, float]:
         """``(a0, a1, a2, a3)`` of ``tau = a0 + a1 phi + a2 betad + a3 phid``.

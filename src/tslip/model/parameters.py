@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, NamedTuple
 
-from .._checks import check_number
+from .._checks import check_fields, check_number
 from .._io import read_toml
 from .controllers import (
     ConstantTorque,
@@ -25,7 +25,6 @@ from .controllers import (
     GlobalPD,
     LocalVelocity,
     Passive,
-    check_finite_fields,
     controller_from_dict,
 )
 
@@ -159,13 +158,7 @@ class Params:
     leg_reset: LegReset = "local"
 
     def __post_init__(self) -> None:
-        for row in PARAMETER_TABLE:
-            value = check_number(
-                getattr(self, row.name), row.name, unit=row.unit, lower=row.lower,
-                upper=row.upper, lower_open=row.lower_open, upper_open=row.upper_open,
-            )
-            object.__setattr__(self, row.name, value)
-        check_finite_fields(self)
+        check_fields(self)  # every PARAMETER_TABLE row, by its field's metadata
         if not isinstance(self.controller, Controller):
             raise ValueError(
                 "controller must be one of Passive, GlobalPD, LocalVelocity, ConstantTorque, "

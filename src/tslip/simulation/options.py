@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._checks import check_fields
 from ..model._pack import (
     METHODS,
     NO,
@@ -18,7 +19,6 @@ from ..model._pack import (
     O_TMAX_FLIGHT,
     O_TMAX_STANCE,
 )
-from ..model.controllers import check_finite_fields
 
 __all__ = ["IntegratorOptions"]
 
@@ -49,7 +49,7 @@ class IntegratorOptions:
                                                      "choices": METHODS})
 
     def __post_init__(self) -> None:
-        check_finite_fields(self, prefix="IntegratorOptions.")
+        check_fields(self, prefix="IntegratorOptions.")
         if self.method not in METHODS:
             raise ValueError(f"IntegratorOptions.method must be one of {', '.join(METHODS)}, "
                              f"got {self.method!r}")
