@@ -1,0 +1,78 @@
+"""Time the same workload on an earlier revision of tslip, in the same run.
+
+A benchmark prints its speed as a ratio against a baseline measured in the
+same invocation, because the machines here are shared and noisy. When the
+baseline is "the code as it was before a change", this module extracts that
+revision's ``src/`` (``git archive``, no change to the repository's state) into
+``~/.cache/tslip-bench/<rev>/`` and runs a snippet against it in a subprocess,
+so the old and new code are timed minutes apart on the same machine.
+
+Usage::
+
+    from _baseline import run_at
+    t = run_at(BASELINE_REV, setup="import tslip; p = tslip.presets.table_6_1()",
+               stmt="tslip.simulate(p, ...)", repeat=5)   # best of 5, in seconds
+
+The snippet runs with numba's cache warm (a first untimed call is made), on
+the same number of threads as the caller unless ``threads`` is given.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import subprocess
+import sys
+import tarfile
+from pathlib import Path
+
+#: The revision every benchmark of issue 12 compares with: main before that work.
+BASELINE_REV = "1b54594"
+
+_REPO = Path(__file__).resolve().parents[1]
+_CACHE = Path(os.environ.get("TSLIP_BENCH_CACHE", Path.home() / ".cache" / "tslip-bench"))
+
+_RUNNER = r"""
+import json, sys, time
+setup, stmt, repeat, number = json.loads(sys.argv[1])
+ns = {}
+exec(setup, ns)
+exec(stmt, ns)  # warm: compile or load the numba cache
+best = float("inf")
+for _ in range(repeat):
+    t0 = time.perf_counter()
+    for _ in range(number):
+        exec(stmt, ns)
+    best = min(best, (time.perf_counter() - t0) / number)
+print(json.dumps(best))
+"""
+
+
+def source_at(rev: str = BASELINE_REV) -> Path:
+    """The ``src`` folder of ``rev``, extracted once into the benchmark cache."""
+    full = subprocess.run(["git", "-C", str(_REPO), "rev-parse", rev], check=True,
+                          capture_output=True, text=True).stdout.strip()
+    dest = _CACHE / full[:12]
+    src = dest / "src"
+    if not (src / "tslip" / "__init__.py").exists():
+        data = subprocess.run(["git", "-C", str(_REPO), "archive", full, "src"], check=True,
+                              capture_output=True).stdout
+        tmp = dest.with_name(dest.name + f".tmp{os.getpid()}")
+        with tarfile.open(fileobj=io.BytesIO(data)) as tar:
+            tar.extractall(tmp, filter="data")
+        tmp.replace(dest) if not dest.exists() else None
+    return src
+
+
+def run_at(rev: str, setup: str, stmt: str, repeat: int = 5, number: int = 1,
+           threads: int | None = None) -> float:
+    """Best-of-``repeat`` seconds per execution of ``stmt`` on revision ``rev``."""
+    env = dict(os.environ, PYTHONPATH=str(source_at(rev)))
+    if threads is not None:
+        env["NUMBA_NUM_THREADS"] = str(threads)
+    out = subprocess.run([sys.executable, "-c", _RUNNER, json.dumps([setup, stmt, repeat, number])],
+                         capture_output=True, text=True, env=env)
+    if out.returncode != 0:
+        raise RuntimeError(f"baseline {rev} failed:\n{out.stderr[-2000:]}")
+    return float(out.stdout.strip().splitlines()[-1])
