@@ -38,6 +38,7 @@ import json, sys, time
 setup, stmt, repeat, number = json.loads(sys.argv[1])
 ns = {}
 exec(setup, ns)
+stmt = compile(stmt, "<stmt>", "exec")
 exec(stmt, ns)  # warm: compile or load the numba cache
 best = float("inf")
 for _ in range(repeat):
