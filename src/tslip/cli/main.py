@@ -3,15 +3,17 @@
 Each subcommand module (:mod:`~tslip.cli.simulate`, :mod:`~tslip.cli.experiment`,
 :mod:`~tslip.cli.gait`, :mod:`~tslip.cli.studies`, :mod:`~tslip.cli.biped`)
 defines its commands and imports its shared options and error handling from
-:mod:`tslip.cli._common`; this module only puts them together and is the console script's
-entry point. Invalid input prints
+:mod:`tslip.cli._common`; this module only puts them together, adds
+``--version`` and is the console script's entry point. Invalid input prints
 one line ``error: <message>`` to stderr and exits with code 2.
 """
 
 import sys
+from typing import Annotated
 
 import typer
 
+from .. import __version__
 from . import biped, experiment, gait, simulate, studies
 from ._common import run
 
@@ -28,6 +30,21 @@ app = typer.Typer(
 for _module in (simulate, experiment, gait, studies):  # the order `tslip --help` lists
     app.registered_commands.extend(_module.commands.registered_commands)
 app.add_typer(biped.biped_app, name="biped")
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        typer.echo(f"tslip {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    version: Annotated[bool, typer.Option(
+        "--version", callback=_print_version, is_eager=True,
+        help="Print the version (tslip X.Y.Z) and exit.")] = False,
+) -> None:
+    """Self-stable planar running with the spring-mass model with a trunk (TSLIP)."""
 
 
 def main() -> None:

@@ -3,7 +3,8 @@
 A thin skin over the public API: options are parsed into :class:`tslip.Params`
 (preset, then ``--params`` TOML, then ``--set key=value``), the periodic gait
 is solved with :func:`tslip.gait.find_gait`, :func:`tslip.simulate` runs it,
-and results go to explicit output files.
+and results go to explicit output files (with the version and the code hash
+in the ``.json`` beside them).
 """
 
 import dataclasses
@@ -21,6 +22,7 @@ from rich.table import Table
 
 from .. import __version__
 from .._checks import check_number, check_output
+from .._codehash import code_hash
 from ..gait import Gait, find_gait
 from ..model.parameters import PARAMETER_TABLE, Params, preset, preset_description, presets
 from ..model.state import TouchdownState
@@ -47,6 +49,9 @@ __all__ = ["commands", "presets_cmd", "simulate_cmd", "animate_cmd", "demo_cmd"]
 commands = typer.Typer()
 
 _ANIM_SUFFIXES = (".gif", ".mp4")
+#: The modules that compute a run (gait search, simulation): their code hash goes into the
+#: ``.json`` beside the data, next to ``tslip_version``, like a study's ``run.json``.
+CODE = ("tslip.gait.fixed_point", "tslip.simulation.integrate")
 
 # -- options of these commands -------------------------------------------------------------
 
@@ -115,6 +120,7 @@ def _run(
         **traj.meta,
         "options": {"rtol": rtol, "atol": atol},
         "start": dataclasses.asdict(state),
+        "code": code_hash(*CODE),
         **meta,
     }
     return dataclasses.replace(traj, meta=meta)
