@@ -4,7 +4,7 @@ Implements the model of M. J. van den Broek, "Fast Self-Stable Planar Bipedal
 Running" (TU Delft / IHMC, 2019), in the dimensionless units of its Table 3.1.
 """
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 from .gait import (  # noqa: E402
     Branch,

@@ -13,6 +13,11 @@ Imports inside functions count too (they run when the function does). A
 ``from package import name`` counts ``package/name.py`` when that file
 exists, else the module the package's ``__init__`` takes ``name`` from, else
 the ``__init__``'s own source (for a name it defines, like ``__version__``).
+
+The version string is a label, not code: a ``__version__ = ...`` line is
+left out of the hashed sources, so a release that only bumps the version
+keeps every cached result, while any other edit (the same file's included)
+recomputes them.
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ from __future__ import annotations
 import ast
 import functools
 import hashlib
+import re
 from importlib import metadata
 from pathlib import Path
 
@@ -27,6 +33,9 @@ __all__ = ["module_closure", "code_hash"]
 
 _ROOT = Path(__file__).parent
 _PKG = "tslip"
+
+#: A module-level ``__version__ = ...`` line: not part of the hashed source.
+_VERSION_LINE = re.compile(rb"^__version__\s*=.*$", re.MULTILINE)
 
 #: Third-party libraries whose version can change a computed number.
 LIBRARIES: tuple[str, ...] = ("numpy", "scipy", "numba", "llvmlite", "cma")
@@ -140,5 +149,6 @@ def code_hash(*modules: str) -> str:
         h.update(f"{lib}={_version(lib)}\n".encode())
     for m in module_closure(*modules):
         h.update(m.encode() + b"\n")
-        h.update(_file(m.removesuffix(":self")).read_bytes())  # type: ignore[union-attr]
+        source = _file(m.removesuffix(":self")).read_bytes()  # type: ignore[union-attr]
+        h.update(_VERSION_LINE.sub(b"", source))
     return h.hexdigest()[:24]

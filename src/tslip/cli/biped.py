@@ -1,7 +1,7 @@
 """``tslip biped ...``: simulate, search, animate and report the two-legged model.
 
-Registered on the main app as the ``biped`` command group when this module is
-imported (``from . import biped`` in :mod:`tslip.cli.main`).
+:data:`biped_app` is added to the app as the ``biped`` command group by
+:mod:`tslip.cli.main`.
 """
 
 from __future__ import annotations
@@ -24,13 +24,12 @@ from ..biped.gait import (
     tracking_errors,
 )
 from ..biped.metacentre import metacentric_table, metacentric_test
-from .main import _console, _errors, app
+from ._common import errors, make_console
 
 __all__ = ["biped_app"]
 
 biped_app = typer.Typer(help="Two-legged running model with massed legs (thesis App. E).",
                         no_args_is_help=True)
-app.add_typer(biped_app, name="biped")
 
 SetOpt = Annotated[list[str] | None, typer.Option(
     "--set", "-s", metavar="KEY=VALUE", help="Override a biped parameter, e.g. Kp_h=0.8.")]
@@ -101,13 +100,13 @@ def simulate_cmd(
     out: Annotated[Path | None, typer.Option("--out", help="CSV of the run.")] = None,
 ) -> None:
     """Run the biped from Table E.2 (or a gait) and report strides and tracking."""
-    with _errors():
+    with errors():
         _check_strides(strides, tol)
         if out is not None:
             check_output(out, "--out", (".csv", ".parquet"))
         p, y, t0 = _start(sets, gait, from_tslip)
         tr = simulate(p, y, strides, t0=t0, options=BipedOptions(rtol=tol, atol=tol))
-        c = _console()
+        c = make_console()
         c.print(f"{tr.n_strides} strides, {tr.status.reason} (t = {tr.stats['t_end']:.3f})")
         if tr.n_strides:
             for leg, name in ((0, "right"), (1, "left")):
@@ -165,7 +164,7 @@ def search_cmd(
     """Periodic gait: optional CMA-ES (eqs E.35-E.36), then shooting refinement."""
     from ..biped.gait import refine_periodic_gait
 
-    with _errors():
+    with errors():
         check_output(out, "--out", (".json",))
         _check_strides(strides, tol)
         check_number(cma_evals, "--cma-evals", lower=0, upper=10**7, integer=True)
@@ -175,7 +174,7 @@ def search_cmd(
         p, y, t0 = _start(sets, gait, from_tslip)
         z0 = to_section(p, y, t0)
         free = tuple(free_param) if free_param else ("T", "theta_f", "theta_s", "Kp_h", "Kd_h")
-        c = _console()
+        c = make_console()
         history: list[float] = []
         evals = 0
         if cma_evals > 0:
@@ -214,14 +213,14 @@ def animate_cmd(
     """Animate the runner with both legs."""
     from ..plotting.biped import animate_biped
 
-    with _errors():
+    with errors():
         check_output(out, "--out", (".gif", ".mp4"))
         _check_strides(strides)
         check_number(fps, "--fps", lower=1, upper=1000, integer=True)
         p, y, t0 = _start(sets, gait, from_tslip)
         tr = simulate(p, y, strides, t0=t0)
         animate_biped(tr, out, fps=fps)
-        _console().print(f"{tr.n_strides} strides, {tr.status.reason}; wrote {out}")
+        make_console().print(f"{tr.n_strides} strides, {tr.status.reason}; wrote {out}")
 
 
 @biped_app.command("report")
@@ -241,13 +240,13 @@ def report_cmd(
     from .._io import write_table
     from ..plotting.biped import plot_foot_path, plot_metacentric, plot_tracking
 
-    with _errors():
+    with errors():
         check_output(out_dir / "multipliers.csv", "--out-dir")
         _check_strides(strides)
         p, y, t0 = _start(sets, gait, from_tslip)
         out_dir.mkdir(parents=True, exist_ok=True)
         tr = simulate(p, y, strides, t0=t0)
-        c = _console()
+        c = make_console()
         c.print(f"strides until fall: {tr.n_strides} ({tr.status.reason})")
         plot_tracking(tr).savefig(out_dir / "fig_e2_tracking.png", dpi=120)
         plot_foot_path(tr).savefig(out_dir / "fig_e3_foot_path.png", dpi=120)
@@ -299,7 +298,7 @@ def optimise_cmd(
     from ..biped.design import DESIGN_BOUNDS, check_search_settings, stable_gait_search
     from ..biped.gait import section_multipliers
 
-    with _errors():
+    with errors():
         check_output(out, "--out", (".json",))
         check_search_settings(
             {"budget_s": "--budget", "max_evals": "--max-evals", "popsize": "--popsize",
@@ -308,7 +307,7 @@ def optimise_cmd(
             processes=processes)
         p, y, t0 = _start(None, gait)
         z0 = to_section(p, y, t0)
-        c = _console()
+        c = make_console()
 
         def checkpoint(b: dict[str, Any]) -> None:  # a usable --gait file at every new best
             write_json(out, {"design": b["design"], "bounds": DESIGN_BOUNDS,

@@ -20,9 +20,13 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from .._checks import check_number, check_output
 from .._io import atomic_write, write_json, write_table
-from .main import _DATA_SUFFIXES, PresetOpt, SetOpt, _build_params, _console, _errors, _fail, app
+from ._common import DATA_SUFFIXES, PresetOpt, SetOpt, build_params, errors, fail, make_console
 
-__all__ = ["synth_video_cmd", "track_cmd", "process_cmd", "fit_cmd", "experiment_cmd"]
+__all__ = ["commands", "synth_video_cmd", "track_cmd", "process_cmd", "fit_cmd", "experiment_cmd"]
+
+#: ``synth-video``, ``track``, ``process``, ``fit``, ``experiment``, added to the app by
+#: :mod:`tslip.cli.main`.
+commands = typer.Typer()
 
 _SPACING = 0.18
 _MARKER_R = 0.025
@@ -31,7 +35,7 @@ _FOOT_R = 0.016
 
 def _bar(label: str) -> Progress:
     return Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-                    console=_console(stderr=True), transient=True)
+                    console=make_console(stderr=True), transient=True)
 
 
 #: Columns `tslip process` reads from a tracks table (written by `tslip track`).
@@ -44,7 +48,7 @@ _STEP_COLUMNS = ("step", "tau", "stance_time", "flight_time", "y", "l", "beta", 
 
 def _read_table(path: Path, columns: tuple[str, ...], what: str) -> pd.DataFrame:
     """Read a .csv/.parquet table that must have numeric ``columns`` (one-line errors)."""
-    if path.suffix.lower() not in _DATA_SUFFIXES:
+    if path.suffix.lower() not in DATA_SUFFIXES:
         raise ValueError(f"{what} must be a .csv or .parquet table, got {str(path)!r}")
     if not path.is_file():
         raise ValueError(f"{what} {str(path)!r} does not exist")
@@ -63,7 +67,7 @@ def _read_table(path: Path, columns: tuple[str, ...], what: str) -> pd.DataFrame
     return table
 
 
-@app.command("synth-video")
+@commands.command("synth-video")
 def synth_video_cmd(
     out: Annotated[Path, typer.Option("--out", "-o", help="Video: .mp4 or a folder of PNGs.")]
     = Path("synthetic.mp4"),
@@ -88,7 +92,7 @@ def synth_video_cmd(
     The run is the preset's TSLIP gait, or with --biped-gait the two-legged
     model of Appendix E (--preset is then unused).
     """
-    with _errors():
+    with errors():
         from ..experiment.render import check_mp4_size, write_video
         from ..experiment.synth import (
             Camera,
@@ -121,10 +125,10 @@ def synth_video_cmd(
             model: dict[str, Any] = {"model": "biped", "gait_file": str(biped_gait),
                                      "params": bp.to_dict(), "z": list(gd["z"]), "t0": t0}
         else:
-            params = _build_params(preset_name, sets, None)
+            params = build_params(preset_name, sets, None)
             gait = find_gait(params)
             if not gait.converged:
-                _fail(f"no periodic gait for the preset: {gait.message}", 1)
+                fail(f"no periodic gait for the preset: {gait.message}", 1)
             run = synthesize(gait.params, gait.state, duration, camera=cam, options=render)
             model = {"params": gait.params.to_dict()}
         with _bar("rendering") as bar:
@@ -139,7 +143,7 @@ def synth_video_cmd(
             "geometry": {"r": run.geometry.r, "a": run.geometry.a, "b": run.geometry.b,
                          "marker_radius": run.geometry.marker_radius,
                          "foot_radius": run.geometry.foot_radius}})
-        c = _console()
+        c = make_console()
         c.print(f"wrote {out} ({run.n_frames} frames, {width}x{height} px at {fps:g} Hz)")
         c.print(f"wrote {truth}")
 
@@ -156,7 +160,7 @@ def _track(video: Path, out: Path, fps: float | None, scale: float | None,
 
     if (scale is None) != (ground is None):
         raise ValueError("give both --scale and --ground, or neither (measured from the frame)")
-    check_output(out, "--out", _DATA_SUFFIXES)
+    check_output(out, "--out", DATA_SUFFIXES)
     if fps is not None:
         check_number(fps, "--fps", unit="Hz", lower=0.0, upper=1e5, lower_open=True)
     if scale is not None:
@@ -183,7 +187,7 @@ def _track(video: Path, out: Path, fps: float | None, scale: float | None,
         "video": str(video), "fps": res.fps, "px_per_m": cal.px_per_m, "ground_y_px":
         cal.ground_y, "x0_px": cal.x0, "problems": res.problems, "fatal": res.fatal,
         "body_detection_rate": res.body_detection_rate})
-    c = _console()
+    c = make_console()
     c.print(f"tracked {len(res.tracks)} frames: body markers in "
             f"{100 * res.body_detection_rate:.1f} % (scale {cal.px_per_m:.1f} px/m, ground at "
             f"row {cal.ground_y:.1f})")
@@ -191,11 +195,11 @@ def _track(video: Path, out: Path, fps: float | None, scale: float | None,
         typer.echo(f"warning: {p}", err=True)
     c.print(f"wrote {out}")
     if res.fatal:
-        _fail(res.problems[-1] if res.problems else "tracking failed", 1)
+        fail(res.problems[-1] if res.problems else "tracking failed", 1)
     return res
 
 
-@app.command("track")
+@commands.command("track")
 def track_cmd(
     video: Annotated[Path, typer.Argument(help="Video (.mp4) or folder of frames.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Tracks table (.csv/.parquet).")]
@@ -208,14 +212,14 @@ def track_cmd(
     max_frames: Annotated[int | None, typer.Option("--max-frames")] = None,
 ) -> None:
     """Track body discs and feet in a video; write per-frame positions."""
-    with _errors():
+    with errors():
         _track(video, out, fps, scale, ground, max_frames)
 
 
 def _process(tracks_path: Path, out: Path) -> Any:
     from ..experiment.signals import process_tracks
 
-    check_output(out, "--out", _DATA_SUFFIXES)
+    check_output(out, "--out", DATA_SUFFIXES)
     tracks = _read_table(tracks_path, _TRACK_COLUMNS, "tracks table")
     if len(tracks) < 2:
         raise ValueError(f"too few frames in {str(tracks_path)!r}: {len(tracks)}")
@@ -230,7 +234,7 @@ def _process(tracks_path: Path, out: Path) -> Any:
     write_json(out.with_suffix(".json"), {"belt_speed_m_s": data.belt_speed,
                                            "problems": data.problems, **data.meta})
     write_table(data.frames, out.with_name(out.stem + ".frames" + out.suffix))
-    c = _console()
+    c = make_console()
     st = data.steps
     c.print(f"{len(st)} near-foot steps: t_s = {st.stance_time.mean():.4f} +- "
             f"{st.stance_time.std(ddof=0):.4f}, t_f = {st.flight_time.mean():.4f} +- "
@@ -241,14 +245,14 @@ def _process(tracks_path: Path, out: Path) -> Any:
     return data
 
 
-@app.command("process")
+@commands.command("process")
 def process_cmd(
     tracks: Annotated[Path, typer.Argument(help="Tracks table from `tslip track`.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Steps table (.csv/.parquet).")]
     = Path("steps.csv"),
 ) -> None:
     """Filter tracks, compute states, split and resample the near-foot steps."""
-    with _errors():
+    with errors():
         _process(tracks, out)
 
 
@@ -278,29 +282,29 @@ def _fit(steps_path: Path, out_dir: Path, frames: Any = None) -> Any:
         fig2 = plot_foot_trajectory(frames)
         atomic_write(out_dir / "figureD_2.png",
                      lambda tmp: fig2.savefig(tmp, format="png", dpi=90))
-    c = _console()
+    c = make_console()
     c.print(res.message)
     c.print("fitted: " + ", ".join(f"{k} = {v:.4f}" for k, v in res.values.items()))
     c.print(res.times.to_string(index=False, float_format=lambda x: f"{x:.4f}"))
     c.print(res.scores.to_string(index=False, float_format=lambda x: f"{x:.3f}"))
     c.print(f"wrote {out_dir}/table6_2.csv, table6_3.csv, fit.json, figure6_1.png")
     if not res.converged:
-        _fail(res.message, 1)
+        fail(res.message, 1)
     return res
 
 
-@app.command("fit")
+@commands.command("fit")
 def fit_cmd(
     steps: Annotated[Path, typer.Argument(help="Steps table from `tslip process`.")],
     out_dir: Annotated[Path, typer.Option("--out-dir", "-o", help="Folder for tables, "
                                           "figure and fit.json.")] = Path("fit"),
 ) -> None:
     """Fit TSLIP (local velocity control + leg damping) to the step averages."""
-    with _errors():
+    with errors():
         _fit(steps, out_dir)
 
 
-@app.command("experiment")
+@commands.command("experiment")
 def experiment_cmd(
     video: Annotated[Path, typer.Argument(help="Video (.mp4) or folder of frames.")],
     out_dir: Annotated[Path, typer.Option("--out-dir", "-o")] = Path("experiment"),
@@ -309,11 +313,11 @@ def experiment_cmd(
     ground: Annotated[float | None, typer.Option("--ground", help="Ground row \\[px].")] = None,
 ) -> None:
     """Run track -> process -> fit and write everything into one folder."""
-    with _errors():
+    with errors():
         t0 = time.perf_counter()
         check_output(out_dir / "tracks.csv", "--out-dir")  # the files make the folder
         _track(video, out_dir / "tracks.csv", fps, scale, ground, None)
         data = _process(out_dir / "tracks.csv", out_dir / "steps.csv")
         _fit(out_dir / "steps.csv", out_dir, data)
-        _console().print(f"done in {time.perf_counter() - t0:.1f} s"
+        make_console().print(f"done in {time.perf_counter() - t0:.1f} s"
                          if math.isfinite(t0) else "done")

@@ -19,22 +19,24 @@ from .._io import atomic_write, write_table
 from ..gait import analyse, continue_gait, find_gait, get_param, impulse_linearisation
 from ..gait import pitch_disturbance_response as pitch_response
 from ..gait.stride import friction_ratio
-from .main import (
-    _DATA_SUFFIXES,
+from ._common import (
+    DATA_SUFFIXES,
     ParamsOpt,
     PresetOpt,
     SetOpt,
-    _build_params,
-    _check_plot_suffix,
-    _check_suffix,
-    _console,
-    _errors,
-    _fail,
-    _size,
-    app,
+    build_params,
+    check_plot_suffix,
+    check_suffix,
+    errors,
+    fail,
+    file_size,
+    make_console,
 )
 
-__all__ = ["gait_cmd", "continue_cmd"]
+__all__ = ["commands", "gait_cmd", "continue_cmd"]
+
+#: ``gait`` and ``continue``, added to the app by :mod:`tslip.cli.main`.
+commands = typer.Typer()
 
 #: Memory one branch point holds at least: its gait, multipliers and table row.
 _POINT_BYTES = 2000.0
@@ -56,7 +58,7 @@ def _table(title: str, *cols: str) -> Table:
 
 
 def _print_report(rep: dict[str, Any]) -> None:
-    console = _console()
+    console = make_console()
     g = rep["gait"]
     console.print(f"gait: {g['message']}")
     t = _table("touch-down state of the gait", "beta", "phi", "xd", "yd", "phid", "v", "delta")
@@ -122,7 +124,7 @@ def _print_report(rep: dict[str, Any]) -> None:
                       + (f", from t/t_s = {fr['first_slip']:.2f}" if fr["first_slip"] else ""))
 
 
-@app.command("gait")
+@commands.command("gait")
 def gait_cmd(
     preset_name: PresetOpt = None,
     sets: SetOpt = None,
@@ -141,16 +143,16 @@ def gait_cmd(
     ] = False,
 ) -> None:
     """Solve the periodic gait and report stability, strides, robustness, impulse."""
-    with _errors():
+    with errors():
         if method not in ("newton", "cma"):
             raise ValueError(f"--method must be 'newton' or 'cma', got {method!r}")
         check_number(seed, "--seed", lower=0, upper=2**32 - 1, integer=True)
         if plot is not None:
             check_output(plot / "friction.png", "--plot")
-        params = _build_params(preset_name, sets, params_file)
+        params = build_params(preset_name, sets, params_file)
         gait = find_gait(params, method=method, seed=seed)
         if not gait.converged:
-            _fail(gait.message, 1)
+            fail(gait.message, 1)
         rep = analyse(params, gait=gait, robustness=not no_robustness)
         if as_json:
             typer.echo(json.dumps(rep, indent=2))
@@ -168,10 +170,10 @@ def gait_cmd(
             for name, fig in figs.items():
                 atomic_write(plot / name, lambda tmp, fig=fig: fig.savefig(tmp, format="png"))
                 if not as_json:
-                    _console().print(f"wrote {plot / name} ({_size(plot / name)})")
+                    make_console().print(f"wrote {plot / name} ({file_size(plot / name)})")
 
 
-@app.command("continue")
+@commands.command("continue")
 def continue_cmd(
     param: Annotated[str, typer.Option("--param", help="Parameter to vary, e.g. r, v0, "
                                        "omega_r_bar, controller.c_h.")],
@@ -189,20 +191,20 @@ def continue_cmd(
     ] = None,
 ) -> None:
     """Follow the periodic gait along a parameter; print and save the branch."""
-    with _errors():
+    with errors():
         check_number(points, "--points", lower=2, integer=True)
         check_fits(points, _POINT_BYTES, "--points", "the branch")
         if not (math.isfinite(start) and math.isfinite(stop) and start < stop):
             raise ValueError(f"--from must be below --to (both finite), got {start}, {stop}")
-        _check_suffix(out, _DATA_SUFFIXES, "--out")
-        _check_plot_suffix(plot)
-        params = _build_params(preset_name, sets, params_file)
+        check_suffix(out, DATA_SUFFIXES, "--out")
+        check_plot_suffix(plot)
+        params = build_params(preset_name, sets, params_file)
         get_param(params, param)  # validates the name
         values = np.linspace(start, stop, points)
-        console = _console()
+        console = make_console()
         t0 = time.perf_counter()
         with Progress(TextColumn(f"continuing along {param}"), BarColumn(),
-                      MofNCompleteColumn(), TimeRemainingColumn(), console=_console(True),
+                      MofNCompleteColumn(), TimeRemainingColumn(), console=make_console(True),
                       transient=True) as bar:
             task = bar.add_task("points", total=points)
             branch = continue_gait(params, param, values,
@@ -222,10 +224,10 @@ def continue_cmd(
                          if stable.size else "stable nowhere"))
         if out is not None:
             write_table(df, out)
-            console.print(f"wrote {out} ({_size(out)})")
+            console.print(f"wrote {out} ({file_size(out)})")
         if plot is not None:
             from ..plotting import plot_branch
 
             fig = plot_branch(branch)
             atomic_write(plot, lambda tmp: fig.savefig(tmp, format=plot.suffix.lstrip(".")))
-            console.print(f"wrote {plot} ({_size(plot)})")
+            console.print(f"wrote {plot} ({file_size(plot)})")

@@ -21,9 +21,12 @@ from rich.progress import (
 from rich.table import Table
 
 from .._checks import check_output
-from .main import _console, _errors, app
+from ._common import errors, make_console
 
-__all__ = ["study_cmd", "reproduce_cmd"]
+__all__ = ["commands", "study_cmd", "reproduce_cmd"]
+
+#: ``study`` and ``reproduce``, added to the app by :mod:`tslip.cli.main`.
+commands = typer.Typer()
 
 WorkersOpt = Annotated[int | None, typer.Option("--workers", min=1,
                                                 help="Worker processes (default: all cores).")]
@@ -69,7 +72,7 @@ def _saved_message(out: Path, quick: bool) -> str:
     return str(StudyInterrupted(saved, sum(s.n_points for s in specs.values())))
 
 
-@app.command("study")
+@commands.command("study")
 def study_cmd(
     spec_path: Annotated[Path, typer.Argument(help="Study spec (TOML).", metavar="SPEC.toml")],
     out: Annotated[Path | None, typer.Option("--out", help="Output folder (default: "
@@ -88,14 +91,14 @@ def study_cmd(
     from ..sweeps import StudySpec, run_study
     from ..sweeps.run import StudyInterrupted
 
-    console = _console()
-    with _errors(), _interruptible():
+    console = make_console()
+    with errors(), _interruptible():
         spec = StudySpec.from_toml(spec_path)
         out_dir = out if out is not None else Path("studies") / spec.name
         check_output(out_dir / "run.json", "--out")  # before any work, naming the user's path
         with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                       _Rate(), TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(),
-                      console=_console(stderr=True), transient=False) as bar:
+                      console=make_console(stderr=True), transient=False) as bar:
             task = bar.add_task(f"study {spec.name}", total=spec.n_points)
             try:
                 res = run_study(spec, out_dir, workers=workers, scheduler=scheduler, csv=csv,
@@ -113,7 +116,7 @@ def study_cmd(
                   + " and run.json")
 
 
-@app.command("reproduce")
+@commands.command("reproduce")
 def reproduce_cmd(
     quick: Annotated[bool, typer.Option("--quick", help="Coarse resolution (about a "
                                         "minute).")] = False,
@@ -128,7 +131,7 @@ def reproduce_cmd(
     from ..sweeps import catalogue
     from ..sweeps.claims import Verdict
 
-    console = _console()
+    console = make_console()
     n_studies = len(catalogue.STUDIES)
     t0 = time.perf_counter()
     state = {"studies": 0}
@@ -142,7 +145,7 @@ def reproduce_cmd(
         elif stage == "figure":
             console.print(f"[{el:6.1f} s] figure {name} ({seconds:.1f} s)")
 
-    with _errors(), _interruptible():
+    with errors(), _interruptible():
         check_output(out / "index.html", "--out")  # before any work, naming the user's path
         try:
             path = reproduce(out, quick=quick, workers=workers, scheduler=scheduler,

@@ -1,0 +1,229 @@
+"""What every ``tslip`` command shares: options, parameters, consoles and errors.
+
+The subcommand modules import this module and nothing else from
+:mod:`tslip.cli`; :mod:`tslip.cli.main` imports them and assembles the app,
+so the imports inside the package form no cycle (``tests/cli/test_layout.py``).
+
+Errors: bad input (a :class:`ValueError`) prints one line ``error: ...`` to
+stderr and exits with code 2; valid input whose work fails (:class:`Failed`,
+an unwritable output) exits with code 1; Ctrl-C exits with 130.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.console import Console
+
+from .._checks import check_output, parse_number
+from ..model.parameters import PARAMETER_TABLE, Params, preset, presets, read_params_file
+
+__all__ = [
+    "DATA_SUFFIXES", "Failed", "ParamsOpt", "PresetOpt", "SetOpt", "build_params",
+    "build_params_and_preset", "check_plot_suffix", "check_suffix", "echo_error", "errors",
+    "fail", "file_size", "make_console", "run",
+]
+
+#: Table files the commands read and write.
+DATA_SUFFIXES = (".csv", ".parquet")
+
+_TABLE = {row.name: row for row in PARAMETER_TABLE}
+_STRING_KEYS = ("controller", "leg_reset")
+
+# -- options shared by several commands --------------------------------------------
+
+PresetOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--preset", "-p",
+        help="Base parameter set (see `tslip presets`); default: the --params file's preset, "
+        "else table2.1.",
+    ),
+]
+SetOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--set",
+        "-s",
+        metavar="KEY=VALUE",
+        help="Override a parameter, e.g. k=30, omega_r_bar=0.2, controller=local_velocity, "
+        "controller.Kd=0.4, leg_reset=global. Repeatable; applied after --params.",
+    ),
+]
+ParamsOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--params",
+        metavar="FILE.toml",
+        help="TOML file of parameters (a \\[params] table or top-level keys).",
+    ),
+]
+
+# -- consoles and errors ---------------------------------------------------------------
+
+
+def make_console(stderr: bool = False) -> Console:
+    """A rich console that prints text as given (no markup, no highlighting)."""
+    return Console(stderr=stderr, highlight=False, markup=False, soft_wrap=True)
+
+
+class Failed(Exception):
+    """The input was valid but the work did not succeed (e.g. no periodic gait): exit 1."""
+
+
+def echo_error(message: str) -> None:
+    """Print ``error: <message>`` as one line on stderr."""
+    typer.echo("error: " + " ".join(message.split()), err=True)
+
+
+def fail(message: str, code: int) -> None:
+    """Print the error line and exit with ``code``."""
+    echo_error(message)
+    raise typer.Exit(code=code)
+
+
+@contextmanager
+def errors() -> Iterator[None]:
+    """Turn ValueError (bad input) into ``error: ...`` and exit code 2."""
+    try:
+        yield
+    except Failed as exc:
+        fail(str(exc), 1)
+    except ValueError as exc:
+        fail(str(exc), 2)
+    except OSError as exc:  # e.g. an output directory that cannot be written
+        fail(f"{exc.strerror or exc}: {exc.filename}" if exc.filename else str(exc), 1)
+
+
+def run(app: typer.Typer, prog_name: str) -> int:
+    """Run ``app`` on ``sys.argv`` and return its exit code.
+
+    Usage errors found by the option parser (``--steps abc``, an unknown
+    option) print one line ``error: ...`` like every other bad input.
+    """
+    # typer's (vendored) click exceptions live beside BadParameter
+    exc_mod = sys.modules[typer.BadParameter.__module__]
+    try:
+        code = app(prog_name=prog_name, standalone_mode=False)
+    except exc_mod.NoArgsIsHelpError as exc:
+        exc.show()
+        return exc.exit_code
+    except exc_mod.UsageError as exc:
+        command = exc.ctx.command_path if exc.ctx is not None else prog_name
+        echo_error(f"{exc.format_message()} (see `{command} --help`)")
+        return exc.exit_code
+    except exc_mod.ClickException as exc:
+        echo_error(exc.format_message())
+        return exc.exit_code
+    except typer.Abort:
+        echo_error("interrupted")
+        return 130
+    return code if isinstance(code, int) else 0
+
+
+# -- parameters from --preset, --params and --set ------------------------------------
+
+
+def _parse_sets(items: list[str] | None, base: Params) -> dict[str, Any]:
+    """``["k=30", "controller.Kd=0.4"]`` -> overrides for :meth:`Params.from_dict`."""
+    out: dict[str, Any] = {}
+    gains: dict[str, float] = {}
+    seen: set[str] = set()
+    for item in items or []:
+        key, sep, value = item.partition("=")
+        key, value = key.strip(), value.strip()
+        if not sep or not key or not value:
+            raise ValueError(f"--set expects key=value, got {item!r}")
+        if key in seen:
+            raise ValueError(f"--set {key} is given twice; give it once")
+        seen.add(key)
+        if key.startswith("controller."):
+            gains[key.split(".", 1)[1]] = parse_number(value, f"--set {key}")
+        elif key in _STRING_KEYS:
+            out[key] = value
+        elif key in _TABLE or key == "omega_r_bar":
+            unit = _TABLE[key].unit if key in _TABLE else "-"
+            out[key] = parse_number(value, f"--set {key} [{unit}]")
+        else:
+            raise ValueError(
+                f"unknown parameter {key!r} in --set; allowed: {sorted(_TABLE)} plus "
+                "omega_r_bar, controller, controller.<gain>, leg_reset"
+            )
+    if gains:
+        if "controller" in out:
+            ctrl: dict[str, Any] = {"type": out["controller"]}
+        else:
+            ctrl = base.controller.to_dict()
+        ctrl.update(gains)
+        out["controller"] = ctrl
+    return out
+
+
+def build_params(
+    preset_name: str | None, sets: list[str] | None, params_file: Path | None
+) -> Params:
+    """Parameters from the preset, then the ``--params`` file, then ``--set``."""
+    return build_params_and_preset(preset_name, sets, params_file)[0]
+
+
+def build_params_and_preset(
+    preset_name: str | None, sets: list[str] | None, params_file: Path | None
+) -> tuple[Params, str]:
+    """:func:`build_params` and the name of the preset actually used.
+
+    The preset comes from ``--preset`` or the file's ``preset`` key (default
+    table2.1); both given with different values is an error naming both.
+    """
+    data = {} if params_file is None else read_params_file(params_file)
+    file_preset = data.pop("preset", None)
+    if file_preset is not None:
+        if not isinstance(file_preset, str):
+            raise ValueError(f"parameter file {str(params_file)!r}: preset must be one of "
+                             f"{presets()}, got {file_preset!r}")
+        preset(file_preset)  # validates the name
+        if preset_name is not None and preset_name.strip().lower() != file_preset.strip().lower():
+            raise ValueError(
+                f"--preset {preset_name!r} and preset = {file_preset!r} in "
+                f"{str(params_file)!r} differ; give one of them"
+            )
+    name = preset_name or file_preset or "table2.1"
+    params = preset(name)
+    if data:
+        try:
+            params = Params.from_dict(data, base=params)
+        except ValueError as exc:
+            raise ValueError(f"parameter file {str(params_file)!r}: {exc}") from None
+    overrides = _parse_sets(sets, params)
+    if overrides:
+        params = Params.from_dict(overrides, base=params)
+    return params, name.strip().lower()
+
+
+# -- output files ------------------------------------------------------------------------
+
+
+def check_suffix(path: Path | None, allowed: tuple[str, ...], option: str) -> None:
+    """Check an output file before the work: suffix allowed, directory writable."""
+    if path is not None:
+        check_output(path, option, allowed)
+
+
+def check_plot_suffix(path: Path | None) -> None:
+    """Check a ``--plot`` file: a format matplotlib writes, in a writable directory."""
+    if path is None:
+        return
+    from matplotlib.figure import Figure
+
+    allowed = tuple(f".{s}" for s in sorted(Figure().canvas.get_supported_filetypes()))
+    check_suffix(path, allowed, "--plot")
+
+
+def file_size(path: Path) -> str:
+    """``"1.2 MB"`` or ``"340 kB"``."""
+    n = path.stat().st_size
+    return f"{n / 1e6:.1f} MB" if n >= 1e6 else f"{n / 1e3:.0f} kB"
