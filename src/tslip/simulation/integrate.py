@@ -273,7 +273,9 @@ def simulate(
 
     The run stops early at a fall or an integration error (see
     :attr:`Trajectory.status`). Touch-down and lift-off instants are always
-    samples, so events are never rounded to the grid.
+    samples, so events are never rounded to the grid. The strides run and are
+    sampled in compiled code (one call, two with a disturbance); the
+    :class:`StepResult` of a stride and the events are built when first read.
 
     Examples
     --------
@@ -294,8 +296,7 @@ def simulate(
     td = start.as_array()
     at = n_steps if disturbance is None else min(disturbance.at_step, n_steps)
     status = run.strides(td, terrain, 0, at)
-    if status == Status.OK and at < n_steps:
-        assert disturbance is not None
+    if disturbance is not None and status == Status.OK and at < n_steps:
         td[pk.TD_XD] += disturbance.dxd
         td[pk.TD_PHID] += disturbance.dphid
         if disturbance.dh != 0.0:  # every later touch-down: ground moved by dh
