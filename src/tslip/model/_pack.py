@@ -50,6 +50,23 @@ NOUT = 27
 REC_T, REC_L, REC_BETA, REC_PHI, REC_LD, REC_BETAD, REC_PHID, REC_FX, REC_FY, REC_TAU = range(10)
 NREC = 10
 
+# -- trajectory row (tslip.simulate; the columns of Trajectory.data) ------------------
+TRAJ_COLUMNS = (
+    "t", "step", "stance", "x", "y", "xd", "yd", "phi", "phid", "l", "beta", "ld", "betad",
+    "alpha", "foot_x", "foot_y", "hip_x", "hip_y", "Fx", "Fy", "tau", "energy",
+)
+(TR_T, TR_STEP, TR_STANCE, TR_X, TR_Y, TR_XD, TR_YD, TR_PHI, TR_PHID, TR_L, TR_BETA, TR_LD,
+ TR_BETAD, TR_ALPHA, TR_FOOTX, TR_FOOTY, TR_HIPX, TR_HIPY, TR_FX, TR_FY, TR_TAU,
+ TR_ENERGY) = range(22)
+NTRAJ = 22
+
+# -- one recorded stride of a run (record_run's ``info`` row) --------------------
+# touch-down time, first row, stance rows, end row (exclusive), status, CoM height
+# at touch-down, foot height at lift-off
+RI_T0, RI_ROW0, RI_NSTANCE, RI_ROW1, RI_STATUS, RI_TDY, RI_LOFY = range(7)
+NRI = 7
+RUN_FULL = -1  # record_run's return when the rows of the next stride do not fit
+
 # -- status codes ---------------------------------------------------------------
 ST_OK = 0
 ST_FALL_BACKWARD = 1  # xdot_m < 0 (eq. 2.10)

@@ -22,11 +22,11 @@ from ..model.terrain import Terrain
 from . import _kernels as kn
 from .options import IntegratorOptions
 from .result import (
-    TRAJECTORY_COLUMNS,
     Event,
+    EventList,
     IntegrationError,
-    LiftoffState,
     Status,
+    StepList,
     StepResult,
     Trajectory,
 )
@@ -105,11 +105,11 @@ def _section(q: Sequence[float] | np.ndarray, h: float) -> np.ndarray:
     return td
 
 
-#: Bytes a recorded stride holds per sample row (the table, its stance record and
-#: the copies made while stacking) and per stride (result objects); measured with
-#: tracemalloc for Table 2.1 and 6.1 (tests/simulation/test_input_checks.py).
-_ROW_BYTES = 480.0
-_STRIDE_BYTES = 2000.0
+#: Bytes a recorded stride holds per sample row (a table row and its time since
+#: touch-down) and per stride (the kernel's start, output and info rows); checked
+#: against tracemalloc for Table 2.1 and 6.1 (tests/simulation/test_input_checks.py).
+_ROW_BYTES = 8.0 * (pk.NTRAJ + 1)
+_STRIDE_BYTES = 8.0 * (pk.NTD + pk.NOUT + pk.NRI)
 
 
 def trajectory_bytes_per_stride(params: Params, dt: float) -> float:
@@ -146,30 +146,6 @@ def _run_stride(
         if out[pk.OUT_RECOVF] == 0.0:
             return status, out, rec[: int(out[pk.OUT_NREC])]
         rows *= 4
-
-
-def _step_result(
-    params: Params, start: TouchdownState, status: int, out: np.ndarray, rec: np.ndarray
-) -> StepResult:
-    st = Status(status)
-    nxt = (
-        TouchdownState(*map(float, out[pk.OUT_TD : pk.OUT_TD + 7])) if st == Status.OK else None
-    )
-    return StepResult(
-        state=nxt,
-        stance_time=float(out[pk.OUT_TS]),
-        flight_time=float(out[pk.OUT_TF]),
-        status=st,
-        liftoff=LiftoffState.from_out(out),
-        grf=rec[:, [pk.REC_T, pk.REC_FX, pk.REC_FY, pk.REC_TAU]].copy(),
-        stance=rec[:, : pk.REC_PHID + 1].copy(),
-        foot_x=float(out[pk.OUT_XF]),
-        foot_clearance=float(out[pk.OUT_CLEAR]),
-        fy_negative_at_touchdown=bool(out[pk.OUT_FYNEG] == 1.0),
-        n_integrator_steps=int(out[pk.OUT_NSTEP]) if math.isfinite(out[pk.OUT_NSTEP]) else 0,
-        start=start,
-        params=params,
-    )
 
 
 def step(
@@ -213,7 +189,7 @@ def step(
         pk.pack_params(params), _options(options), start.as_array(), terrain or _FLAT, 0.0,
         _REC_ROWS,
     )
-    result = _step_result(params, start, status, out, rec)
+    result = StepResult.from_kernel(params, start, status, out, rec)
     if raise_on_failure and result.status.is_error:
         raise IntegrationError(result.status.reason)
     return result
@@ -297,7 +273,9 @@ def simulate(
 
     The run stops early at a fall or an integration error (see
     :attr:`Trajectory.status`). Touch-down and lift-off instants are always
-    samples, so events are never rounded to the grid.
+    samples, so events are never rounded to the grid. The strides run and are
+    sampled in compiled code (one call, two with a disturbance); the
+    :class:`StepResult` of a stride and the events are built when first read.
 
     Examples
     --------
@@ -313,61 +291,90 @@ def simulate(
     dt = float(check_number(dt, "dt", unit="g^-1/2 L^1/2", lower=0.0, lower_open=True))
     check_simulation_size(params, n_steps, dt)
     terrain = terrain or _FLAT
-    td = _as_state(state)
-    P = pk.pack_params(params)
-    O = _options(options)
-    steps: list[StepResult] = []
-    events: list[Event] = []
-    chunks: list[np.ndarray] = []
-    t0 = 0.0
-    status = Status.OK
-    for i in range(int(n_steps)):
-        if disturbance is not None and disturbance.at_step == i:
-            td = TouchdownState(
-                td.beta, td.phi, td.xd + disturbance.dxd, td.yd, td.phid + disturbance.dphid,
-                td.x, td.h,
-            )
-            if disturbance.dh != 0.0:  # every later touch-down: ground moved by dh
-                terrain = terrain.shifted_after(_foot_x(params, td), disturbance.dh)
-        st, out, rec = _run_stride(P, O, td.as_array(), terrain, dt, _REC_ROWS)
-        res = _step_result(params, td, st, out, rec)
-        steps.append(res)
-        chunks.append(_stance_rows(params, res, rec, i, t0))
-        events.append(Event("touchdown", i, t0, *_com_xy(params, td), res.foot_x, td.h))
-        status = res.status
-        if status != Status.OK:
-            lo = res.liftoff
-            if status.fell:
-                events.append(
-                    Event("fall", i, t0 + res.stance_time + res.flight_time, lo.x, lo.y,
-                          math.nan, math.nan)
-                )
-            if res.flight_time > 0:
-                chunks.append(_flight_rows(P, params, out, i, t0, dt, final=True))
-            break
-        lo = res.liftoff
-        t_lo = t0 + res.stance_time
-        hip_y = lo.y + params.r * math.cos(lo.phi)
-        events.append(
-            Event("liftoff", i, t_lo, lo.x, lo.y, res.foot_x, hip_y - lo.l * math.sin(lo.beta))
-        )
-        last = i == n_steps - 1
-        chunks.append(_flight_rows(P, params, out, i, t0, dt, final=last))
-        t0 = t_lo + res.flight_time
-        td = res.state  # type: ignore[assignment]
-        if last:
-            events.append(
-                Event("touchdown", i + 1, t0, *_com_xy(params, td), _foot_x(params, td), td.h)
-            )
-    data = np.vstack(chunks) if chunks else np.empty((0, len(TRAJECTORY_COLUMNS)))
+    start = _as_state(state)
+    run = _Recording(params, options, n_steps, dt)
+    td = start.as_array()
+    at = n_steps if disturbance is None else min(disturbance.at_step, n_steps)
+    status = run.strides(td, terrain, 0, at)
+    if disturbance is not None and status == Status.OK and at < n_steps:
+        td[pk.TD_XD] += disturbance.dxd
+        td[pk.TD_PHID] += disturbance.dphid
+        if disturbance.dh != 0.0:  # every later touch-down: ground moved by dh
+            terrain = terrain.shifted_after(_foot_x(params, TouchdownState(*td.tolist())),
+                                            disturbance.dh)
+        status = run.strides(td, terrain, at, n_steps)
     meta = {
         "dt": dt,
-        "start": dataclasses.asdict(_as_state(state)),
+        "start": dataclasses.asdict(start),
         "options": dataclasses.asdict(options or _DEFAULT_OPTIONS),
         "disturbance": None if disturbance is None else dataclasses.asdict(disturbance),
     }
-    return Trajectory(data=data, steps=steps, events=events, status=status, params=params,
-                      terrain=terrain, meta=meta)
+    return run.trajectory(status, terrain, meta)
+
+
+class _Recording:
+    """The buffers of one :func:`simulate` run, which :func:`_kernels.record_run` fills.
+
+    Rows are allocated for a few strides first, then, once the kernel reports
+    them full, for the rest of the run at the rows per stride seen so far
+    (geometric growth if that falls short); the table is trimmed at the end.
+    """
+
+    def __init__(self, params: Params, options: IntegratorOptions | None, n_steps: int,
+                 dt: float) -> None:
+        self.params = params
+        self.P = pk.pack_params(params)
+        self.O = _options(options)
+        self.n_steps = n_steps
+        self.dt = dt
+        t_s = 2.0 * params.l0 * math.cos(params.beta0) / params.v0  # as in the memory estimate
+        rows = int(min(n_steps, 8) * 2.0 * (t_s / dt + 2.0)) + 16
+        self.data = np.empty((rows, pk.NTRAJ))
+        self.tloc = np.empty(rows)
+        self.starts = np.empty((n_steps, pk.NTD))
+        self.outs = np.empty((n_steps, pk.NOUT))
+        self.info = np.empty((n_steps, pk.NRI))
+        self.pos = np.zeros(3)  # next row, its time, next stride
+
+    def strides(self, td: np.ndarray, terrain: Terrain, first: int, last: int) -> Status:
+        """Run strides ``first .. last - 1`` from ``td`` (updated to the next touch-down)."""
+        tx, th = terrain.arrays()
+        close = last == self.n_steps
+        while True:
+            st = int(kn.record_run(self.P, self.O, td, tx, th, first, last, close, self.dt,
+                                   self.data, self.tloc, self.starts, self.outs, self.info,
+                                   self.pos))
+            if st != pk.RUN_FULL:
+                return Status(st)
+            first = int(self.pos[2])
+            self._grow()
+
+    def _grow(self) -> None:
+        row, done = int(self.pos[0]), int(self.pos[2])
+        cap = len(self.data)
+        rows = 2 * cap
+        if done > 0:
+            rows = max(row + math.ceil((self.n_steps - done) * 1.05 * row / done) + 64,
+                       cap + cap // 2)
+        data = np.empty((rows, pk.NTRAJ))
+        data[:row] = self.data[:row]
+        tloc = np.empty(rows)
+        tloc[:row] = self.tloc[:row]
+        self.data, self.tloc = data, tloc
+
+    def trajectory(self, status: Status, terrain: Terrain, meta: dict) -> Trajectory:
+        rows, n = int(self.pos[0]), int(self.pos[2])
+        self.data.resize((rows, pk.NTRAJ), refcheck=False)  # trim in place, no copy
+        self.tloc.resize(rows, refcheck=False)
+        starts, outs, info = self.starts[:n], self.outs[:n], self.info[:n]
+        steps = StepList(self.params, starts, outs, info, self.data, self.tloc)
+        last = None
+        if status == Status.OK and n == self.n_steps:
+            td = TouchdownState(*outs[-1, pk.OUT_TD : pk.OUT_TD + 7].tolist())
+            last = Event("touchdown", n, float(self.pos[1]), *_com_xy(self.params, td),
+                         _foot_x(self.params, td), td.h)
+        return Trajectory(data=self.data, steps=steps, events=EventList(steps, last),
+                          status=status, params=self.params, terrain=terrain, meta=meta)
 
 
 def _foot_x(params: Params, td: TouchdownState) -> float:
@@ -377,58 +384,6 @@ def _foot_x(params: Params, td: TouchdownState) -> float:
 
 def _com_xy(params: Params, td: TouchdownState) -> tuple[float, float]:
     return td.x, td.h + params.l0 * math.sin(td.beta) - params.r * math.cos(td.phi)
-
-
-def _energy(p: Params, y: np.ndarray, xd: np.ndarray, yd: np.ndarray, phid: np.ndarray,
-            l: np.ndarray) -> np.ndarray:  # noqa: E741
-    """Total mechanical energy: kinetic + gravity + leg spring [MgL]."""
-    return (0.5 * p.m * (xd**2 + yd**2) + 0.5 * p.J * phid**2 + p.m * p.g * y
-            + 0.5 * p.k * (p.l0 - l) ** 2)
-
-
-def _stance_rows(p: Params, res: StepResult, rec: np.ndarray, i: int, t0: float) -> np.ndarray:
-    t, l, b, ph, ld, bd, phd, fx, fy, tau = rec.T
-    xf, h = res.foot_x, res.start.h
-    sb, cb, sp, cp = np.sin(b), np.cos(b), np.sin(ph), np.cos(ph)
-    x = xf - l * cb + p.r * sp
-    y = h + l * sb - p.r * cp
-    xd = -ld * cb + l * sb * bd + p.r * cp * phd
-    yd = ld * sb + l * cb * bd + p.r * sp * phd
-    n = len(t)
-    cols = {
-        "t": t0 + t, "step": np.full(n, i), "stance": np.ones(n), "x": x, "y": y, "xd": xd,
-        "yd": yd, "phi": ph, "phid": phd, "l": l, "beta": b, "ld": ld, "betad": bd,
-        "alpha": b + ph, "foot_x": np.full(n, xf), "foot_y": np.full(n, h),
-        "hip_x": xf - l * cb, "hip_y": h + l * sb, "Fx": fx, "Fy": fy, "tau": tau,
-        "energy": _energy(p, y, xd, yd, phd, l),
-    }
-    return np.column_stack([cols[c] for c in TRAJECTORY_COLUMNS])
-
-
-def _flight_rows(P: np.ndarray, p: Params, out: np.ndarray, i: int, t0: float, dt: float,
-                 final: bool) -> np.ndarray:
-    ts_, tf = float(out[pk.OUT_TS]), float(out[pk.OUT_TF])
-    lo = out[pk.OUT_LO : pk.OUT_LO + 6].copy()
-    ts = np.arange(dt, tf, dt)
-    if ts.size and tf - ts[-1] < 1e-9:
-        ts = ts[:-1]
-    if final:
-        ts = np.append(ts, tf)
-    fs = np.empty((len(ts), 10))
-    kn.flight_samples(P, lo, ts, fs)
-    x, y, xd, yd, ph, phd, b, foot_x, foot_y, hip_y = fs.T
-    n = len(ts)
-    betad = np.full(n, p.omega_r) if p.leg_reset == "global" else p.omega_r - phd
-    zeros = np.zeros(n)
-    l = np.full(n, p.l0)  # noqa: E741
-    cols = {
-        "t": t0 + ts_ + ts, "step": np.full(n, i), "stance": zeros, "x": x, "y": y, "xd": xd,
-        "yd": yd, "phi": ph, "phid": phd, "l": l, "beta": b, "ld": zeros, "betad": betad,
-        "alpha": b + ph, "foot_x": foot_x, "foot_y": foot_y, "hip_x": x - p.r * np.sin(ph),
-        "hip_y": hip_y, "Fx": zeros, "Fy": zeros, "tau": zeros,
-        "energy": _energy(p, y, xd, yd, phd, l),
-    }
-    return np.column_stack([cols[c] for c in TRAJECTORY_COLUMNS])
 
 
 # ---------------------------------------------------------------------------

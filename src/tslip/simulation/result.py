@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import enum
+import math
+import operator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 
@@ -18,7 +21,10 @@ from ..model.terrain import Terrain
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["Status", "LiftoffState", "StepResult", "Trajectory", "Event", "IntegrationError"]
+__all__ = [
+    "Status", "LiftoffState", "StepResult", "StepList", "Trajectory", "Event", "EventList",
+    "IntegrationError",
+]
 
 
 class IntegrationError(RuntimeError):
@@ -129,6 +135,29 @@ class StepResult:
     start: TouchdownState
     params: Params
 
+    @classmethod
+    def from_kernel(cls, params: Params, start: TouchdownState, status: int, out: np.ndarray,
+                    rec: np.ndarray) -> StepResult:
+        """From :func:`~tslip.simulation._kernels.stride`'s output ``out`` and stance record."""
+        st = Status(status)
+        nxt = TouchdownState(*out[pk.OUT_TD : pk.OUT_TD + 7].tolist()) if st == Status.OK else None
+        nstep = out[pk.OUT_NSTEP]
+        return cls(
+            state=nxt,
+            stance_time=float(out[pk.OUT_TS]),
+            flight_time=float(out[pk.OUT_TF]),
+            status=st,
+            liftoff=LiftoffState.from_out(out),
+            grf=rec[:, [pk.REC_T, pk.REC_FX, pk.REC_FY, pk.REC_TAU]].copy(),
+            stance=rec[:, : pk.REC_PHID + 1].copy(),
+            foot_x=float(out[pk.OUT_XF]),
+            foot_clearance=float(out[pk.OUT_CLEAR]),
+            fy_negative_at_touchdown=bool(out[pk.OUT_FYNEG] == 1.0),
+            n_integrator_steps=int(nstep) if math.isfinite(nstep) else 0,
+            start=start,
+            params=params,
+        )
+
     @property
     def fell(self) -> bool:
         """True if the runner fell in this stride."""
@@ -171,11 +200,129 @@ class Event:
     foot_y: float
 
 
-#: Columns of :attr:`Trajectory.data`, in order.
-TRAJECTORY_COLUMNS: tuple[str, ...] = (
-    "t", "step", "stance", "x", "y", "xd", "yd", "phi", "phid", "l", "beta", "ld", "betad",
-    "alpha", "foot_x", "foot_y", "hip_x", "hip_y", "Fx", "Fy", "tau", "energy",
-)
+#: Columns of :attr:`Trajectory.data`, in order (the kernels write them: ``_pack.TR_*``).
+TRAJECTORY_COLUMNS: tuple[str, ...] = pk.TRAJ_COLUMNS
+
+#: Trajectory columns that hold a stance record row ``(l, beta, phi, ld, betad, phid,
+#: F_x, F_y, tau)`` (``_pack.REC_L ..``), after its time since touch-down.
+_REC_FROM_TRAJ = [pk.TR_L, pk.TR_BETA, pk.TR_PHI, pk.TR_LD, pk.TR_BETAD, pk.TR_PHID, pk.TR_FX,
+                  pk.TR_FY, pk.TR_TAU]
+
+
+class StepList(Sequence[StepResult]):
+    """The :class:`StepResult` of each stride of a recorded run, each built when first read.
+
+    :func:`tslip.simulate` keeps its strides as the kernel wrote them: the
+    touch-down states ``starts`` (n, 7), the stride outputs ``outs`` (n, NOUT),
+    the ``info`` rows (n, NRI; status and rows of each stride), and the stance
+    rows of the trajectory ``data`` with their times since touch-down ``tloc``.
+    Building a thousand result objects would cost more than the run.
+    """
+
+    __slots__ = ("_params", "_starts", "_outs", "_info", "_data", "_tloc", "_items")
+
+    def __init__(self, params: Params, starts: np.ndarray, outs: np.ndarray, info: np.ndarray,
+                 data: np.ndarray, tloc: np.ndarray) -> None:
+        self._params = params
+        self._starts = starts
+        self._outs = outs
+        self._info = info
+        self._data = data
+        self._tloc = tloc
+        self._items: list[StepResult | None] = [None] * len(starts)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    @overload
+    def __getitem__(self, i: int) -> StepResult: ...
+
+    @overload
+    def __getitem__(self, i: slice) -> list[StepResult]: ...
+
+    def __getitem__(self, i: int | slice) -> StepResult | list[StepResult]:
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        n = len(self._items)
+        k = operator.index(i)
+        if not -n <= k < n:
+            raise IndexError("stride index out of range")
+        k %= n
+        item = self._items[k]
+        if item is None:
+            item = self._items[k] = self._build(k)
+        return item
+
+    def _build(self, k: int) -> StepResult:
+        inf = self._info[k]
+        a, b = int(inf[pk.RI_ROW0]), int(inf[pk.RI_ROW0] + inf[pk.RI_NSTANCE])
+        rec = np.column_stack((self._tloc[a:b], self._data[a:b][:, _REC_FROM_TRAJ]))
+        start = TouchdownState(*self._starts[k].tolist())
+        return StepResult.from_kernel(self._params, start, int(inf[pk.RI_STATUS]), self._outs[k],
+                                      rec)
+
+    def __iter__(self) -> Iterator[StepResult]:
+        return (self[k] for k in range(len(self)))
+
+    def __repr__(self) -> str:
+        return f"<{len(self)} strides>"
+
+
+class EventList(Sequence[Event]):
+    """The touch-down, lift-off and fall events of a recorded run, built when first read.
+
+    From the arrays of the run's :class:`StepList`; ``last`` is the touch-down
+    that ends the run (``None`` if it ended in a fall or an error).
+    """
+
+    __slots__ = ("_steps", "_last", "_items")
+
+    def __init__(self, steps: StepList, last: Event | None) -> None:
+        self._steps = steps
+        self._last = last
+        self._items: list[Event] | None = None
+
+    def _list(self) -> list[Event]:
+        if self._items is None:
+            self._items = self._build()
+        return self._items
+
+    def _build(self) -> list[Event]:
+        sl = self._steps
+        events: list[Event] = []
+        for i, (s, out, inf) in enumerate(zip(sl._starts.tolist(), sl._outs.tolist(),
+                                               sl._info.tolist())):
+            t0, xf = inf[pk.RI_T0], out[pk.OUT_XF]
+            x_lo, y_lo = out[pk.OUT_LO], out[pk.OUT_LO + 1]
+            events.append(Event("touchdown", i, t0, s[pk.TD_X], inf[pk.RI_TDY], xf, s[pk.TD_H]))
+            st = Status(int(inf[pk.RI_STATUS]))
+            if st == Status.OK:
+                events.append(Event("liftoff", i, t0 + out[pk.OUT_TS], x_lo, y_lo, xf,
+                                    inf[pk.RI_LOFY]))
+            elif st.fell:
+                events.append(Event("fall", i, t0 + out[pk.OUT_TS] + out[pk.OUT_TF], x_lo, y_lo,
+                                    math.nan, math.nan))
+        if self._last is not None:
+            events.append(self._last)
+        return events
+
+    def __len__(self) -> int:
+        return len(self._list())
+
+    @overload
+    def __getitem__(self, i: int) -> Event: ...
+
+    @overload
+    def __getitem__(self, i: slice) -> list[Event]: ...
+
+    def __getitem__(self, i: int | slice) -> Event | list[Event]:
+        return self._list()[i]
+
+    def __iter__(self) -> Iterator[Event]:
+        return iter(self._list())
+
+    def __repr__(self) -> str:
+        return repr(self._list())
 
 
 @dataclass(frozen=True)
@@ -186,13 +333,14 @@ class Trajectory:
     stance flag, CoM position and velocity, pitch, leg length and angle with
     rates, local hip angle, foot and hip positions, GRF, hip torque and total
     mechanical energy. ``terrain`` is the ground the run used (including a
-step-down from a :class:`Disturbance`). ``steps`` holds the :class:`StepResult` of each stride,
-    ``events`` the touch-down, lift-off and fall events.
+    step-down from a :class:`Disturbance`). ``steps`` holds the :class:`StepResult`
+    of each stride, ``events`` the touch-down, lift-off and fall events (from
+    :func:`tslip.simulate`: a :class:`StepList` and an :class:`EventList`, built on access).
     """
 
     data: np.ndarray
-    steps: list[StepResult]
-    events: list[Event]
+    steps: Sequence[StepResult]
+    events: Sequence[Event]
     status: Status
     params: Params
     terrain: Terrain = field(default_factory=Terrain)
