@@ -402,7 +402,8 @@ def _quick_note(data: Mapping[str, Any], claim: Claim, check: Check) -> str:
              if hasattr(data.get(n), "frame")]
     if not sizes:
         return check.note
-    warn = f"judged at quick resolution ({', '.join(sizes)}); check the full run"
+    warn = (f"judged at {data.get('resolution', 'quick')} resolution ({', '.join(sizes)}); "
+            "check the full run")
     return f"{check.note}; {warn}" if check.note else warn
 
 
