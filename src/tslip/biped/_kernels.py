@@ -95,6 +95,8 @@ from ._pack import (
 )
 
 _JIT = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
+# small helpers of the right-hand side, inlined into it (numba IR inlining)
+_INLINE = dict(_JIT, inline="always")
 N = 18  # state size
 NB = 7  # bodies: trunk, thigh R, shank R, foot R, thigh L, shank L, foot L
 FOOT = (3, 6)
@@ -193,7 +195,7 @@ def kinematics(P, q, qd, pos, Jp, Ja, cv):
 NBLK = 6 + 2 * 13
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def tmt_blocks(P, q, qd, blk, h, trig):
     """Mass matrix (eq. E.14) as compact blocks, and ``h = J^T (f_g - M_f c)``
     (eqs E.15, E.20-E.21).
@@ -315,7 +317,7 @@ def mass_matrix_and_bias(P, q, qd, M, h):
             M[a, c] = M[c, a]
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def block_solve(blk, r, x, S, N):
     """Solve ``M x = r`` with M in the compact form of :func:`tmt_blocks`.
 
@@ -359,28 +361,21 @@ def block_solve(blk, r, x, S, N):
             x[k] -= m1k * z1 + m2k * z2 + wk * z3
             for c in range(k, 3):
                 S[k, c] -= m1k * N[j, 0, c] + m2k * N[j, 1, c] + wk * N[j, 2, c]
-    # S x_trunk = x[0:3] (3x3 symmetric, Cholesky)
-    l00 = S[0, 0]
-    if not l00 > 0.0:
+    # S x_trunk = x[0:3]: 3x3 symmetric, by cofactors; positive definite by
+    # its leading minors (Sylvester)
+    a, b_, c = S[0, 0], S[0, 1], S[0, 2]
+    d, e, f = S[1, 1], S[1, 2], S[2, 2]
+    c00 = d * f - e * e
+    c01 = c * e - b_ * f
+    c02 = b_ * e - c * d
+    det = a * c00 + b_ * c01 + c * c02
+    if not (a > 0.0 and a * d - b_ * b_ > 0.0 and det > 0.0):
         return False
-    l00 = math.sqrt(l00)
-    l10 = S[0, 1] / l00
-    l20 = S[0, 2] / l00
-    l11 = S[1, 1] - l10 * l10
-    if not l11 > 0.0:
-        return False
-    l11 = math.sqrt(l11)
-    l21 = (S[1, 2] - l20 * l10) / l11
-    l22 = S[2, 2] - l20 * l20 - l21 * l21
-    if not l22 > 0.0:
-        return False
-    l22 = math.sqrt(l22)
-    u0 = x[0] / l00
-    u1 = (x[1] - l10 * u0) / l11
-    u2 = (x[2] - l20 * u0 - l21 * u1) / l22
-    x[2] = u2 / l22
-    x[1] = (u1 - l21 * x[2]) / l11
-    x[0] = (u0 - l10 * x[1] - l20 * x[2]) / l00
+    idet = 1.0 / det
+    r0, r1, r2 = x[0], x[1], x[2]
+    x[0] = (c00 * r0 + c01 * r1 + c02 * r2) * idet
+    x[1] = (c01 * r0 + (a * f - c * c) * r1 + (b_ * c - a * e) * r2) * idet
+    x[2] = (c02 * r0 + (b_ * c - a * e) * r1 + (a * d - b_ * b_) * r2) * idet
     for j in range(2):
         b = 3 + 3 * j
         for a in range(3):
@@ -417,7 +412,7 @@ def leg_phase(P, t, leg):
     return rr
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def references_branch(P, rho, swing):
     """``(l_ref, ld_ref, th_ref, thd_ref)`` of one branch at phase ``rho``
     (eqs E.29-E.30, E.32-E.33), continued smoothly beyond its interval.
@@ -468,7 +463,7 @@ def init_ctl(P, t, ctl):
         ctl[2 * leg + 1] = n
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def ctl_phase(P, t, ctl, leg):
     """Phase of a leg within its current cycle (may pass the branch end slightly)."""
     return t / P[P_T] + P[P_RHO0] + 0.5 * leg - ctl[2 * leg + 1]
@@ -491,7 +486,7 @@ def ctl_switch(ctl, leg):
         ctl[2 * leg] = 1.0
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def foot_state_trig(P, y, leg, sb, cb, sg, cg):
     """:func:`foot_state` given ``sin, cos`` of ``theta_b`` and of the leg angle."""
     r1 = P[P_R1]
@@ -528,7 +523,7 @@ def contact_force(P, y, cs, leg, clamp):
     return contact_law(P, foot_state(P, y, leg), cs, leg, clamp)
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def contact_law(P, foot, cs, leg, clamp):
     """Eqs E.23-E.24 for the foot state ``foot = (x, z, xd, zd)`` (see :func:`contact_force`)."""
     x, z, xd, zd = foot
@@ -540,7 +535,7 @@ def contact_law(P, foot, cs, leg, clamp):
     return 0.0, 0.0, fz
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def actuation(P, t, y, ctl, leg):
     """``(F_t, F_s, tau)`` of a leg (eqs E.28, E.31, E.34) in controller state ``ctl``."""
     b = 3 + 3 * leg
