@@ -11,7 +11,8 @@ Three measurements, each printed as ratios measured in the same run:
    stride's end against the compiled run at 1e-12.
 2. *Per stride*, the stride map (no recording) of the Table E.2 start at the
    tolerance (default 1e-8), with each Runge-Kutta pair, against revision
-   ``1b54594`` (``_baseline.run_at``) and against scipy's fastest solver of 1.
+   ``1b54594`` (``_baseline.run_at``, wall time; and the CPU time of the
+   process, steadier on a shared machine) and scipy's fastest solver of 1.
 3. *A falling run*: a Table E.2 start perturbed within its rounding
    (:func:`tslip.sweeps.appendix_e.table_e2_perturbations`), 20 strides
    requested, against ``1b54594``.
@@ -22,10 +23,14 @@ Three measurements, each printed as ratios measured in the same run:
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import subprocess
+import sys
 import time
 
 import numpy as np
-from _baseline import BASELINE_REV, run_at
+from _baseline import BASELINE_REV, run_at, source_at
 
 from tslip.biped import BipedOptions, BipedParams, BipedState, simulate, stride
 from tslip.biped import _kernels as kn
@@ -89,14 +94,38 @@ def scipy_stride(p: BipedParams, y0: np.ndarray, method: str, tol: float) -> dic
             cs[pk.CS_ON_R + k] = 0.0
 
 
-def _best(fn, repeat: int) -> float:
+def _best(fn, repeat: int, clock=time.perf_counter) -> float:
     fn()
     best = np.inf
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0 = clock()
         fn()
-        best = min(best, time.perf_counter() - t0)
+        best = min(best, clock() - t0)
     return best
+
+
+_CPU_RUNNER = r"""
+import json, sys, time
+setup, stmt, repeat = json.loads(sys.argv[1])
+ns = {}
+exec(setup, ns)
+exec(stmt, ns)
+best = float("inf")
+for _ in range(repeat):
+    t0 = time.process_time()
+    exec(stmt, ns)
+    best = min(best, time.process_time() - t0)
+print(json.dumps(best))
+"""
+
+
+def cpu_at(rev: str, setup: str, stmt: str, repeat: int) -> float:
+    """Like ``_baseline.run_at`` but best CPU time of the process (steadier when the
+    machine is shared: time slices lost to other processes do not count)."""
+    env = dict(os.environ, PYTHONPATH=str(source_at(rev)))
+    out = subprocess.run([sys.executable, "-c", _CPU_RUNNER, json.dumps([setup, stmt, repeat])],
+                         capture_output=True, text=True, env=env, check=True)
+    return float(out.stdout.strip().splitlines()[-1])
 
 
 _SETUP = ("import numpy as np\n"
@@ -129,21 +158,27 @@ def main() -> None:
             print(f"   {m:8s} {r['steps']:7d} {r['nfev']:8d} {r['njev']:5d} {dt:9.3f} "
                   f"{abs(r['t'] - ref.t):11.2e} {np.abs(r['y'] - ref.state).max():11.2e}")
 
-    print(f"2. stride map, Table E.2 start, tolerance {a.tol:g} (best of {a.repeat})")
-    new = {}
+    print(f"2. stride map, Table E.2 start, tolerance {a.tol:g} (best of {a.repeat}; wall "
+          f"time, and CPU time of the process)")
+    new, new_cpu = {}, {}
     for m in ("dopri5", "dop853"):
         opts = BipedOptions(rtol=a.tol, atol=a.tol, method=m)
         r = stride(p, y0, 0.0, options=opts)
         new[m] = _best(lambda opts=opts: stride(p, y0, 0.0, options=opts), a.repeat)
-        print(f"   {m:7s}: {1e3 * new[m]:7.2f} ms/stride, {r.accepted} steps, "
-              f"|t - t_ref| {abs(r.t - ref.t):.1e}, |y - y_ref| "
+        new_cpu[m] = _best(lambda opts=opts: stride(p, y0, 0.0, options=opts), a.repeat,
+                           time.process_time)
+        print(f"   {m:7s}: {1e3 * new[m]:7.2f} ms/stride wall, {1e3 * new_cpu[m]:7.2f} ms CPU, "
+              f"{r.accepted} steps, |t - t_ref| {abs(r.t - ref.t):.1e}, |y - y_ref| "
               f"{np.abs(r.state - ref.state).max():.1e}")
     if not a.no_baseline:
-        old = run_at(BASELINE_REV, _SETUP, f"stride(p, y0, 0.0, options=BipedOptions("
-                     f"rtol={a.tol!r}, atol={a.tol!r}))", repeat=a.repeat)
-        print(f"   {BASELINE_REV} (dopri5): {1e3 * old:7.2f} ms/stride")
+        stmt = f"stride(p, y0, 0.0, options=BipedOptions(rtol={a.tol!r}, atol={a.tol!r}))"
+        old = run_at(BASELINE_REV, _SETUP, stmt, repeat=a.repeat)
+        old_cpu = cpu_at(BASELINE_REV, _SETUP, stmt, a.repeat)
+        print(f"   {BASELINE_REV} (dopri5): {1e3 * old:7.2f} ms/stride wall, {1e3 * old_cpu:7.2f} "
+              f"ms CPU")
         for m in new:
-            print(f"   speed-up vs {BASELINE_REV}, {m}: {old / new[m]:5.1f}x")
+            print(f"   speed-up vs {BASELINE_REV}, {m}: {old / new[m]:5.1f}x wall, "
+                  f"{old_cpu / new_cpu[m]:5.1f}x CPU")
     if np.isfinite(best_scipy):
         for m in new:
             print(f"   speed-up vs scipy's fastest explicit solver, {m}: "

@@ -192,7 +192,7 @@ class BipedEvent:
 
 @dataclass(frozen=True)
 class BipedTrajectory:
-    """A biped run, recorded at every accepted integrator step.
+    """A biped run, recorded at every accepted integrator step and event.
 
     Attributes
     ----------
