@@ -1,66 +1,136 @@
-"""Strides per second of the compiled biped simulator (thesis Appendix E).
+"""Biped simulator speed (thesis Appendix E): strides, stiffness, falling runs.
 
-Runs the Table E.2 start for its first two strides (before the gait degrades)
-at tolerance 1e-8 on one core, with the stride map (no recording) and with a
-recorded run, and prints integrator steps per stride. Baseline: the same two
-strides with scipy's ``solve_ivp`` (DOP853) on the kernel right-hand side
-called from Python, with contact switching only between steps (no event
-location), at the same tolerance, so the ratio is the cost of the Python loop.
+Three measurements, each printed as ratios measured in the same run:
 
-    python benchmarks/bench_biped.py [--repeat 5] [--tol 1e-8] [--no-scipy]
+1. *Is the right-hand side stiff?* One stride from the Table E.2 start with
+   scipy's implicit (BDF, Radau, LSODA) and explicit (RK45, DOP853) solvers on
+   the kernel's right-hand side, run piecewise between the same events (contact
+   changes and controller switches located by ``solve_ivp``'s event finder, the
+   discrete state switched between pieces): steps, right-hand sides (the
+   implicit methods' finite-difference Jacobians included), time and the
+   stride's end against the compiled run at 1e-12.
+2. *Per stride*, the stride map (no recording) of the Table E.2 start at the
+   tolerance (default 1e-8), with each Runge-Kutta pair, against revision
+   ``1b54594`` (``_baseline.run_at``, wall time; and the CPU time of the
+   process, steadier on a shared machine) and scipy's fastest solver of 1.
+3. *A falling run*: a Table E.2 start perturbed within its rounding
+   (:func:`tslip.sweeps.appendix_e.table_e2_perturbations`), 20 strides
+   requested, against ``1b54594``.
+
+    python benchmarks/bench_biped.py [--repeat 5] [--tol 1e-8] [--no-scipy] [--no-baseline]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import subprocess
+import sys
 import time
 
 import numpy as np
+from _baseline import BASELINE_REV, run_at, source_at
 
 from tslip.biped import BipedOptions, BipedParams, BipedState, simulate, stride
 from tslip.biped import _kernels as kn
 from tslip.biped import _pack as pk
+from tslip.sweeps.appendix_e import table_e2_perturbations
+
+SCIPY_METHODS = ("BDF", "Radau", "LSODA", "RK45", "DOP853")
 
 
-def _strides_compiled(p, y0, opts, n=2):
-    t, y = 0.0, y0
-    steps = 0
-    for _ in range(n):
-        r = stride(p, y, t, options=opts)
-        t, y = r.t, r.state
-        steps += r.accepted
-    return steps
-
-
-def _scipy_two_strides(p, y0, tol):
-    from scipy.integrate import DOP853
+def scipy_stride(p: BipedParams, y0: np.ndarray, method: str, tol: float) -> dict:
+    """One stride with ``solve_ivp(method)`` piecewise between events (see 1. above)."""
+    from scipy.integrate import solve_ivp
 
     P = pk.pack_params(p)
     cs = np.zeros(pk.NCS)
     kn.init_contact(P, y0, cs)
+    ctl = np.empty(4)
+    kn.init_ctl(P, 0.0, ctl)
     ws = kn._make_ws()
     aux = np.empty(10)
-    out = np.empty(18)
 
     def f(t, y):
-        kn.rhs(P, t, y, cs, out, ws, aux)
-        return out.copy()
+        out = np.empty(18)
+        kn.rhs(P, t, y, cs, ctl, False, out, ws, aux)
+        return out
 
-    solver = DOP853(f, 0.0, y0, 3.09, rtol=tol, atol=tol)
-    g_old = [kn.event_value(P, y0, cs, leg) for leg in range(2)]
-    while solver.status == "running":
-        solver.step()
-        for leg in range(2):  # switch contact after the step (no event location)
-            g = kn.event_value(P, solver.y, cs, leg)
-            if g_old[leg] > 0.0 and g <= 0.0:
-                x, _, _, _ = kn.foot_state(P, solver.y, leg)
-                on = cs[pk.CS_ON_R + leg] == 0.0
-                cs[pk.CS_ON_R + leg] = 1.0 if on else 0.0
-                if on:
-                    cs[pk.CS_XR + 2 * leg] = x
-                    cs[pk.CS_ZR + 2 * leg] = 0.0
-            g_old[leg] = kn.event_value(P, solver.y, cs, leg)
-    return solver.nfev
+    def contact(leg):
+        def g(t, y):
+            return kn.event_value(P, y, cs, leg)
+        g.terminal, g.direction = True, -1
+        return g
+
+    def switch(leg):
+        def g(t, y):
+            return kn.ctl_switch_time(P, ctl, leg) - t
+        g.terminal, g.direction = True, -1
+        return g
+
+    events = [contact(0), contact(1), switch(0), switch(1)]
+    t, y = 0.0, y0.copy()
+    steps = nfev = njev = 0
+    while True:
+        sol = solve_ivp(f, (t, t + 5.0), y, method=method, rtol=tol, atol=tol, events=events)
+        steps += len(sol.t) - 1
+        nfev += sol.nfev + 18 * sol.njev  # finite-difference Jacobians: 18 rhs each
+        njev += sol.njev
+        hit = [(te[0], k) for k, te in enumerate(sol.t_events) if len(te)]
+        if not hit:
+            raise RuntimeError(f"{method}: no event ({sol.message})")
+        t, k = min(hit)
+        y = sol.y_events[k][0].copy()
+        if k >= 2:
+            kn.ctl_switch(ctl, k - 2)
+            continue
+        x, _, _, _ = kn.foot_state(P, y, k)
+        if cs[pk.CS_ON_R + k] == 0.0:
+            cs[pk.CS_ON_R + k], cs[pk.CS_XR + 2 * k], cs[pk.CS_ZR + 2 * k] = 1.0, x, 0.0
+            if k == 0:
+                return {"t": t, "y": y, "steps": steps, "nfev": nfev, "njev": njev}
+        else:
+            cs[pk.CS_ON_R + k] = 0.0
+
+
+def _best(fn, repeat: int, clock=time.perf_counter) -> float:
+    fn()
+    best = np.inf
+    for _ in range(repeat):
+        t0 = clock()
+        fn()
+        best = min(best, clock() - t0)
+    return best
+
+
+_CPU_RUNNER = r"""
+import json, sys, time
+setup, stmt, repeat = json.loads(sys.argv[1])
+ns = {}
+exec(setup, ns)
+exec(stmt, ns)
+best = float("inf")
+for _ in range(repeat):
+    t0 = time.process_time()
+    exec(stmt, ns)
+    best = min(best, time.process_time() - t0)
+print(json.dumps(best))
+"""
+
+
+def cpu_at(rev: str, setup: str, stmt: str, repeat: int) -> float:
+    """Like ``_baseline.run_at`` but best CPU time of the process (steadier when the
+    machine is shared: time slices lost to other processes do not count)."""
+    env = dict(os.environ, PYTHONPATH=str(source_at(rev)))
+    out = subprocess.run([sys.executable, "-c", _CPU_RUNNER, json.dumps([setup, stmt, repeat])],
+                         capture_output=True, text=True, env=env, check=True)
+    return float(out.stdout.strip().splitlines()[-1])
+
+
+_SETUP = ("import numpy as np\n"
+          "from tslip.biped import BipedOptions, BipedParams, BipedState, simulate, stride\n"
+          "p = BipedParams(); y0 = BipedState.thesis().to_array()\n")
 
 
 def main() -> None:
@@ -68,32 +138,65 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--tol", type=float, default=1e-8)
     ap.add_argument("--no-scipy", action="store_true")
+    ap.add_argument("--no-baseline", action="store_true")
     a = ap.parse_args()
     p = BipedParams()
     y0 = BipedState.thesis().to_array()
-    opts = BipedOptions(rtol=a.tol, atol=a.tol)
-    steps = _strides_compiled(p, y0, opts)  # compile / load cache
-    simulate(p, y0, 2, options=opts)
-    best = np.inf
-    for _ in range(a.repeat):
-        t0 = time.perf_counter()
-        _strides_compiled(p, y0, opts)
-        best = min(best, time.perf_counter() - t0)
-    rate = 2 / best
-    best_rec = np.inf
-    for _ in range(a.repeat):
-        t0 = time.perf_counter()
-        simulate(p, y0, 2, options=opts)
-        best_rec = min(best_rec, time.perf_counter() - t0)
-    print(f"tolerance {a.tol:g}: {steps / 2:.0f} accepted steps per stride")
-    print(f"stride map (no recording): {rate:8.1f} strides/s  ({1e3 / rate:.1f} ms/stride)")
-    print(f"recorded run             : {2 / best_rec:8.1f} strides/s")
+    ref = stride(p, y0, 0.0, options=BipedOptions(rtol=1e-12, atol=1e-12, method="dop853"))
+
+    best_scipy = np.inf
     if not a.no_scipy:
-        t0 = time.perf_counter()
-        nfev = _scipy_two_strides(p, y0, a.tol)
-        ts = time.perf_counter() - t0
-        print(f"scipy DOP853 baseline    : {2 / ts:8.1f} strides/s  ({nfev} rhs calls); "
-              f"compiled is {ts / best:.0f}x faster")
+        print(f"1. one stride, scipy solve_ivp piecewise between events, tolerance {a.tol:g}")
+        print(f"   {'method':8s} {'steps':>7s} {'rhs':>8s} {'jac':>5s} {'time [s]':>9s} "
+              f"{'|t - t_ref|':>11s} {'|y - y_ref|':>11s}")
+        for m in SCIPY_METHODS:
+            t0 = time.perf_counter()
+            r = scipy_stride(p, y0, m, a.tol)
+            dt = time.perf_counter() - t0
+            if m in ("RK45", "DOP853"):
+                best_scipy = min(best_scipy, dt)
+            print(f"   {m:8s} {r['steps']:7d} {r['nfev']:8d} {r['njev']:5d} {dt:9.3f} "
+                  f"{abs(r['t'] - ref.t):11.2e} {np.abs(r['y'] - ref.state).max():11.2e}")
+
+    print(f"2. stride map, Table E.2 start, tolerance {a.tol:g} (best of {a.repeat}; wall "
+          f"time, and CPU time of the process)")
+    new, new_cpu = {}, {}
+    for m in ("dopri5", "dop853"):
+        opts = BipedOptions(rtol=a.tol, atol=a.tol, method=m)
+        r = stride(p, y0, 0.0, options=opts)
+        new[m] = _best(lambda opts=opts: stride(p, y0, 0.0, options=opts), a.repeat)
+        new_cpu[m] = _best(lambda opts=opts: stride(p, y0, 0.0, options=opts), a.repeat,
+                           time.process_time)
+        print(f"   {m:7s}: {1e3 * new[m]:7.2f} ms/stride wall, {1e3 * new_cpu[m]:7.2f} ms CPU, "
+              f"{r.accepted} steps, |t - t_ref| {abs(r.t - ref.t):.1e}, |y - y_ref| "
+              f"{np.abs(r.state - ref.state).max():.1e}")
+    if not a.no_baseline:
+        stmt = f"stride(p, y0, 0.0, options=BipedOptions(rtol={a.tol!r}, atol={a.tol!r}))"
+        old = run_at(BASELINE_REV, _SETUP, stmt, repeat=a.repeat)
+        old_cpu = cpu_at(BASELINE_REV, _SETUP, stmt, a.repeat)
+        print(f"   {BASELINE_REV} (dopri5): {1e3 * old:7.2f} ms/stride wall, {1e3 * old_cpu:7.2f} "
+              f"ms CPU")
+        for m in new:
+            print(f"   speed-up vs {BASELINE_REV}, {m}: {old / new[m]:5.1f}x wall, "
+                  f"{old_cpu / new_cpu[m]:5.1f}x CPU")
+    if np.isfinite(best_scipy):
+        for m in new:
+            print(f"   speed-up vs scipy's fastest explicit solver, {m}: "
+                  f"{best_scipy / new[m]:5.0f}x")
+
+    print(f"3. falling run: perturbed Table E.2 start, 20 strides requested (best of "
+          f"{min(a.repeat, 3)})")
+    yf = table_e2_perturbations(0)[0]
+    tr = simulate(p, yf, 20)
+    t_new = _best(lambda: simulate(p, yf, 20), min(a.repeat, 3))
+    print(f"   now: {t_new:6.3f} s, {tr.status.name} at t = {tr.stats['t_end']:.3f}, "
+          f"{tr.count_strides()} strides, {tr.stats['accepted']} steps "
+          f"{tr.stats['rejected']} rejected")
+    if not a.no_baseline:
+        old = run_at(BASELINE_REV, _SETUP + "from tslip.sweeps.appendix_e import "
+                     "table_e2_perturbations\nyf = table_e2_perturbations(0)[0]\n",
+                     "simulate(p, yf, 20)", repeat=min(a.repeat, 3))
+        print(f"   {BASELINE_REV}: {old:6.3f} s; speed-up {old / t_new:5.1f}x")
 
 
 if __name__ == "__main__":

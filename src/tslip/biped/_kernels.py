@@ -95,6 +95,8 @@ from ._pack import (
 )
 
 _JIT = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
+# small helpers of the right-hand side, inlined into it (numba IR inlining)
+_INLINE = dict(_JIT, inline="always")
 N = 18  # state size
 NB = 7  # bodies: trunk, thigh R, shank R, foot R, thigh L, shank L, foot L
 FOOT = (3, 6)
@@ -186,68 +188,217 @@ def kinematics(P, q, qd, pos, Jp, Ja, cv):
                 Ja[i, b + 2] = 1.0
 
 
-@njit(**_JIT)
-def mass_matrix_and_bias(P, q, qd, pos, Jp, Ja, cv, mass, inertia, M, h):
-    """``M = J^T M_f J`` (eq. E.14) and ``h = J^T (f_g - M_f c)`` (eqs E.15, E.20-E.21)."""
-    kinematics(P, q, qd, pos, Jp, Ja, cv)
-    body_props(P, mass, inertia)
+#: layout of the compact mass matrix ``blk`` of :func:`tmt_blocks`: the trunk
+#: block (xx, xz, x theta_b, zz, z theta_b, theta_b theta_b), then per leg the
+#: columns of l_t, l_s, theta_h in the trunk rows (3 each) and the leg block
+#: entries (l_t l_t, l_t l_s, l_s l_s, theta_h theta_h)
+NBLK = 6 + 2 * 13
+
+
+@njit(**_INLINE)
+def tmt_blocks(P, q, qd, blk, h, trig):
+    """Mass matrix (eq. E.14) as compact blocks, and ``h = J^T (f_g - M_f c)``
+    (eqs E.15, E.20-E.21).
+
+    Closed form of the TMT products of :func:`kinematics`: the three bodies of
+    a leg lie on its axis ``u = (sin gamma, cos gamma)`` at distances
+    ``s_k = a_k l_t + b_k l_s`` below the hip (eqs E.6-E.8), so with
+    ``u' = du/dgamma``, ``e = d b_z / d theta_b`` (eq. E.2) and
+    ``theta_h = gamma - theta_b`` each entry is a sum over the leg's masses:
+    ``S1 = sum m_k s_k``, ``S2 = sum m_k s_k^2`` and constants
+    ``sum m_k a_k``, ``sum m_k a_k b_k``, ... The legs do not couple to each
+    other, and within a leg ``theta_h`` does not couple to ``l_t, l_s``
+    (``u . u' = 0``): the zeros :func:`block_solve` relies on. ``trig`` gets
+    ``sin, cos`` of ``theta_b`` and of both leg angles (for the contact forces).
+    """
+    mt = P[P_MT]
+    ms = P[P_MS]
+    mf = P[P_MF]
+    r1 = P[P_R1]
+    r2 = P[P_R2]
     g = P[P_G]
+    m3 = mt + ms + mf
+    a1 = mt * r2 + ms + mf  # sum m_k a_k
+    b1 = ms * r2 + mf  # sum m_k b_k
+    jl = P[P_JT] + P[P_JS]
+    tb = q[2]
+    tbd = qd[2]
+    sb = math.sin(tb)
+    cb = math.cos(tb)
+    trig[0] = sb
+    trig[1] = cb
+    mtot = P[P_MB] + 2.0 * m3
+    blk[0] = mtot
+    blk[1] = 0.0
+    blk[2] = 0.0
+    blk[3] = mtot
+    blk[4] = 0.0
+    blk[5] = P[P_JB]
+    h[0] = 0.0
+    h[1] = -P[P_MB] * g
+    h[2] = 0.0
+    f0x = r1 * tbd * tbd * sb  # gravity minus the hip's convective acceleration
+    f0z = -g + r1 * tbd * tbd * cb
+    for j in range(2):
+        b = 3 + 3 * j
+        o = 6 + 13 * j
+        lt = q[b]
+        ls = q[b + 1]
+        ltd = qd[b]
+        lsd = qd[b + 1]
+        gam = tb + q[b + 2]
+        gd = tbd + qd[b + 2]
+        ux = math.sin(gam)
+        uz = math.cos(gam)
+        trig[2 + 2 * j] = ux
+        trig[3 + 2 * j] = uz
+        upx = uz
+        upz = -ux
+        sth = ux * cb - uz * sb  # sin, cos theta_h
+        cth = uz * cb + ux * sb
+        st_ = r2 * lt  # thigh, shank, foot distances from the hip (eqs E.6-E.8)
+        ss_ = lt + r2 * ls
+        sf_ = lt + ls
+        s1 = a1 * lt + b1 * ls
+        s2 = mt * st_ * st_ + ms * ss_ * ss_ + mf * sf_ * sf_
+        sd1 = a1 * ltd + b1 * lsd
+        ssd = mt * st_ * r2 * ltd + ms * ss_ * (ltd + r2 * lsd) + mf * sf_ * (ltd + lsd)
+        as_ = mt * r2 * st_ + ms * ss_ + mf * sf_
+        bs_ = ms * r2 * ss_ + mf * sf_
+        blk[2] += m3 * r1 * cb - s1 * upx
+        blk[4] += -m3 * r1 * sb - s1 * upz
+        blk[5] += m3 * r1 * r1 + s2 - 2.0 * r1 * s1 * cth + jl
+        blk[o] = -a1 * ux
+        blk[o + 1] = -a1 * uz
+        blk[o + 2] = -a1 * r1 * sth
+        blk[o + 3] = -b1 * ux
+        blk[o + 4] = -b1 * uz
+        blk[o + 5] = -b1 * r1 * sth
+        blk[o + 6] = -s1 * upx
+        blk[o + 7] = -s1 * upz
+        blk[o + 8] = s2 - r1 * s1 * cth + jl
+        blk[o + 9] = mt * r2 * r2 + ms + mf
+        blk[o + 10] = ms * r2 + mf
+        blk[o + 11] = ms * r2 * r2 + mf
+        blk[o + 12] = s2 + jl
+        # sum of m_k (g - c_k) over the leg, and its moments about the hip
+        fx = m3 * f0x + 2.0 * gd * sd1 * upx - gd * gd * s1 * ux
+        fz = m3 * f0z + 2.0 * gd * sd1 * upz - gd * gd * s1 * uz
+        w = s1 * (upx * f0x + upz * f0z) + 2.0 * gd * ssd  # sum s_k u'.F_k
+        uf0 = ux * f0x + uz * f0z
+        h[0] += fx
+        h[1] += fz
+        h[2] += r1 * (cb * fx - sb * fz) - w
+        h[b] = -(a1 * uf0 - gd * gd * as_)
+        h[b + 1] = -(b1 * uf0 - gd * gd * bs_)
+        h[b + 2] = -w
+
+
+@njit(**_JIT)
+def mass_matrix_and_bias(P, q, qd, M, h):
+    """``M = J^T M_f J`` (eq. E.14, 9 x 9) and ``h`` from :func:`tmt_blocks`."""
+    blk = np.empty(NBLK)
+    tmt_blocks(P, q, qd, blk, h, np.empty(6))
     for a in range(9):
-        h[a] = 0.0
         for c in range(9):
             M[a, c] = 0.0
-    for i in range(NB):
-        m = mass[i]
-        J = inertia[i]
-        fx = -m * cv[i, 0]
-        fz = -m * g - m * cv[i, 1]
-        for a in range(9):
-            pa0 = Jp[i, 0, a]
-            pa1 = Jp[i, 1, a]
-            aa = Ja[i, a]
-            h[a] += pa0 * fx + pa1 * fz
-            if pa0 == 0.0 and pa1 == 0.0 and aa == 0.0:
-                continue
-            for c in range(a, 9):
-                M[a, c] += m * (pa0 * Jp[i, 0, c] + pa1 * Jp[i, 1, c]) + J * aa * Ja[i, c]
+    M[0, 0], M[0, 1], M[0, 2] = blk[0], blk[1], blk[2]
+    M[1, 1], M[1, 2], M[2, 2] = blk[3], blk[4], blk[5]
+    for j in range(2):
+        b = 3 + 3 * j
+        o = 6 + 13 * j
+        for col in range(3):
+            for row in range(3):
+                M[row, b + col] = blk[o + 3 * col + row]
+        M[b, b], M[b, b + 1], M[b + 1, b + 1] = blk[o + 9], blk[o + 10], blk[o + 11]
+        M[b + 2, b + 2] = blk[o + 12]
     for a in range(9):
         for c in range(a):
             M[a, c] = M[c, a]
 
 
-@njit(**_JIT)
-def chol_solve(M, b, x):
-    """Solve ``M x = b`` for symmetric positive definite M (in-place Cholesky of M)."""
-    n = M.shape[0]
-    for j in range(n):
-        s = M[j, j]
-        for k in range(j):
-            s -= M[j, k] * M[j, k]
-        if s <= 0.0:
+@njit(**_INLINE)
+def block_solve(blk, r, x, S, N):
+    """Solve ``M x = r`` with M in the compact form of :func:`tmt_blocks`.
+
+    Block elimination of the legs: with a leg's trunk columns ``m1, m2, w``
+    (of ``l_t, l_s, theta_h``), its 2x2 block ``D2`` and ``d = M[theta_h,
+    theta_h]``, the trunk's Schur complement is ``S = A - sum (m1 n1^T +
+    m2 n2^T + w w^T / d)`` with ``(n1, n2) = D2^-1 (m1, m2)``; then
+    ``x_leg = D^-1 (r_leg - B^T x_trunk)``. ``S`` (3, 3) and ``N`` (2, 3, 3) are
+    work arrays. About 200 flops, against some 600
+    for a Cholesky factorisation of the 9 x 9 matrix. Returns False unless
+    every pivot is positive (M positive definite).
+    """
+    for k in range(3):
+        x[k] = r[k]
+    S[0, 0], S[0, 1], S[0, 2] = blk[0], blk[1], blk[2]
+    S[1, 1], S[1, 2], S[2, 2] = blk[3], blk[4], blk[5]
+    for j in range(2):
+        b = 3 + 3 * j
+        o = 6 + 13 * j
+        aa, ab, bb, dd = blk[o + 9], blk[o + 10], blk[o + 11], blk[o + 12]
+        det = aa * bb - ab * ab
+        if not (aa > 0.0 and det > 0.0 and dd > 0.0):
             return False
-        d = math.sqrt(s)
-        M[j, j] = d
-        for i in range(j + 1, n):
-            s = M[i, j]
-            for k in range(j):
-                s -= M[i, k] * M[j, k]
-            M[i, j] = s / d
-    for i in range(n):
-        s = b[i]
-        for k in range(i):
-            s -= M[i, k] * x[k]
-        x[i] = s / M[i, i]
-    for i in range(n - 1, -1, -1):
-        s = x[i]
-        for k in range(i + 1, n):
-            s -= M[k, i] * x[k]
-        x[i] = s / M[i, i]
+        idet = 1.0 / det
+        idd = 1.0 / dd
+        p = bb * idet  # D2^-1 = [[p, pq], [pq, pr]]
+        pq = -ab * idet
+        pr = aa * idet
+        z1 = p * r[b] + pq * r[b + 1]
+        z2 = pq * r[b] + pr * r[b + 1]
+        z3 = r[b + 2] * idd
+        x[b], x[b + 1], x[b + 2] = z1, z2, z3
+        for k in range(3):  # N[j] = (n1, n2, w / d): D^-1 B^T
+            N[j, 0, k] = p * blk[o + k] + pq * blk[o + 3 + k]
+            N[j, 1, k] = pq * blk[o + k] + pr * blk[o + 3 + k]
+            N[j, 2, k] = blk[o + 6 + k] * idd
+        for k in range(3):
+            m1k = blk[o + k]
+            m2k = blk[o + 3 + k]
+            wk = blk[o + 6 + k]
+            x[k] -= m1k * z1 + m2k * z2 + wk * z3
+            for c in range(k, 3):
+                S[k, c] -= m1k * N[j, 0, c] + m2k * N[j, 1, c] + wk * N[j, 2, c]
+    # S x_trunk = x[0:3]: 3x3 symmetric, by cofactors; positive definite by
+    # its leading minors (Sylvester)
+    a, b_, c = S[0, 0], S[0, 1], S[0, 2]
+    d, e, f = S[1, 1], S[1, 2], S[2, 2]
+    c00 = d * f - e * e
+    c01 = c * e - b_ * f
+    c02 = b_ * e - c * d
+    det = a * c00 + b_ * c01 + c * c02
+    if not (a > 0.0 and a * d - b_ * b_ > 0.0 and det > 0.0):
+        return False
+    idet = 1.0 / det
+    r0, r1, r2 = x[0], x[1], x[2]
+    x[0] = (c00 * r0 + c01 * r1 + c02 * r2) * idet
+    x[1] = (c01 * r0 + (a * f - c * c) * r1 + (b_ * c - a * e) * r2) * idet
+    x[2] = (c02 * r0 + (b_ * c - a * e) * r1 + (a * d - b_ * b_) * r2) * idet
+    for j in range(2):
+        b = 3 + 3 * j
+        for a in range(3):
+            x[b + a] -= N[j, a, 0] * x[0] + N[j, a, 1] * x[1] + N[j, a, 2] * x[2]
     return True
 
 
 # ---------------------------------------------------------------------------
 # Controller (eqs E.25-E.34) and contact (eqs E.23-E.24)
 # ---------------------------------------------------------------------------
+#
+# The right-hand side is smooth between discontinuities, which are events:
+# each leg's controller switches branch at phase d (stance -> swing, eq. E.29
+# and E.30: the thigh velocity reference jumps) and at phase 1 = 0 (swing ->
+# stance); a foot touches down or lifts off (eqs E.23-E.24). A run carries the
+# discrete state of both: the contact state ``cs`` (flags and anchors) and the
+# controller state ``ctl = (branch_R, n_R, branch_L, n_L)``, the branch (0
+# stance, 1 swing) and the cycle of each leg, so that the phase is
+# ``rho = t/T + rho0 (+ 1/2 for the left leg) - n`` (eqs E.25-E.27) without a
+# modulo. Within one discrete state the right-hand side is the smooth
+# continuation of the current branch and contact law, so a step may run past
+# a switch; the event is then located on the dense output and the integration
+# restarted there in the new state.
 
 
 @njit(**_JIT)
@@ -261,9 +412,10 @@ def leg_phase(P, t, leg):
     return rr
 
 
-@njit(**_JIT)
-def references(P, rho):
-    """``(l_ref, ld_ref, th_ref, thd_ref)`` at phase ``rho`` (eqs E.29-E.30, E.32-E.33).
+@njit(**_INLINE)
+def references_branch(P, rho, swing):
+    """``(l_ref, ld_ref, th_ref, thd_ref)`` of one branch at phase ``rho``
+    (eqs E.29-E.30, E.32-E.33), continued smoothly beyond its interval.
 
     Eq. E.32 is used in the form ``theta_f + theta_s/2 (1 - cos(pi rho/d))``
     in stance, the continuous trajectory whose derivative is eq. E.33 (the
@@ -275,79 +427,159 @@ def references(P, rho):
     thf = P[P_THF]
     lt0 = P[P_LT0]
     lts = P[P_LTS]
-    if rho <= d:
-        a = math.pi * rho / d
-        return (lt0, 0.0, thf + 0.5 * ths * (1.0 - math.cos(a)),
-                math.pi / d * 0.5 * ths * math.sin(a) / T)
-    u = (2.0 * rho - 1.0 - d) / (1.0 - d)
-    a = math.pi * (rho - d) / (1.0 - d)
-    return (lts * u * u + (lt0 - lts), 4.0 * lts / (1.0 - d) * u / T,
-            thf + 0.5 * ths * (math.cos(a) + 1.0),
-            -math.pi / (1.0 - d) * 0.5 * ths * math.sin(a) / T)
+    if not swing:
+        w = math.pi / d
+        a = w * rho
+        return (lt0, 0.0, thf + 0.5 * ths * (1.0 - math.cos(a)), w * 0.5 * ths * math.sin(a) / T)
+    e = 1.0 / (1.0 - d)
+    u = (2.0 * rho - 1.0 - d) * e
+    a = math.pi * (rho - d) * e
+    return (lts * u * u + (lt0 - lts), 4.0 * lts * e * u / T,
+            thf + 0.5 * ths * (math.cos(a) + 1.0), -math.pi * e * 0.5 * ths * math.sin(a) / T)
+
+
+@njit(**_JIT)
+def references(P, rho):
+    """References at phase ``rho`` in [0, 1): stance branch for ``rho <= d``."""
+    return references_branch(P, rho, rho > P[P_D])
+
+
+#: a phase within this of a branch end counts as past it (the right limit)
+PHASE_EPS = 1e-12
+
+
+@njit(**_JIT)
+def init_ctl(P, t, ctl):
+    """Controller state at time ``t``: the branch that holds just after ``t``."""
+    d = P[P_D]
+    for leg in range(2):
+        s = t / P[P_T] + P[P_RHO0] + 0.5 * leg
+        n = float(math.floor(s))
+        r = s - n
+        if r >= 1.0 - PHASE_EPS:
+            n += 1.0
+            r = 0.0
+        ctl[2 * leg] = 1.0 if r >= d - PHASE_EPS else 0.0
+        ctl[2 * leg + 1] = n
+
+
+@njit(**_INLINE)
+def ctl_phase(P, t, ctl, leg):
+    """Phase of a leg within its current cycle (may pass the branch end slightly)."""
+    return t / P[P_T] + P[P_RHO0] + 0.5 * leg - ctl[2 * leg + 1]
+
+
+@njit(**_JIT)
+def ctl_switch_time(P, ctl, leg):
+    """Time at which the leg's current branch ends (phase d or 1)."""
+    end = 1.0 if ctl[2 * leg] != 0.0 else P[P_D]
+    return (ctl[2 * leg + 1] + end - P[P_RHO0] - 0.5 * leg) * P[P_T]
+
+
+@njit(**_JIT)
+def ctl_switch(ctl, leg):
+    """Next branch of a leg: stance -> swing, swing -> stance of the next cycle."""
+    if ctl[2 * leg] != 0.0:
+        ctl[2 * leg] = 0.0
+        ctl[2 * leg + 1] += 1.0
+    else:
+        ctl[2 * leg] = 1.0
+
+
+@njit(**_INLINE)
+def foot_state_trig(P, y, leg, sb, cb, sg, cg):
+    """:func:`foot_state` given ``sin, cos`` of ``theta_b`` and of the leg angle."""
+    r1 = P[P_R1]
+    tbd = y[11]
+    b = 3 + 3 * leg
+    s = y[b] + y[b + 1]
+    sd = y[9 + b] + y[9 + b + 1]
+    gd = tbd + y[9 + b + 2]
+    x = y[0] + r1 * sb - s * sg
+    z = y[1] + r1 * cb - s * cg
+    xd = y[9] + r1 * cb * tbd - sd * sg - s * cg * gd
+    zd = y[10] - r1 * sb * tbd - sd * cg + s * sg * gd
+    return x, z, xd, zd
 
 
 @njit(**_JIT)
 def foot_state(P, y, leg):
     """Foot position and velocity ``(x, z, xd, zd)`` of a leg (eq. E.8)."""
-    r1 = P[P_R1]
-    tb = y[2]
-    tbd = y[11]
-    b = 3 + 3 * leg
-    s = y[b] + y[b + 1]
-    sd = y[9 + b] + y[9 + b + 1]
-    gam = tb + y[b + 2]
-    gd = tbd + y[9 + b + 2]
-    sg = math.sin(gam)
-    cg = math.cos(gam)
-    x = y[0] + r1 * math.sin(tb) - s * sg
-    z = y[1] + r1 * math.cos(tb) - s * cg
-    xd = y[9] + r1 * math.cos(tb) * tbd - sd * sg - s * cg * gd
-    zd = y[10] - r1 * math.sin(tb) * tbd - sd * cg + s * sg * gd
-    return x, z, xd, zd
+    gam = y[2] + y[3 + 3 * leg + 2]
+    return foot_state_trig(P, y, leg, math.sin(y[2]), math.cos(y[2]), math.sin(gam),
+                           math.cos(gam))
 
 
 @njit(**_JIT)
-def contact_force(P, y, cs, leg):
-    """``(F_x, F_z, F_z_raw)``: eqs E.23-E.24, zero unless in contact and pushing."""
+def contact_force(P, y, cs, leg, clamp):
+    """``(F_x, F_z, F_z_raw)`` of a foot in contact (eqs E.23-E.24).
+
+    With ``clamp`` the force is zero unless the foot pushes (eq. E.23); without,
+    the spring-damper law holds throughout the contact, the smooth continuation
+    the integrator steps with until the lift-off event ends the contact.
+    """
     if P[P_CONTACT] == 0.0 or cs[CS_ON_R + leg] == 0.0:
         return 0.0, 0.0, 0.0
-    x, z, xd, zd = foot_state(P, y, leg)
+    return contact_law(P, foot_state(P, y, leg), cs, leg, clamp)
+
+
+@njit(**_INLINE)
+def contact_law(P, foot, cs, leg, clamp):
+    """Eqs E.23-E.24 for the foot state ``foot = (x, z, xd, zd)`` (see :func:`contact_force`)."""
+    x, z, xd, zd = foot
     xt = cs[CS_XR + 2 * leg]
     zt = cs[CS_ZR + 2 * leg]
     fz = P[P_KZ] * (zt - z) - P[P_CZ] * zd
-    if fz > 0.0 and z <= zt:
+    if not clamp or (fz > 0.0 and z <= zt):
         return P[P_KX] * (xt - x) - P[P_CX] * xd, fz, fz
     return 0.0, 0.0, fz
 
 
-@njit(**_JIT)
-def actuation(P, t, y, leg):
-    """``(F_t, F_s, tau)`` of a leg (eqs E.28, E.31, E.34)."""
+@njit(**_INLINE)
+def actuation(P, t, y, ctl, leg):
+    """``(F_t, F_s, tau)`` of a leg (eqs E.28, E.31, E.34) in controller state ``ctl``."""
     b = 3 + 3 * leg
     fs = P[P_K] * (P[P_LS0] - y[b + 1]) - P[P_CL] * y[9 + b + 1]
     if P[P_ACT] == 0.0:
         return 0.0, fs, 0.0
-    lr, ldr, thr, thdr = references(P, leg_phase(P, t, leg))
+    lr, ldr, thr, thdr = references_branch(P, ctl_phase(P, t, ctl, leg), ctl[2 * leg] != 0.0)
     ft = P[P_KPT] * (lr - y[b]) + P[P_KDT] * (ldr - y[9 + b])
     tau = P[P_KPH] * (thr - y[b + 2]) + P[P_KDH] * (thdr - y[9 + b + 2])
     return ft, fs, tau
 
 
 @njit(**_JIT)
-def rhs(P, t, y, cs, out, ws, aux):
-    """State derivative of ``y = (q, qd)`` (eq. E.22); forces go to ``aux`` (10)."""
-    pos, Jp, Ja, cv, mass, inertia, M, h, qdd = ws
-    q = y[:9]
-    qd = y[9:]
-    mass_matrix_and_bias(P, q, qd, pos, Jp, Ja, cv, mass, inertia, M, h)
+def rhs(P, t, y, cs, ctl, clamp, out, ws, aux):
+    """State derivative of ``y = (q, qd)`` (eq. E.22); forces go to ``aux`` (10).
+
+    ``clamp``: see :func:`contact_force` (the integrator steps unclamped).
+    """
+    blk, h, qdd, S, Nw, trig = ws
+    tmt_blocks(P, y[:9], y[9:], blk, h, trig)
+    r1 = P[P_R1]
+    sb = trig[0]
+    cb = trig[1]
     for leg in range(2):
-        fx, fz, _ = contact_force(P, y, cs, leg)
-        f = FOOT[leg]
-        for a in range(9):  # J^T f_grf (eq. E.18)
-            h[a] += Jp[f, 0, a] * fx + Jp[f, 1, a] * fz
-        ft, fs, tau = actuation(P, t, y, leg)
-        b = 3 + 3 * leg  # internal actuators do work on their own coordinates
-        h[b] += ft
+        b = 3 + 3 * leg
+        fx = 0.0
+        fz = 0.0
+        if P[P_CONTACT] != 0.0 and cs[CS_ON_R + leg] != 0.0:
+            ux = trig[2 + 2 * leg]
+            uz = trig[3 + 2 * leg]
+            foot = foot_state_trig(P, y, leg, sb, cb, ux, uz)
+            fx, fz, _ = contact_law(P, foot, cs, leg, clamp)
+            # J_foot^T f_grf (eq. E.18), the foot at s = l_t + l_s on the leg axis
+            s = y[b] + y[b + 1]
+            upf = uz * fx - ux * fz
+            uf = ux * fx + uz * fz
+            h[0] += fx
+            h[1] += fz
+            h[2] += r1 * (cb * fx - sb * fz) - s * upf
+            h[b] -= uf
+            h[b + 1] -= uf
+            h[b + 2] -= s * upf
+        ft, fs, tau = actuation(P, t, y, ctl, leg)
+        h[b] += ft  # internal actuators do work on their own coordinates
         h[b + 1] += fs
         h[b + 2] += tau
         aux[2 * leg] = fx
@@ -355,7 +587,7 @@ def rhs(P, t, y, cs, out, ws, aux):
         aux[4 + leg] = tau
         aux[6 + leg] = ft
         aux[8 + leg] = fs
-    ok = chol_solve(M, h, qdd)
+    ok = block_solve(blk, h, qdd, S, Nw)
     for a in range(9):
         out[a] = y[9 + a]
         out[9 + a] = qdd[a] if ok else math.nan
@@ -363,19 +595,31 @@ def rhs(P, t, y, cs, out, ws, aux):
 
 def make_workspace():
     """Work arrays for :func:`rhs` (a tuple; allocated once per run)."""
-    return (np.empty((NB, 2)), np.empty((NB, 2, 9)), np.empty((NB, 9)), np.empty((NB, 2)),
-            np.empty(NB), np.empty(NB), np.empty((9, 9)), np.empty(9), np.empty(9))
+    return (np.empty(NBLK), np.empty(9), np.empty(9), np.empty((3, 3)), np.empty((2, 3, 3)),
+            np.empty(6))
 
 
 _make_ws = njit(**_JIT)(make_workspace)
 
 
+def make_kin_workspace():
+    """Work arrays for :func:`kinematics`: pos, Jp, Ja, cv, mass, inertia."""
+    return (np.empty((NB, 2)), np.empty((NB, 2, 9)), np.empty((NB, 9)), np.empty((NB, 2)),
+            np.empty(NB), np.empty(NB))
+
+
+_make_kin_ws = njit(**_JIT)(make_kin_workspace)
+
+
 @njit(**_JIT)
 def energy(P, y):
     """Kinetic + gravitational + shank-spring energy (no ground springs)."""
-    ws = _make_ws()
-    pos, Jp, Ja, cv, mass, inertia, M, h, _ = ws
-    mass_matrix_and_bias(P, y[:9], y[9:], pos, Jp, Ja, cv, mass, inertia, M, h)
+    M = np.empty((9, 9))
+    h = np.empty(9)
+    mass_matrix_and_bias(P, y[:9], y[9:], M, h)
+    pos, Jp, Ja, cv, mass, inertia = _make_kin_ws()
+    kinematics(P, y[:9], y[9:], pos, Jp, Ja, cv)
+    body_props(P, mass, inertia)
     e = 0.0
     for a in range(9):
         for c in range(9):
@@ -394,36 +638,24 @@ def energy(P, y):
 
 
 @njit(**_JIT)
-def _stage_time(method, s, t, h, t_end_eval):
-    """Time of stage ``s``: ``t + c_s h``, or ``t_end_eval`` for ``c_s = 1``."""
-    c = _rk.stage_c(method, s)
-    return t_end_eval if c == 1.0 else t + c * h
-
-
-@njit(**_JIT)
-def rk_step(P, method, t, y, h, K, ytmp, ynew, cs, ws, aux, t_end_eval):
-    """One step from ``(t, y)`` with ``K[0] = f(t, y)``; ``K[ns] = f(ynew)``.
-
-    ``t_end_eval`` is the time at which the stages with ``c = 1`` (and the
-    FSAL row) are evaluated: the left limit when the step ends on a controller
-    phase boundary.
-    """
+def rk_step(P, method, t, y, h, K, ytmp, ynew, cs, ctl, ws, aux):
+    """One step from ``(t, y)`` with ``K[0] = f(t, y)``; ``K[ns] = f(ynew)``."""
     ns = _rk.n_stages(method)
     for s in range(1, ns):
         _rk.stage_state(method, N, y, h, K, s, ytmp)
-        rhs(P, _stage_time(method, s, t, h, t_end_eval), ytmp, cs, K[s], ws, aux)
+        rhs(P, t + _rk.stage_c(method, s) * h, ytmp, cs, ctl, False, K[s], ws, aux)
     _rk.stage_state(method, N, y, h, K, ns, ynew)
-    rhs(P, t_end_eval, ynew, cs, K[ns], ws, aux)
+    rhs(P, t + h, ynew, cs, ctl, False, K[ns], ws, aux)
 
 
 @njit(**_JIT)
-def dense_output(P, method, t, y, ynew, h, K, R, ytmp, cs, ws, aux, t_end_eval):
+def dense_output(P, method, t, y, ynew, h, K, R, ytmp, cs, ctl, ws, aux):
     """Continuous extension of the step just taken; returns the extra rhs calls."""
     ns = _rk.n_stages(method)
     ne = _rk.n_extra(method)
     for s in range(ns + 1, ns + 1 + ne):
         _rk.stage_state(method, N, y, h, K, s, ytmp)
-        rhs(P, _stage_time(method, s, t, h, t_end_eval), ytmp, cs, K[s], ws, aux)
+        rhs(P, t + _rk.stage_c(method, s) * h, ytmp, cs, ctl, False, K[s], ws, aux)
     _rk.dense_coeffs(method, y, ynew, h, K, R)
     return ne
 
@@ -442,39 +674,6 @@ def event_value(P, y, cs, leg):
 
 
 @njit(**_JIT)
-def next_boundary(P, t):
-    """Next time after ``t`` at which a leg phase crosses 0 or d (eqs E.26-E.27)."""
-    T = P[P_T]
-    d = P[P_D]
-    s = t / T + P[P_RHO0]
-    best = math.inf
-    for c in (0.0, d, 0.5, (d + 0.5) % 1.0):
-        cand = c + math.floor(s - c) + 1.0
-        if cand - s < 1e-12:
-            cand += 1.0
-        if cand < best:
-            best = cand
-    return (best - P[P_RHO0]) * T
-
-
-@njit(**_JIT)
-def _record(P, rec, row, t, y, cs, aux):
-    rec[row, 0] = t
-    for i in range(N):
-        rec[row, R_Y + i] = y[i]
-    rec[row, R_CON] = cs[CS_ON_R]
-    rec[row, R_CON + 1] = cs[CS_ON_L]
-    for leg in range(2):
-        fx, fz, _ = contact_force(P, y, cs, leg)
-        ft, fs, tau = actuation(P, t, y, leg)
-        rec[row, R_F + 2 * leg] = fx
-        rec[row, R_F + 2 * leg + 1] = fz
-        rec[row, R_TAU + leg] = tau
-        rec[row, R_FT + leg] = ft
-        rec[row, R_FS + leg] = fs
-
-
-@njit(**_JIT)
 def fall_check(P, y):
     """Fall status of a state, or ``ST_OK`` (hip, backward, pitch, leg collapse)."""
     if y[1] + P[P_R1] * math.cos(y[2]) <= 0.0:
@@ -486,6 +685,60 @@ def fall_check(P, y):
     if y[3] <= 0.0 or y[4] <= 0.0 or y[6] <= 0.0 or y[7] <= 0.0:
         return ST_FALL_LEG
     return ST_OK
+
+
+@njit(**_JIT)
+def fall_value(P, y):
+    """``(g, status)``: the smallest of the fall margins of :func:`fall_check` (hip
+    height, forward speed, pitch to +-pi/2, thigh and shank lengths) and the
+    fall it measures; a fall is its crossing to <= 0."""
+    g = y[1] + P[P_R1] * math.cos(y[2])
+    kind = ST_FALL_HIP
+    if y[9] < g:
+        g = y[9]
+        kind = ST_FALL_BACKWARD
+    v = 0.5 * math.pi - abs(y[2])
+    if v < g:
+        g = v
+        kind = ST_FALL_PITCH
+    for i in (3, 4, 6, 7):
+        if y[i] < g:
+            g = y[i]
+            kind = ST_FALL_LEG
+    return g, kind
+
+
+# events of a run: contact of each leg, controller switch of each leg, fall
+NEVK = 5
+K_CTL = 2
+K_FALL = 4
+
+
+@njit(**_JIT)
+def event_g(P, k, t, y, cs, tsw):
+    """Switching function ``k`` at ``(t, y)``: contact (0, 1), controller (2, 3), fall (4)."""
+    if k < K_CTL:
+        return event_value(P, y, cs, k)
+    if k < K_FALL:
+        return tsw[k - K_CTL] - t
+    return fall_value(P, y)[0]
+
+
+@njit(**_JIT)
+def _record(P, rec, row, t, y, cs, ctl):
+    rec[row, 0] = t
+    for i in range(N):
+        rec[row, R_Y + i] = y[i]
+    rec[row, R_CON] = cs[CS_ON_R]
+    rec[row, R_CON + 1] = cs[CS_ON_L]
+    for leg in range(2):
+        fx, fz, _ = contact_force(P, y, cs, leg, True)
+        ft, fs, tau = actuation(P, t, y, ctl, leg)
+        rec[row, R_F + 2 * leg] = fx
+        rec[row, R_F + 2 * leg + 1] = fz
+        rec[row, R_TAU + leg] = tau
+        rec[row, R_FT + leg] = ft
+        rec[row, R_FS + leg] = fs
 
 
 @njit(**_JIT)
@@ -510,10 +763,18 @@ def init_contact(P, y, cs):
 def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
     """Integrate from ``(t0, y0, cs0)`` until ``n_strides`` right touch-downs.
 
+    Every discontinuity of the right-hand side is an event (see the section
+    comment above): after each accepted step the switching functions of
+    :func:`event_g` are checked for a crossing, the earliest crossing is
+    located on the dense output (Illinois, :mod:`tslip.simulation._rk`, to
+    1e-13 in time), the state there is taken, every event that occurs there
+    is applied and the integration restarts. A fall is an event too: the run
+    stops where the first fall margin of :func:`fall_value` reaches zero.
+
     Stops earlier at ``O_TEND``, a fall (if ``O_FALLS``), no right touch-down
     within ``O_TSTRIDE``, or an integrator failure. Records every accepted
-    step in ``rec`` (until full), events in ``ev`` and the state just after
-    each right touch-down in ``strides``. Returns the status.
+    step and event in ``rec`` (until full), contact events in ``ev`` and the
+    state just after each right touch-down in ``strides``. Returns the status.
     """
     rtol = O[O_RTOL]
     atol = O[O_ATOL]
@@ -533,6 +794,18 @@ def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
     ynew = np.empty(N)
     yev = np.empty(N)
     cs = cs0.copy()
+    ctl = np.empty(4)
+    init_ctl(P, t0, ctl)
+    tsw = np.empty(2)
+    for leg in range(2):
+        tsw[leg] = ctl_switch_time(P, ctl, leg)
+    active = np.zeros(NEVK, dtype=np.bool_)
+    for leg in range(2):
+        active[leg] = P[P_CONTACT] != 0.0
+        active[K_CTL + leg] = P[P_ACT] != 0.0
+    active[K_FALL] = O[O_FALLS] != 0.0
+    g_old = np.empty(NEVK)
+    g_new = np.empty(NEVK)
     t = t0
     nrec = 0
     nev = 0
@@ -544,34 +817,25 @@ def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
     status = ST_OK
     nrec_cap = rec.shape[0]
     if nrec_cap > 0:
-        _record(P, rec, 0, t, y, cs, aux)
+        _record(P, rec, 0, t, y, cs, ctl)
         nrec = 1
-    rhs(P, t, y, cs, K[0], ws, aux)
+    rhs(P, t, y, cs, ctl, False, K[0], ws, aux)
     nfev += 1
     h = O[O_H0]
     if h <= 0.0:
         h = min(1e-3, hmax)
-    g_old = np.empty(2)
-    for leg in range(2):
-        g_old[leg] = event_value(P, y, cs, leg)
-    tb = next_boundary(P, t)
+    for k in range(NEVK):
+        g_old[k] = event_g(P, k, t, y, cs, tsw)
     done = n_strides <= 0
     while not done:
         if nacc + nrej >= maxsteps:
             status = ST_ERR_MAX_STEPS
             break
-        clip = False
         hstep = min(h, hmax)
-        if t + hstep >= tb:
-            hstep = tb - t
-            clip = True
-        if t + hstep >= t_end:
+        at_end = t + hstep >= t_end
+        if at_end:
             hstep = t_end - t
-            clip = False
-        t_eval = t + hstep
-        if clip:
-            t_eval = tb - 1e-12 * P[P_T]
-        rk_step(P, method, t, y, hstep, K, ytmp, ynew, cs, ws, aux, t_eval)
+        rk_step(P, method, t, y, hstep, K, ytmp, ynew, cs, ctl, ws, aux)
         nfev += ns
         err = _rk.error_norm(method, N, y, ynew, hstep, K, rtol, atol)
         if not math.isfinite(err):
@@ -583,103 +847,110 @@ def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
                 status = ST_ERR_UNDERFLOW if math.isfinite(ynew[0]) else ST_ERR_NONFINITE
                 break
             continue
-        # accepted: look for contact events inside the step (Illinois on the
-        # dense output, to 1e-13 in time)
+        nacc += 1
+        # accepted: the earliest crossing of a switching function in the step
         theta_ev = 2.0
-        leg_ev = -1
+        k_ev = -1
         have_dense = False
-        for leg in range(2):
-            if P[P_CONTACT] == 0.0:
-                break
-            g_new = event_value(P, ynew, cs, leg)
-            if g_old[leg] > 0.0 and g_new <= 0.0:
+        for k in range(NEVK):
+            if not active[k]:
+                continue
+            g_new[k] = event_g(P, k, t + hstep, ynew, cs, tsw)
+            if g_old[k] > 0.0 and g_new[k] <= 0.0:
                 if not have_dense:
-                    nfev += dense_output(P, method, t, y, ynew, hstep, K, R, yev, cs, ws, aux,
-                                         t_eval)
+                    nfev += dense_output(P, method, t, y, ynew, hstep, K, R, yev, cs, ctl, ws,
+                                         aux)
                     have_dense = True
-                _rk.root_start(st, g_old[leg], g_new)
+                _rk.root_start(st, g_old[k], g_new[k])
                 for _ in range(100):
                     c = _rk.root_guess(st)
                     _rk.dense_eval(method, R, c, yev)
-                    if _rk.root_update(st, c, event_value(P, yev, cs, leg), 1e-13 / hstep):
+                    gc = event_g(P, k, t + c * hstep, yev, cs, tsw)
+                    if _rk.root_update(st, c, gc, 1e-13 / hstep):
                         break
                 if st[1] < theta_ev:
                     theta_ev = st[1]
-                    leg_ev = leg
-        nacc += 1
-        if leg_ev >= 0:
+                    k_ev = k
+        if k_ev >= 0:
             _rk.dense_eval(method, R, theta_ev, ynew)
-            t = t + theta_ev * hstep
+            t_ev = t + theta_ev * hstep
+            if K_CTL <= k_ev < K_FALL:
+                t_ev = tsw[k_ev - K_CTL]  # a controller switch is at a known time
+            t = t_ev
             for i in range(N):
                 y[i] = ynew[i]
-            x, z, _, _ = foot_state(P, y, leg_ev)
-            if cs[CS_ON_R + leg_ev] == 0.0:
-                cs[CS_ON_R + leg_ev] = 1.0
-                cs[CS_XR + 2 * leg_ev] = x
-                cs[CS_ZR + 2 * leg_ev] = 0.0
-                kind = EV_TD_R + leg_ev
-            else:
-                cs[CS_ON_R + leg_ev] = 0.0
-                kind = EV_LO_R + leg_ev
-            if nev < ev.shape[0]:
-                ev[nev, 0] = t
-                ev[nev, 1] = kind
-                ev[nev, 2] = x
-                ev[nev, 3] = z
-                nev += 1
-            if kind == EV_TD_R:
-                t_last_td = t
-                if nstr < strides.shape[0]:
-                    strides[nstr, 0] = t
-                    for i in range(N):
-                        strides[nstr, 1 + i] = y[i]
-                    for i in range(NCS):
-                        strides[nstr, 1 + N + i] = cs[i]
-                nstr += 1
-                if nstr >= n_strides:
-                    done = True
-            rhs(P, t, y, cs, K[0], ws, aux)
+            # apply every event that has occurred at this point
+            for k in range(NEVK):
+                if not active[k] or not g_old[k] > 0.0:
+                    continue
+                if k != k_ev and event_g(P, k, t, y, cs, tsw) > 0.0:
+                    continue
+                if k == K_FALL:
+                    status = fall_value(P, y)[1]
+                elif k >= K_CTL:
+                    ctl_switch(ctl, k - K_CTL)
+                    tsw[k - K_CTL] = ctl_switch_time(P, ctl, k - K_CTL)
+                else:
+                    x, z, _, _ = foot_state(P, y, k)
+                    if cs[CS_ON_R + k] == 0.0:
+                        cs[CS_ON_R + k] = 1.0
+                        cs[CS_XR + 2 * k] = x
+                        cs[CS_ZR + 2 * k] = 0.0
+                        kind = EV_TD_R + k
+                    else:
+                        cs[CS_ON_R + k] = 0.0
+                        kind = EV_LO_R + k
+                    if nev < ev.shape[0]:
+                        ev[nev, 0] = t
+                        ev[nev, 1] = kind
+                        ev[nev, 2] = x
+                        ev[nev, 3] = z
+                        nev += 1
+                    if kind == EV_TD_R:
+                        t_last_td = t
+                        if nstr < strides.shape[0]:
+                            strides[nstr, 0] = t
+                            for i in range(N):
+                                strides[nstr, 1 + i] = y[i]
+                            for i in range(NCS):
+                                strides[nstr, 1 + N + i] = cs[i]
+                        nstr += 1
+                        if nstr >= n_strides:
+                            done = True
+            rhs(P, t, y, cs, ctl, False, K[0], ws, aux)
             nfev += 1
+            for k in range(NEVK):
+                g_old[k] = event_g(P, k, t, y, cs, tsw)
         else:
-            if clip:
-                t = tb
-            else:
-                t = t + hstep
+            t = t_end if at_end else t + hstep
             for i in range(N):
                 y[i] = ynew[i]
-            if clip:  # right limit after a phase boundary
-                rhs(P, t + 1e-12 * P[P_T], y, cs, K[0], ws, aux)
-                nfev += 1
-            else:
-                for i in range(N):
-                    K[0, i] = K[ns, i]
-        if clip or leg_ev >= 0 or t >= tb:
-            tb = next_boundary(P, t)
-        for leg in range(2):
-            g_old[leg] = event_value(P, y, cs, leg)
+                K[0, i] = K[ns, i]
+            for k in range(NEVK):
+                g_old[k] = g_new[k]
         if nrec < nrec_cap:
-            _record(P, rec, nrec, t, y, cs, aux)
+            _record(P, rec, nrec, t, y, cs, ctl)
             nrec += 1
         elif nrec_cap > 0:
             stats[S_RECFULL] = 1.0
+        if status != ST_OK:  # fell at a located fall event
+            break
         if not math.isfinite(y[0]):
             status = ST_ERR_NONFINITE
             break
         if O[O_FALLS] != 0.0:
-            fs = fall_check(P, y)
+            fs = fall_check(P, y)  # a margin that started at zero has no crossing
             if fs != ST_OK:
                 status = fs
                 break
             if t - t_last_td > O[O_TSTRIDE]:
                 status = ST_FALL_NO_TD
                 break
-        if t >= t_end:
+        if t >= t_end and not done:
             status = ST_TEND
             break
         # step-size control (Hairer)
         h = hstep * _rk.step_factor(method, err, 5.0)
-        if clip or leg_ev >= 0:
-            h = max(h, 1e-3 * min(hmax, 1.0))
     if status >= 10 and status < 20 and nev < ev.shape[0]:
         ev[nev, 0] = t
         ev[nev, 1] = EV_FALL
@@ -703,4 +974,3 @@ def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
 # numba does not notice when a kernel called from another file changes; drop
 # cached kernels compiled against other sources (see tslip._kernel_cache).
 _check_cache(run, __file__)
-

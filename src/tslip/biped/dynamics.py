@@ -1,9 +1,10 @@
 """Biped equations of motion (TMT method, eqs E.1-E.22) as NumPy-facing calls.
 
-The compiled kernels in :mod:`._kernels` evaluate the TMT products numerically:
-per body the position Jacobian ``J`` (eq. E.11) and convective acceleration
-``c = (dJ/dq qd) qd`` (eq. E.20) in closed form, then ``M = J^T M_f J``
-(eq. E.14) and ``Q - C = J^T (f_g + f_grf - M_f c) + f_a`` (eqs E.18-E.22).
+The compiled kernels in :mod:`._kernels` give per body the position Jacobian
+``J`` (eq. E.11) and convective acceleration ``c = (dJ/dq qd) qd`` (eq. E.20)
+in closed form, and the products ``M = J^T M_f J`` (eq. E.14) and
+``Q - C = J^T (f_g + f_grf - M_f c) + f_a`` (eqs E.18-E.22) summed in closed
+form over the three bodies of each leg.
 The tests compare them with an independent symbolic Lagrangian derivation.
 
 Notes on the thesis text
@@ -55,12 +56,22 @@ def _q(q: NDArray[np.float64] | BipedState, qd: NDArray[np.float64] | None = Non
     return q, qd
 
 
-def _terms(params: BipedParams, q: NDArray[np.float64], qd: NDArray[np.float64]):
+def _tmt(params: BipedParams, q: NDArray[np.float64], qd: NDArray[np.float64],
+         ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(M, h)`` of :func:`._kernels.mass_matrix_and_bias` (eqs E.14-E.21)."""
+    M = np.empty((9, 9))
+    h = np.empty(9)
+    kn.mass_matrix_and_bias(pk.pack_params(params), q, qd, M, h)
+    return M, h
+
+
+def _kin(params: BipedParams, q: NDArray[np.float64], qd: NDArray[np.float64]):
+    """Body positions, Jacobians, masses and inertias (eqs E.4-E.13)."""
     P = pk.pack_params(params)
-    ws = kn._make_ws()
-    pos, Jp, Ja, cv, mass, inertia, M, h, _ = ws
-    kn.mass_matrix_and_bias(P, q, qd, pos, Jp, Ja, cv, mass, inertia, M, h)
-    return P, ws
+    pos, Jp, Ja, cv, mass, inertia = kn._make_kin_ws()
+    kn.kinematics(P, q, qd, pos, Jp, Ja, cv)
+    kn.body_props(P, mass, inertia)
+    return pos, Jp, Ja, mass, inertia
 
 
 def mass_matrix(params: BipedParams, q: NDArray[np.float64] | BipedState) -> NDArray[np.float64]:
@@ -72,8 +83,7 @@ def mass_matrix(params: BipedParams, q: NDArray[np.float64] | BipedState) -> NDA
         Symmetric positive definite.
     """
     q, qd = _q(q)
-    _, ws = _terms(params, q, qd)
-    return ws[6].copy()
+    return _tmt(params, q, qd)[0]
 
 
 def bias_forces(params: BipedParams, q: NDArray[np.float64] | BipedState,
@@ -86,8 +96,7 @@ def bias_forces(params: BipedParams, q: NDArray[np.float64] | BipedState,
         Passive generalised forces without ground, actuators and shank spring.
     """
     q, qd = _q(q, qd)
-    _, ws = _terms(params, q, qd)
-    return ws[7].copy()
+    return _tmt(params, q, qd)[1]
 
 
 def accelerations(params: BipedParams, state: BipedState | NDArray[np.float64], t: float = 0.0,
@@ -102,7 +111,9 @@ def accelerations(params: BipedParams, state: BipedState | NDArray[np.float64], 
     P = pk.pack_params(params)
     cs = np.zeros(pk.NCS) if contact is None else np.asarray(contact, dtype=np.float64)
     out = np.empty(18)
-    kn.rhs(P, float(t), y, cs, out, kn._make_ws(), np.empty(10))
+    ctl = np.empty(4)
+    kn.init_ctl(P, float(t), ctl)
+    kn.rhs(P, float(t), y, cs, ctl, True, out, kn._make_ws(), np.empty(10))
     return out[9:]
 
 
@@ -122,8 +133,7 @@ def body_positions(params: BipedParams, q: NDArray[np.float64] | BipedState,
         Eqs E.4-E.8.
     """
     q, qd = _q(q)
-    _, ws = _terms(params, q, qd)
-    return ws[0].copy()
+    return _kin(params, q, qd)[0]
 
 
 def momentum(params: BipedParams, state: BipedState | NDArray[np.float64],
@@ -147,8 +157,7 @@ def momentum(params: BipedParams, state: BipedState | NDArray[np.float64],
         Angular momentum about ``com`` [M g^1/2 L^3/2].
     """
     q, qd = _q(state)
-    _, ws = _terms(params, q, qd)
-    pos, Jp, Ja, _, mass, inertia = ws[:6]
+    pos, Jp, Ja, mass, inertia = _kin(params, q, qd)
     v = Jp @ qd
     m_tot = float(mass.sum())
     com = mass @ pos / m_tot

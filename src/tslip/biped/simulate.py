@@ -29,6 +29,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import check_fields
+from ..model._pack import METHODS
 from . import _kernels as kn
 from . import _pack as pk
 from .parameters import STATE_FIELDS, BipedParams, BipedState
@@ -98,6 +100,14 @@ _REASONS = {
 }
 
 
+def _m(description: str, lower: float, lower_open: bool = True, unit: str = "") -> dict:
+    return {"description": description, "lower": lower, "lower_open": lower_open,
+            "upper_open": True, "unit": unit}
+
+
+_TIME = "g^-1/2 L^1/2"
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class BipedOptions:
     """Integrator options of the biped simulator.
@@ -105,7 +115,7 @@ class BipedOptions:
     Parameters
     ----------
     rtol, atol : float
-        DOPRI5 tolerances (thesis: 1e-8, Section E.2.5).
+        Tolerances (thesis: 1e-8 with Dormand-Prince 5(4), Section E.2.5).
     h0, h_max, h_min : float
         First, largest and smallest step [g^-1/2 L^1/2] (``h0 = 0``: 1e-3).
     max_steps : int
@@ -116,30 +126,30 @@ class BipedOptions:
     check_falls : bool
         Stop at falls (off for the free-flight conservation tests).
     max_records : int
-        Rows of the recorded trajectory (one per accepted step).
+        Rows of the recorded trajectory (one per accepted step and event).
+    method : str
+        Runge-Kutta pair of :mod:`tslip.simulation._rk`: ``"dopri5"``
+        (Dormand-Prince 5(4), the thesis's) or ``"dop853"`` (8th order, fewer
+        steps at tight tolerances).
     """
 
-    rtol: float = 1e-8
-    atol: float = 1e-8
-    h0: float = 0.0
-    h_max: float = 0.05
-    h_min: float = 1e-12
-    max_steps: int = 5_000_000
-    stride_time_max: float = 5.0
+    rtol: float = field(default=1e-8, metadata=_m("relative tolerance", 0.0))
+    atol: float = field(default=1e-8, metadata=_m("absolute tolerance", 0.0))
+    h0: float = field(default=0.0, metadata=_m("first step (0: automatic)", 0.0, False, _TIME))
+    h_max: float = field(default=0.05, metadata=_m("largest step", 0.0, True, _TIME))
+    h_min: float = field(default=1e-12, metadata=_m("smallest step", 0.0, True, _TIME))
+    max_steps: int = field(default=5_000_000, metadata=_m("step limit", 1.0, False))
+    stride_time_max: float = field(default=5.0, metadata=_m("longest stride", 0.0, True, _TIME))
     check_falls: bool = True
-    max_records: int = 400_000
+    max_records: int = field(default=400_000, metadata=_m("recorded rows", 1.0, False))
+    method: str = field(default="dopri5", metadata={"description": "Runge-Kutta pair",
+                                                     "choices": METHODS})
 
     def __post_init__(self) -> None:
-        for name in ("rtol", "atol", "h_max", "h_min", "stride_time_max"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be a positive number, got {v!r}")
-        if not (isinstance(self.h0, (int, float)) and math.isfinite(self.h0) and self.h0 >= 0):
-            raise ValueError(f"h0 must be >= 0, got {self.h0!r}")
-        for name in ("max_steps", "max_records"):
-            v = getattr(self, name)
-            if not isinstance(v, (int, np.integer)) or v < 1:
-                raise ValueError(f"{name} must be an integer >= 1, got {v!r}")
+        check_fields(self, prefix="BipedOptions.")
+        if self.method not in METHODS:
+            raise ValueError(f"BipedOptions.method must be one of {', '.join(METHODS)}, "
+                             f"got {self.method!r}")
 
     def pack(self, t_end: float = math.inf) -> NDArray[np.float64]:
         """Options vector for the kernels."""
@@ -153,6 +163,7 @@ class BipedOptions:
         O[pk.O_TSTRIDE] = self.stride_time_max
         O[pk.O_TEND] = t_end
         O[pk.O_FALLS] = 1.0 if self.check_falls else 0.0
+        O[pk.O_METHOD] = METHODS.index(self.method)
         return O
 
 
@@ -181,7 +192,7 @@ class BipedEvent:
 
 @dataclass(frozen=True)
 class BipedTrajectory:
-    """A biped run, recorded at every accepted integrator step.
+    """A biped run, recorded at every accepted integrator step and event.
 
     Attributes
     ----------

@@ -231,10 +231,14 @@ def stage_state(method, n, y, h, K, s, out):
     """
     a = A_TAB[method, s]
     for i in range(n):
-        acc = 0.0
-        for j in range(s):
-            acc += a[j] * K[j, i]
-        out[i] = y[i] + h * acc
+        out[i] = 0.0
+    for j in range(s):  # row by row (contiguous), skipping zeros: same sums as per component
+        aj = a[j]
+        if aj != 0.0:
+            for i in range(n):
+                out[i] += aj * K[j, i]
+    for i in range(n):
+        out[i] = y[i] + h * out[i]
 
 
 @njit(**_INLINE)
