@@ -11,7 +11,8 @@ command measured. Two are stored in ``tslip/biped/gaits/``:
     residual 1.2e-9, largest multiplier 0.788).
 ``optimised``
     The most stable design found by ``tslip biped optimise`` (largest
-    multiplier 0.101; survives step-down -0.16, push -0.82 and pitch rate
+    multiplier 0.1005; 0.1007 as stored, before controller switches were
+    events); survives step-down -0.16, push -0.82 and pitch rate
     -3.26 over 25 strides; see its ``provenance`` and
     ``robustness_25_strides``).
 """
