@@ -14,7 +14,7 @@ from typing import Any
 __all__ = ["atomic_write", "git_hash", "read_toml", "write_json", "write_mp4", "write_table"]
 
 
-def atomic_write(path: str | Path, write: Callable[[str], None]) -> Path:
+def atomic_write(path: str | Path, write: Callable[[str], object]) -> Path:
     """Call ``write(tmp_path)`` then rename the temporary file onto ``path``.
 
     The temporary file sits beside ``path`` (same file system, so the rename

@@ -145,7 +145,7 @@ def _reduced_jacobian(params: BipedParams, z: NDArray[np.float64], step: float,
 def _sorted_eigvals(A: NDArray[np.float64]) -> NDArray[np.complex128]:
     if not np.all(np.isfinite(A)):
         return np.full(A.shape[0], np.nan + 0j)
-    ev = np.linalg.eigvals(A)
+    ev = np.linalg.eigvals(A).astype(np.complex128)
     return ev[np.argsort(-np.abs(ev))]
 
 
@@ -322,7 +322,8 @@ def find_periodic_gait(
     history.append(best)
     if cma_evals > 0:
         finite = np.isfinite(lo) & np.isfinite(hi)
-        opts = {"seed": seed, "maxfevals": cma_evals, "verbose": -9, "tolfun": 1e-14}
+        opts: dict[str, Any] = {"seed": seed, "maxfevals": cma_evals, "verbose": -9,
+                                "tolfun": 1e-14}
         if finite.any():
             opts["bounds"] = [np.where(finite, lo, -np.inf).tolist(),
                               np.where(finite, hi, np.inf).tolist()]

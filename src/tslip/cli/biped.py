@@ -66,7 +66,7 @@ def _check_strides(strides: int, tol: float | None = None) -> None:
         check_number(tol, "--tol", lower=0.0, upper=1.0, lower_open=True, upper_open=True)
 
 
-def _start(sets: list[str] | None, gait: Path | None,
+def _start(sets: list[str] | None, gait: str | Path | None,
            from_tslip: str | None = None) -> tuple[BipedParams, np.ndarray, float]:
     """Parameters, start state and start time: Table E.2, a TSLIP gait or a saved gait."""
     if gait is not None and from_tslip is not None:

@@ -168,7 +168,7 @@ def _track(video: Path, out: Path, fps: float | None, scale: float | None,
         check_number(ground, "--ground", unit="px", lower=0.0)
     if max_frames is not None:
         check_number(max_frames, "--max-frames", lower=1, integer=True)
-    if scale is None:
+    if scale is None or ground is None:  # both or neither (checked above)
         frames, _, _ = open_video(video)
         first = next(frames, None)
         if first is None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import time
@@ -150,7 +151,7 @@ def gait_cmd(
         if plot is not None:
             check_output(plot / "friction.png", "--plot")
         params = build_params(preset_name, sets, params_file)
-        gait = find_gait(params, method=method, seed=seed)
+        gait = find_gait(params, method="cma" if method == "cma" else "newton", seed=seed)
         if not gait.converged:
             fail(gait.message, 1)
         rep = analyse(params, gait=gait, robustness=not no_robustness)
@@ -168,7 +169,7 @@ def gait_cmd(
                 "friction.png": plot_friction(friction_ratio(gait.params, gait.state)),
             }
             for name, fig in figs.items():
-                atomic_write(plot / name, lambda tmp, fig=fig: fig.savefig(tmp, format="png"))
+                atomic_write(plot / name, functools.partial(fig.savefig, format="png"))
                 if not as_json:
                     make_console().print(f"wrote {plot / name} ({file_size(plot / name)})")
 
@@ -214,7 +215,7 @@ def continue_cmd(
                    "gait", "max |lambda|", "stability", "t_s", "t_f")
         for row in df.itertuples():
             t.add_row(_fmt(row.value), "yes" if row.converged else "no",
-                      _fmt(row.max_nontrivial), row.stability, _fmt(row.stance_time),
+                      _fmt(row.max_nontrivial), str(row.stability), _fmt(row.stance_time),
                       _fmt(row.flight_time))
         console.print(t)
         lo, hi = branch.exists()

@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -22,6 +23,9 @@ from scipy.optimize import least_squares
 
 from ..model.parameters import Params, preset
 from .signals import SIGNALS, StepAverage, correlation, vaf
+
+if TYPE_CHECKING:
+    from ..gait.fixed_point import Gait
 
 __all__ = ["FitResult", "fit_model", "model_curves", "fit_scores", "stride_table",
            "FIT_SIGNALS"]
@@ -75,14 +79,14 @@ class FitResult:
 def _set(base: Params, values: dict[str, float]) -> Params:
     ctrl = {k: v for k, v in values.items() if k in ("Kd",)}
     top = {k: v for k, v in values.items() if k not in ("Kd",)}
-    p = dataclasses.replace(base, **top)
+    p = Params.from_dict(top, base=base) if top else base
     if ctrl:
         p = dataclasses.replace(p, controller=dataclasses.replace(p.controller, **ctrl))
     return p
 
 
 def model_curves(params: Params, tau: np.ndarray, *, guess: np.ndarray | None = None
-                 ) -> tuple[pd.DataFrame, float, float, object]:
+                 ) -> tuple[pd.DataFrame, float, float, Gait]:
     """Model signals of one periodic stride on the normalised step time.
 
     Returns
@@ -156,13 +160,13 @@ def fit_model(avg: StepAverage, *, base: Params | None = None,
     meas = {s: avg.mean[s].to_numpy()[sel] for s in FIT_SIGNALS}
     scale = {s: max(float(np.std(meas[s])), 1e-3) for s in FIT_SIGNALS}
     n_res = sum(int(sel.sum()) for _ in FIT_SIGNALS) + 2
-    state: dict[str, object] = {"guess": None, "n": 0}
+    n_evals = [0]
 
     def residual(x: np.ndarray) -> np.ndarray:
-        state["n"] = int(state["n"]) + 1  # type: ignore[call-overload]
+        n_evals[0] += 1
         p = _set(base, dict(zip(free, map(float, x))))
         try:
-            curves, ts, tf, gait = model_curves(p, avg.tau, guess=state["guess"])
+            curves, ts, tf, _ = model_curves(p, avg.tau)
         except (ValueError, RuntimeError):
             return np.full(n_res, 10.0)
         # model stance on the measured stance fraction: compare in stance-normalised time
@@ -184,7 +188,7 @@ def fit_model(avg: StepAverage, *, base: Params | None = None,
     return FitResult(params=gait.params, values=values, stance_time=ts, flight_time=tf,
                      curves=curves, scores=fit_scores(avg, curves, d_m),
                      times=stride_table(avg, ts, tf), cost=float(sol.cost),
-                     n_evals=int(state["n"]), converged=ok, message=msg)  # type: ignore[arg-type]
+                     n_evals=n_evals[0], converged=ok, message=msg)
 
 
 def fit_scores(avg: StepAverage, curves: pd.DataFrame, duty: float | None = None

@@ -51,9 +51,10 @@ def render_frames(run: SyntheticRun, *, start: int = 0, stop: int | None = None
     P = run._poses
     stop = run.n_frames if stop is None else min(stop, run.n_frames)
     leg_w = 0.012 * s
+    times = run.truth["t"].to_numpy(float)
     for k in range(start, stop):
         f = background.copy()
-        shift = int(round(run.belt_speed * run.truth["t"].iat[k] * s)) % period
+        shift = int(round(run.belt_speed * times[k] * s)) % period
         f[gy:, :] = belt[:, shift:shift + W]
         hip = P["now"]["hip"][k]
         phi = float(P["now"]["phi"][k])
@@ -146,14 +147,15 @@ def _quad(f: np.ndarray, c: np.ndarray, color: tuple[float, ...]) -> None:
     ys = np.arange(y0, y1, dtype=np.float32)[:, None]
     orient = np.sign((c[1, 0] - c[0, 0]) * (c[2, 1] - c[0, 1])
                      - (c[1, 1] - c[0, 1]) * (c[2, 0] - c[0, 0]))
-    sd = None
+    sd: np.ndarray | None = None
     for i in range(4):
         p, q = c[i], c[(i + 1) % 4]
         e = q - p
         n = float(np.hypot(*e))
         side = orient * ((e[0]) * (ys - p[1]) - (e[1]) * (xs - p[0])) / n  # > 0 inside
         sd = side if sd is None else np.minimum(sd, side)
-    _paint(f, y0, x0, np.clip(sd + 0.5, 0.0, 1.0), color)
+    if sd is not None:  # always: the loop ran four times
+        _paint(f, y0, x0, np.clip(sd + 0.5, 0.0, 1.0), color)
 
 
 def write_video(run: SyntheticRun, path: str | Path, *, quality: int = 16,

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -305,10 +306,10 @@ def contact_events(height: np.ndarray, t: np.ndarray, level: float, threshold: f
     h = np.asarray(height, float)
     with np.errstate(invalid="ignore"):
         st = h < level + threshold
-    runs = []
+    runs: list[tuple[float, float, int, int]] = []
     d = np.diff(np.concatenate([[0], st.astype(np.int8), [0]]))
     starts, stops = np.flatnonzero(d == 1), np.flatnonzero(d == -1) - 1
-    for a, b in zip(starts, stops):
+    for a, b in zip(starts.tolist(), stops.tolist()):
         if b - a < 2 or a < 2 or b > len(h) - 3:
             continue
         if not (np.isfinite(h[a - 1]) and np.isfinite(h[b + 1])):
@@ -343,7 +344,7 @@ def _corner(h: np.ndarray, t: np.ndarray, level: float, thr: float, i: int, j: i
     is NaN when the samples run out (recording edge or a tracking gap)
     before the foot is clear of the ground, as the stance is then incomplete.
     """
-    out = []
+    out: list[int] = []
     k = i + direction
     while (0 <= k < len(h) and len(out) < 40 and np.isfinite(h[k])
            and h[k] < level + 8 * thr):
@@ -423,7 +424,7 @@ def process_tracks(tracks: pd.DataFrame, fps: float, geometry: BodyGeometry | No
     rear = np.stack([clean("rear_x_m", body_ok), clean("rear_y_m", body_ok)], axis=1)
     com, hip, phi = geometry.com_from_discs(front, rear)
     counts = {f: int((tracks[f"{f}_q"] == 1).sum()) for f in ("foot1", "foot2")}
-    near = o.near if o.near != "auto" else max(counts, key=counts.get)
+    near = o.near if o.near != "auto" else max(counts, key=lambda f: counts[f])
     hind = "foot2" if near == "foot1" else "foot1"
     feet = {}
     raw_h = {}
@@ -471,7 +472,8 @@ def process_tracks(tracks: pd.DataFrame, fps: float, geometry: BodyGeometry | No
     sig_si = {"y": com[:, 1], "l": l_, "beta": beta, "phi": phi, **vel}
     unit = {"y": L, "l": L, "beta": 1.0, "phi": 1.0, "xd": V, "yd": V, "ld": V, "betad": W,
             "phid": W}
-    rows, srows = [], []
+    rows: list[pd.DataFrame] = []
+    srows: list[dict[str, Any]] = []
     for k, (t_td, t_lo, a, b) in enumerate(near_ev):
         later = hind_td[hind_td > t_lo]
         nxt = near_ev[k + 1][0] if k + 1 < len(near_ev) else math.inf

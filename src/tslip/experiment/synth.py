@@ -231,7 +231,7 @@ class SyntheticRun:
     flight_time: float
     touchdowns: pd.DataFrame
     t0: float = 0.0
-    _poses: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
+    _poses: dict[str, dict[str, np.ndarray]] = field(repr=False, default_factory=dict)
 
     @property
     def n_frames(self) -> int:

@@ -390,7 +390,8 @@ def _table(rows: list[tuple[float, ...]], cal: Calibration, fps: float) -> pd.Da
     df.insert(0, "t", np.arange(len(df)) / fps)
     df.insert(0, "frame", np.arange(len(df)))
     for m in ("front", "rear", "foot1", "foot2"):
-        df[f"{m}_x_m"], df[f"{m}_y_m"] = cal.to_metres(df[f"{m}_x_px"], df[f"{m}_y_px"])
+        df[f"{m}_x_m"], df[f"{m}_y_m"] = cal.to_metres(df[f"{m}_x_px"].to_numpy(),
+                                                       df[f"{m}_y_px"].to_numpy())
     for q in ("body_q", "foot1_q", "foot2_q"):
         df[q] = df[q].astype(int)
     return df
@@ -411,7 +412,7 @@ def _fmt_ranges(r: list[tuple[int, int]], limit: int = 4) -> str:
 
 
 def _gap_report(df: pd.DataFrame) -> list[str]:
-    out = []
+    out: list[str] = []
     n = len(df)
     if n == 0:
         return out
@@ -660,11 +661,11 @@ def _refine_circle(grey: np.ndarray, c: np.ndarray, R: float, canny_low: float,
     if x1 - x0 < 8 or y1 - y0 < 8:
         return c
     edges = cv2.Canny(grey[y0:y1, x0:x1], canny_low, canny_high)
-    ys, xs = np.nonzero(edges)
-    if len(xs) < 12:
+    iy, ix = np.nonzero(edges)
+    if len(ix) < 12:
         return c
-    xs = xs + float(x0)
-    ys = ys + float(y0)
+    xs = ix + float(x0)
+    ys = iy + float(y0)
     for _ in range(2):
         keep = np.abs(np.hypot(xs - c[0], ys - c[1]) - R) < 3.0
         n = int(keep.sum())

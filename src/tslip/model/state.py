@@ -67,7 +67,8 @@ class TouchdownState:
         q = np.asarray(q, dtype=float)
         if q.shape != (5,):
             raise ValueError(f"section vector must have shape (5,), got {q.shape}")
-        return cls(*map(float, q), x=x, h=h)
+        beta, phi, xd, yd, phid = map(float, q)
+        return cls(beta, phi, xd, yd, phid, x=x, h=h)
 
     @property
     def v(self) -> float:

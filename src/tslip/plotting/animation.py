@@ -127,7 +127,7 @@ class _Scene:
             ],
             axis=1,
         )
-        ax.add_collection(LineCollection(segs, colors="0.45", lw=0.8, zorder=1))
+        ax.add_collection(LineCollection(list(segs), colors="0.45", lw=0.8, zorder=1))
         # footholds of the run (faint marks)
         feet = [(e.foot_x, e.foot_y) for e in traj.events if e.kind == "touchdown"]
         if feet:

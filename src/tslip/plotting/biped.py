@@ -136,7 +136,7 @@ def draw_biped(ax: Any, params: Any, y: np.ndarray) -> None:
         ax.plot(foot[0], foot[1], "o", color=color, ms=4)
 
 
-def animate_biped(tr: BipedTrajectory, path: str | Path, fps: int = 30,
+def animate_biped(tr: BipedTrajectory, path: str | Path, fps: float = 30,
                   speed: float = 0.5) -> Path:
     """Write a GIF or MP4 of the run with both legs drawn (right red, left blue).
 
@@ -150,9 +150,8 @@ def animate_biped(tr: BipedTrajectory, path: str | Path, fps: int = 30,
     path = Path(path)
     if path.suffix.lower() not in (".gif", ".mp4"):
         raise ValueError(f"animation file must end in .gif or .mp4, got {str(path)!r}")
-    if path.suffix.lower() == ".gif":
-        fps = gif_fps(fps)
-    t_frames = np.arange(tr.time[0], tr.time[-1], speed / fps)
+    rate = gif_fps(fps) if path.suffix.lower() == ".gif" else float(fps)
+    t_frames = np.arange(tr.time[0], tr.time[-1], speed / rate)
     idx = np.searchsorted(tr.time, t_frames).clip(0, tr.time.size - 1)
     fig = Figure(figsize=(6, 3), dpi=80, layout="constrained")  # 480 x 240 pixels
     canvas = FigureCanvasAgg(fig)
@@ -171,4 +170,4 @@ def animate_biped(tr: BipedTrajectory, path: str | Path, fps: int = 30,
             canvas.draw()
             yield np.asarray(canvas.buffer_rgba())[..., :3].copy()
 
-    return write_frames(path, frames(), fps, total=len(idx))
+    return write_frames(path, frames(), rate, total=len(idx))

@@ -62,4 +62,4 @@ def plot_foot_trajectory(data: StepData, ax: Axes | None = None) -> Figure:
     ax.set_xlabel("x - x_m [m]")
     ax.set_ylabel("y - y_m [m]")
     ax.legend(fontsize="small")
-    return fig  # type: ignore[return-value]
+    return fig

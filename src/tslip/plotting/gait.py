@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -35,7 +35,7 @@ __all__ = [
 
 
 def _axes_list(ax: Axes | Sequence[Axes] | None, n: int, fig_size: tuple[float, float],
-               **kw: object) -> tuple[Figure, list[Axes]]:
+               **kw: Any) -> tuple[Figure, list[Axes]]:
     """``n`` axes: a new row of panels, ``ax`` repeated ``n`` times, or ``ax`` itself."""
     if ax is None:
         fig = Figure(figsize=fig_size, layout="constrained")
@@ -282,7 +282,7 @@ def plot_velocity_angle_effect(
         axes = list(ax)
         if len(axes) != 3:
             raise ValueError(f"ax must hold 3 axes, got {len(axes)}")
-        fig = axes[0].get_figure()  # type: ignore[assignment]
+        fig = axes[0].get_figure()
     ax_path, ax_fy, ax_fx = axes
     for k, c in enumerate(cases):
         color = f"C{k}"

@@ -291,4 +291,4 @@ def plot_touchdowns(
     axes[-1].set_xlabel("touch-down number")
     if ax is None:
         fig.suptitle("touch-down states and stride times")
-    return fig  # type: ignore[return-value]
+    return fig

@@ -421,12 +421,13 @@ def evaluate(data: Mapping[str, Any],
     for c in claims:
         if not all(n in data for n in c.needs):
             continue
-        common = {"quote": c.quote, "source": c.source, "reading": c.reading}
         try:
             k = _as_check(c.test(data))
             out.append(ClaimResult(c.figure, c.text, k.numbers, k.verdict, evidence=k.evidence,
-                                   note=_quick_note(data, c, k), **common))
+                                   note=_quick_note(data, c, k), quote=c.quote,
+                                   source=c.source, reading=c.reading))
         except Exception as exc:  # noqa: BLE001 - shown in the report as a failure
             out.append(ClaimResult(c.figure, c.text, {}, Verdict.FAILS,
-                                   f"{type(exc).__name__}: {exc}", **common))
+                                   f"{type(exc).__name__}: {exc}", quote=c.quote,
+                                   source=c.source, reading=c.reading))
     return out
