@@ -20,6 +20,7 @@ from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..model.terrain import Terrain
 from . import _kernels as kn
+from ._threads import choose
 from .options import IntegratorOptions
 from .result import (
     TRAJECTORY_COLUMNS,
@@ -507,13 +508,16 @@ def step_batch(
     """One stride for each row of ``states`` in a single compiled call.
 
     ``params`` is one :class:`Params` for all rows or one per row; ``states``
-    has shape (n, 5) (section on ground height 0) or (n, 7).
+    has shape (n, 5) (section on ground height 0) or (n, 7). Small batches
+    run serially in the calling thread, large ones on numba's threads
+    (:mod:`tslip.simulation._threads`).
     """
     Ps, S, TX, TH = _batch_inputs(params, states, terrain)
     n = len(S)
     OUT = np.empty((n, pk.NOUT))
     status = np.empty(n, dtype=np.int64)
-    kn.stride_batch(Ps, _options(options), S, TX, TH, OUT, status)
+    kernel = choose(kn.stride_batch_serial, kn.stride_batch, n)
+    kernel(Ps, _options(options), S, TX, TH, OUT, status)
     nxt = OUT[:, pk.OUT_TD : pk.OUT_TD + 7].copy()
     nxt[status != 0] = np.nan
     return BatchStep(nxt, OUT[:, pk.OUT_TS].copy(), OUT[:, pk.OUT_TF].copy(), status, OUT)
@@ -527,7 +531,7 @@ def run_batch(
     terrain: Terrain | Sequence[Terrain] | None = None,
     options: IntegratorOptions | None = None,
 ) -> BatchRun:
-    """Run ``n_steps`` strides for every row in one parallel compiled call.
+    """Run ``n_steps`` strides for every row in one compiled call (parallel when large).
 
     Terrain may differ per row (e.g. one step-down height per row), which is
     how robustness searches evaluate many disturbances at once.
@@ -540,6 +544,7 @@ def run_batch(
     status = np.empty(n, dtype=np.int64)
     n_done = np.empty(n, dtype=np.int64)
     t_fall = np.empty(n)
-    kn.run_batch(Ps, _options(options), S, int(n_steps), TX, TH, hist, status, n_done, t_fall)
+    kernel = choose(kn.run_batch_serial, kn.run_batch, n)
+    kernel(Ps, _options(options), S, int(n_steps), TX, TH, hist, status, n_done, t_fall)
     return BatchRun(n_done, status, t_fall, hist)
 
