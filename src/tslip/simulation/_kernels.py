@@ -660,6 +660,9 @@ def stride_simple(P, O, td, tx, th, out):
 # loop in the calling thread (small batches: waking threads costs more than a
 # row, and under load a sleeping core is not free) and a ``prange`` loop over
 # numba's thread pool. ``parallel=True`` kernels compile only when first used.
+# They call :func:`stride` directly, not :func:`stride_simple`: every kernel
+# level re-optimises all the code below it, so a wrapper level costs a sixth
+# of the first stride's compile time.
 _PAR = {"parallel": True, "cache": True, "nogil": True}
 
 
@@ -671,6 +674,7 @@ def run_row(P, O, td0, n_steps, tx, th, hist):
     fall are left as they are); ``t_fall`` is NaN unless the run fell.
     """
     out = np.empty(NOUT)
+    no_rec = np.empty((0, NREC))
     td = td0.copy()
     for j in range(7):
         hist[0, j] = td[j]
@@ -679,7 +683,7 @@ def run_row(P, O, td0, n_steps, tx, th, hist):
     done = 0
     t_fall = math.nan
     for s in range(n_steps):
-        st = stride_simple(P, O, td, tx, th, out)
+        st = stride(P, O, td, tx, th, no_rec, 0.0, out)
         if st != ST_OK:
             if st < 10:
                 t_fall = t_total + out[OUT_TFALL]
@@ -718,15 +722,17 @@ def run_batch(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall):
 @njit(**_JIT)
 def stride_batch_serial(Ps, O, TDs, TX, TH, OUTs, status):
     """:func:`stride_batch` row after row in the calling thread."""
+    no_rec = np.empty((0, NREC))
     for i in range(Ps.shape[0]):
-        status[i] = stride_simple(Ps[i], O, TDs[i], TX[i], TH[i], OUTs[i])
+        status[i] = stride(Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0, OUTs[i])
 
 
 @njit(**_PAR)
 def stride_batch(Ps, O, TDs, TX, TH, OUTs, status):
     """One stride per row, in parallel over rows (the batched Poincare map)."""
+    no_rec = np.empty((0, NREC))  # zero rows: never written, shared by the threads
     for i in prange(Ps.shape[0]):
-        status[i] = stride_simple(Ps[i], O, TDs[i], TX[i], TH[i], OUTs[i])
+        status[i] = stride(Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0, OUTs[i])
 
 
 @njit(**_JIT)

@@ -47,6 +47,9 @@ __all__ = [
 
 _FLAT = Terrain.flat(0.0)
 _REC_ROWS = 4096
+#: ``rec`` of a stride that records nothing (``kn.stride`` straight, not its
+#: ``stride_simple`` wrapper: one kernel level less to compile on first use)
+_NO_REC = np.empty((0, pk.NREC))
 
 
 @dataclass(frozen=True, slots=True)
@@ -249,7 +252,7 @@ def step_map(
     out = np.empty(pk.NOUT)
     tx, th = _FLAT.arrays()
     th = th + h
-    status = Status(int(kn.stride_simple(P, _options(options), td, tx, th, out)))
+    status = Status(int(kn.stride(P, _options(options), td, tx, th, _NO_REC, 0.0, out)))
     return MapResult(
         out[pk.OUT_TD : pk.OUT_TD + 5].copy(), float(out[pk.OUT_TS]), float(out[pk.OUT_TF]),
         status,
