@@ -14,12 +14,14 @@ Their batches have 3-8 rows. Each runs with numba's default thread count and
 with ``NUMBA_NUM_THREADS=1``, on this checkout and on revision ``1b54594``
 (today's code). Target (issue 12, item 4): default threads no slower than one
 thread, i.e. ``new default / new 1-thread <= 1``; ``old default / old
-1-thread`` shows the spinning it replaces.
+1-thread`` shows the spinning it replaces. Wall and CPU seconds (all threads)
+are printed; on a loaded machine the CPU seconds are the steadier figure.
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 import subprocess
 import sys
@@ -53,12 +55,14 @@ def main() -> None:
     setup = SETUP.format(points=args.points)
     spinner = subprocess.Popen([sys.executable, "-c", "while True: pass"])
     try:
-        for name, stmt in WORK.items():
-            t = {(rev, th): run_at(rev, setup, stmt, repeat=args.repeat, threads=th)
+        for (name, stmt), clock in itertools.product(WORK.items(), ("perf_counter",
+                                                                     "process_time")):
+            t = {(rev, th): run_at(rev, setup, stmt, repeat=args.repeat, threads=th, clock=clock)
                  for rev in (None, args.rev) for th in (None, 1)}
             new_d, new_1, old_d, old_1 = (t[None, None], t[None, 1], t[args.rev, None],
                                           t[args.rev, 1])
-            print(f"{name} (second core busy), seconds: new default {new_d:.3f}, "
+            unit = "wall" if clock == "perf_counter" else "CPU"
+            print(f"{name} (second core busy), {unit} s: new default {new_d:.3f}, "
                   f"new 1-thread {new_1:.3f}, old default {old_d:.3f}, old 1-thread {old_1:.3f}")
             print(f"  new default / new 1-thread {new_d / new_1:.2f} (target <= 1)   "
                   f"old default / old 1-thread {old_d / old_1:.2f}   "
