@@ -15,6 +15,8 @@ Usage::
 
 The snippet runs with numba's cache warm (a first untimed call is made), on
 the same number of threads as the caller unless ``threads`` is given.
+``rev=None`` means this checkout's ``src``. :func:`run_fresh` runs a script in
+a fresh interpreter instead (cold starts: pass ``NUMBA_CACHE_DIR`` in ``env``).
 """
 
 from __future__ import annotations
@@ -35,23 +37,26 @@ _CACHE = Path(os.environ.get("TSLIP_BENCH_CACHE", Path.home() / ".cache" / "tsli
 
 _RUNNER = r"""
 import json, sys, time
-setup, stmt, repeat, number = json.loads(sys.argv[1])
+setup, stmt, repeat, number, clock = json.loads(sys.argv[1])
+clock = getattr(time, clock)
 ns = {}
 exec(setup, ns)
 stmt = compile(stmt, "<stmt>", "exec")
 exec(stmt, ns)  # warm: compile or load the numba cache
 best = float("inf")
 for _ in range(repeat):
-    t0 = time.perf_counter()
+    t0 = clock()
     for _ in range(number):
         exec(stmt, ns)
-    best = min(best, (time.perf_counter() - t0) / number)
+    best = min(best, (clock() - t0) / number)
 print(json.dumps(best))
 """
 
 
-def source_at(rev: str = BASELINE_REV) -> Path:
-    """The ``src`` folder of ``rev``, extracted once into the benchmark cache."""
+def source_at(rev: str | None = BASELINE_REV) -> Path:
+    """The ``src`` folder of ``rev``, extracted once into the benchmark cache (None: this one)."""
+    if rev is None:
+        return _REPO / "src"
     full = subprocess.run(["git", "-C", str(_REPO), "rev-parse", rev], check=True,
                           capture_output=True, text=True).stdout.strip()
     dest = _CACHE / full[:12]
@@ -66,14 +71,32 @@ def source_at(rev: str = BASELINE_REV) -> Path:
     return src
 
 
-def run_at(rev: str, setup: str, stmt: str, repeat: int = 5, number: int = 1,
-           threads: int | None = None) -> float:
-    """Best-of-``repeat`` seconds per execution of ``stmt`` on revision ``rev``."""
+def run_at(rev: str | None, setup: str, stmt: str, repeat: int = 5, number: int = 1,
+           threads: int | None = None, clock: str = "perf_counter") -> float:
+    """Best-of-``repeat`` seconds per execution of ``stmt`` on revision ``rev``.
+
+    ``clock`` names the :mod:`time` function: ``"process_time"`` counts the CPU
+    seconds of all the process's threads (spinning ones included).
+    """
     env = dict(os.environ, PYTHONPATH=str(source_at(rev)))
     if threads is not None:
         env["NUMBA_NUM_THREADS"] = str(threads)
-    out = subprocess.run([sys.executable, "-c", _RUNNER, json.dumps([setup, stmt, repeat, number])],
-                         capture_output=True, text=True, env=env)
+    args = json.dumps([setup, stmt, repeat, number, clock])
+    out = subprocess.run([sys.executable, "-c", _RUNNER, args], capture_output=True, text=True,
+                         env=env)
     if out.returncode != 0:
         raise RuntimeError(f"baseline {rev} failed:\n{out.stderr[-2000:]}")
     return float(out.stdout.strip().splitlines()[-1])
+
+
+def run_fresh(rev: str | None, script: str, env: dict[str, str] | None = None) -> str:
+    """The last line ``script`` prints, run by a fresh interpreter on revision ``rev``.
+
+    ``env`` adds to the environment (e.g. ``NUMBA_CACHE_DIR`` for a cold start).
+    """
+    full_env = dict(os.environ, PYTHONPATH=str(source_at(rev)), **(env or {}))
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         env=full_env)
+    if out.returncode != 0:
+        raise RuntimeError(f"script on {rev or 'this checkout'} failed:\n{out.stderr[-2000:]}")
+    return out.stdout.strip().splitlines()[-1]

@@ -2,44 +2,64 @@
 
 Implements the model of M. J. van den Broek, "Fast Self-Stable Planar Bipedal
 Running" (TU Delft / IHMC, 2019), in the dimensionless units of its Table 3.1.
+
+The public names below are imported on first use (PEP 562), so ``import
+tslip`` loads neither numba's kernels nor pandas or scipy.
 """
 
 __version__ = "0.2.0"
 
-from .gait import (  # noqa: E402
-    Branch,
-    Floquet,
-    Gait,
-    continue_gait,
-    find_gait,
-    floquet,
-    robustness,
-    robustness_report,
-)
-from .model import (  # noqa: E402
-    ConstantTorque,
-    GlobalPD,
-    LocalVelocity,
-    Params,
-    Passive,
-    Terrain,
-    TouchdownState,
-    preset,
-    presets,
-)
-from .simulation import (  # noqa: E402
-    Disturbance,
-    IntegratorOptions,
-    Status,
-    StepResult,
-    Trajectory,
-    run_batch,
-    simulate,
-    step,
-    step_batch,
-    step_jacobian,
-    step_map,
-)
+from typing import TYPE_CHECKING  # noqa: E402
+
+if TYPE_CHECKING:  # the same names, for type checkers and tslip._codehash
+    from .gait import (
+        Branch,
+        Floquet,
+        Gait,
+        continue_gait,
+        find_gait,
+        floquet,
+        robustness,
+        robustness_report,
+    )
+    from .model import (
+        ConstantTorque,
+        GlobalPD,
+        LocalVelocity,
+        Params,
+        Passive,
+        Terrain,
+        TouchdownState,
+        preset,
+        presets,
+    )
+    from .simulation import (
+        Disturbance,
+        IntegratorOptions,
+        Status,
+        StepResult,
+        Trajectory,
+        run_batch,
+        simulate,
+        step,
+        step_batch,
+        step_jacobian,
+        step_map,
+    )
+
+#: The subpackage each public name is imported from.
+_SUBPACKAGE = {
+    **dict.fromkeys(("ConstantTorque", "GlobalPD", "LocalVelocity", "Params", "Passive",
+                     "Terrain", "TouchdownState", "preset", "presets"), "model"),
+    **dict.fromkeys(("Disturbance", "IntegratorOptions", "Status", "StepResult", "Trajectory",
+                     "run_batch", "simulate", "step", "step_batch", "step_map",
+                     "step_jacobian"), "simulation"),
+    **dict.fromkeys(("Gait", "find_gait", "Floquet", "floquet", "robustness",
+                     "robustness_report", "Branch", "continue_gait"), "gait"),
+}
+
+#: Subpackages, imported on first attribute access too (``tslip.gait.analyse``).
+_SUBPACKAGES = ("biped", "cli", "experiment", "gait", "model", "plotting", "simulation", "sweeps")
 
 __all__ = [
     "__version__",
@@ -50,3 +70,20 @@ __all__ = [
     "Gait", "find_gait", "Floquet", "floquet", "robustness", "robustness_report", "Branch",
     "continue_gait",
 ]
+
+
+def __getattr__(name: str) -> object:
+    import importlib
+
+    if name in _SUBPACKAGES:
+        return importlib.import_module(f".{name}", __name__)
+    sub = _SUBPACKAGE.get(name)
+    if sub is None:
+        raise AttributeError(f"module 'tslip' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{sub}", __name__), name)
+    globals()[name] = value  # later lookups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

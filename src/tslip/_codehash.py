@@ -80,7 +80,9 @@ def _provider(package: str, name: str) -> str:
     init = _file(package)
     if init is None or init.name != "__init__.py":
         return package
-    for node in ast.parse(init.read_text(encoding="utf-8")).body:
+    # walk, not just the top level: a lazy ``__init__`` (PEP 562) states its
+    # names in an ``if TYPE_CHECKING:`` block
+    for node in ast.walk(ast.parse(init.read_text(encoding="utf-8"))):
         if isinstance(node, ast.ImportFrom) and any((a.asname or a.name) == name
                                                      for a in node.names):
             base = _resolve(node, package)

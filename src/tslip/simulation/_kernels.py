@@ -687,7 +687,55 @@ def stride_simple(P, O, td, tx, th, out):
     return stride(P, O, td, tx, th, rec, 0.0, out)
 
 
-@njit(parallel=True, cache=True, nogil=True)
+# Batches: one row's work is a plain kernel; each driver exists twice, a serial
+# loop in the calling thread (small batches: waking threads costs more than a
+# row, and under load a sleeping core is not free) and a ``prange`` loop over
+# numba's thread pool. ``parallel=True`` kernels compile only when first used.
+# They call :func:`stride` directly, not :func:`stride_simple`: every kernel
+# level re-optimises all the code below it, so a wrapper level costs a sixth
+# of the first stride's compile time.
+_PAR = {"parallel": True, "cache": True, "nogil": True}
+
+
+@njit(**_JIT)
+def run_row(P, O, td0, n_steps, tx, th, hist):
+    """Run up to ``n_steps`` strides from ``td0``; returns ``(status, n_done, t_fall)``.
+
+    ``hist`` (n_steps + 1, 7) receives the touch-down states (rows after a
+    fall are left as they are); ``t_fall`` is NaN unless the run fell.
+    """
+    out = np.empty(NOUT)
+    no_rec = np.empty((0, NREC))
+    td = td0.copy()
+    for j in range(7):
+        hist[0, j] = td[j]
+    t_total = 0.0
+    st = ST_OK
+    done = 0
+    t_fall = math.nan
+    for s in range(n_steps):
+        st = stride(P, O, td, tx, th, no_rec, 0.0, out)
+        if st != ST_OK:
+            if st < 10:
+                t_fall = t_total + out[OUT_TFALL]
+            break
+        t_total += out[OUT_TS] + out[OUT_TF]
+        for j in range(7):
+            td[j] = out[OUT_TD + j]
+            hist[s + 1, j] = td[j]
+        done = s + 1
+    return st, done, t_fall
+
+
+@njit(**_JIT)
+def run_batch_serial(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall):
+    """:func:`run_batch` row after row in the calling thread."""
+    for i in range(Ps.shape[0]):
+        status[i], n_done[i], t_fall[i] = run_row(Ps[i], O, TDs[i], n_steps, TX[i], TH[i],
+                                                  td_hist[i])
+
+
+@njit(**_PAR)
 def run_batch(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall):
     """Run ``n_steps`` strides for each row, in parallel over rows.
 
@@ -697,37 +745,25 @@ def run_batch(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall):
     ``status``, the number of completed strides ``n_done`` and the time of
     the fall ``t_fall`` (NaN if none).
     """
-    n = Ps.shape[0]
-    for i in prange(n):
-        out = np.empty(NOUT)
-        td = TDs[i].copy()
-        for j in range(7):
-            td_hist[i, 0, j] = td[j]
-        t_total = 0.0
-        st = ST_OK
-        done = 0
-        t_fall[i] = math.nan
-        for s in range(n_steps):
-            st = stride_simple(Ps[i], O, td, TX[i], TH[i], out)
-            if st != ST_OK:
-                if st < 10:
-                    t_fall[i] = t_total + out[OUT_TFALL]
-                break
-            t_total += out[OUT_TS] + out[OUT_TF]
-            for j in range(7):
-                td[j] = out[OUT_TD + j]
-                td_hist[i, s + 1, j] = td[j]
-            done = s + 1
-        status[i] = st
-        n_done[i] = done
+    for i in prange(Ps.shape[0]):
+        status[i], n_done[i], t_fall[i] = run_row(Ps[i], O, TDs[i], n_steps, TX[i], TH[i],
+                                                  td_hist[i])
 
 
-@njit(parallel=True, cache=True, nogil=True)
+@njit(**_JIT)
+def stride_batch_serial(Ps, O, TDs, TX, TH, OUTs, status):
+    """:func:`stride_batch` row after row in the calling thread."""
+    no_rec = np.empty((0, NREC))
+    for i in range(Ps.shape[0]):
+        status[i] = stride(Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0, OUTs[i])
+
+
+@njit(**_PAR)
 def stride_batch(Ps, O, TDs, TX, TH, OUTs, status):
     """One stride per row, in parallel over rows (the batched Poincare map)."""
-    n = Ps.shape[0]
-    for i in prange(n):
-        status[i] = stride_simple(Ps[i], O, TDs[i], TX[i], TH[i], OUTs[i])
+    no_rec = np.empty((0, NREC))  # zero rows: never written, shared by the threads
+    for i in prange(Ps.shape[0]):
+        status[i] = stride(Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0, OUTs[i])
 
 
 @njit(**_JIT)

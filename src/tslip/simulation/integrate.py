@@ -20,6 +20,7 @@ from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..model.terrain import Terrain
 from . import _kernels as kn
+from ._threads import choose
 from .options import IntegratorOptions
 from .result import (
     Event,
@@ -46,6 +47,9 @@ __all__ = [
 
 _FLAT = Terrain.flat(0.0)
 _REC_ROWS = 4096
+#: ``rec`` of a stride that records nothing (``kn.stride`` straight, not its
+#: ``stride_simple`` wrapper: one kernel level less to compile on first use)
+_NO_REC = np.empty((0, pk.NREC))
 
 
 @dataclass(frozen=True, slots=True)
@@ -224,7 +228,7 @@ def step_map(
     out = np.empty(pk.NOUT)
     tx, th = _FLAT.arrays()
     th = th + h
-    status = Status(int(kn.stride_simple(P, _options(options), td, tx, th, out)))
+    status = Status(int(kn.stride(P, _options(options), td, tx, th, _NO_REC, 0.0, out)))
     return MapResult(
         out[pk.OUT_TD : pk.OUT_TD + 5].copy(), float(out[pk.OUT_TS]), float(out[pk.OUT_TF]),
         status,
@@ -462,13 +466,16 @@ def step_batch(
     """One stride for each row of ``states`` in a single compiled call.
 
     ``params`` is one :class:`Params` for all rows or one per row; ``states``
-    has shape (n, 5) (section on ground height 0) or (n, 7).
+    has shape (n, 5) (section on ground height 0) or (n, 7). Small batches
+    run serially in the calling thread, large ones on numba's threads
+    (:mod:`tslip.simulation._threads`).
     """
     Ps, S, TX, TH = _batch_inputs(params, states, terrain)
     n = len(S)
     OUT = np.empty((n, pk.NOUT))
     status = np.empty(n, dtype=np.int64)
-    kn.stride_batch(Ps, _options(options), S, TX, TH, OUT, status)
+    kernel = choose(kn.stride_batch_serial, kn.stride_batch, n)
+    kernel(Ps, _options(options), S, TX, TH, OUT, status)
     nxt = OUT[:, pk.OUT_TD : pk.OUT_TD + 7].copy()
     nxt[status != 0] = np.nan
     return BatchStep(nxt, OUT[:, pk.OUT_TS].copy(), OUT[:, pk.OUT_TF].copy(), status, OUT)
@@ -482,7 +489,7 @@ def run_batch(
     terrain: Terrain | Sequence[Terrain] | None = None,
     options: IntegratorOptions | None = None,
 ) -> BatchRun:
-    """Run ``n_steps`` strides for every row in one parallel compiled call.
+    """Run ``n_steps`` strides for every row in one compiled call (parallel when large).
 
     Terrain may differ per row (e.g. one step-down height per row), which is
     how robustness searches evaluate many disturbances at once.
@@ -495,6 +502,7 @@ def run_batch(
     status = np.empty(n, dtype=np.int64)
     n_done = np.empty(n, dtype=np.int64)
     t_fall = np.empty(n)
-    kn.run_batch(Ps, _options(options), S, int(n_steps), TX, TH, hist, status, n_done, t_fall)
+    kernel = choose(kn.run_batch_serial, kn.run_batch, n)
+    kernel(Ps, _options(options), S, int(n_steps), TX, TH, hist, status, n_done, t_fall)
     return BatchRun(n_done, status, t_fall, hist)
 

@@ -1,0 +1,72 @@
+"""``import tslip`` is cheap: the public names load on first use (PEP 562).
+
+Checked by which modules a fresh interpreter has loaded, never by timing
+(``benchmarks/bench_coldstart.py`` times it).
+"""
+
+import json
+import subprocess
+import sys
+
+import tslip
+
+#: Heavy or compiled modules that ``import tslip`` must not load.
+HEAVY = ("pandas", "pyarrow", "scipy.optimize", "matplotlib", "numba",
+         "tslip.simulation._kernels", "tslip.simulation._variational", "tslip.simulation._rk",
+         "tslip.biped._kernels", "tslip.gait")
+
+_LOADED = """
+import json, sys
+{code}
+print(json.dumps(sorted(sys.modules)))
+"""
+
+
+def _loaded_after(code: str) -> set[str]:
+    out = subprocess.run([sys.executable, "-c", _LOADED.format(code=code)], capture_output=True,
+                         text=True, check=True)
+    return set(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+def test_import_tslip_loads_no_heavy_module():
+    loaded = _loaded_after("import tslip")
+    assert not loaded & set(HEAVY), loaded & set(HEAVY)
+
+
+def test_first_stride_loads_only_what_it_uses():
+    loaded = _loaded_after("import tslip\n"
+                           "tslip.step_map(tslip.preset('table2.1'), [1.05, 0, 5, -0.3, 0])")
+    assert "tslip.simulation._kernels" in loaded  # the check above can see kernels
+    unused = {"pandas", "pyarrow", "scipy.optimize", "matplotlib", "tslip.gait",
+              "tslip.simulation._variational", "tslip.biped._kernels"}
+    assert not loaded & unused, loaded & unused
+
+
+def test_public_names_are_listed_and_resolve():
+    assert set(tslip.__all__) <= set(dir(tslip))
+    ns: dict = {}
+    exec("from tslip import *", ns)
+    assert set(tslip.__all__) <= set(ns)
+    assert ns["simulate"] is tslip.simulation.simulate and ns["Gait"] is tslip.gait.Gait
+    assert tslip.preset is tslip.model.preset
+
+
+def test_lazy_table_matches_the_static_imports():
+    """The name -> subpackage table is the ``TYPE_CHECKING`` imports (what type checkers see)."""
+    import ast
+    from pathlib import Path
+
+    tree = ast.parse(Path(tslip.__file__).read_text(encoding="utf-8"))
+    static = {a.name: node.module for node in ast.walk(tree)
+              if isinstance(node, ast.ImportFrom) and node.level == 1 for a in node.names}
+    assert static == tslip._SUBPACKAGE
+    assert set(static) | {"__version__"} == set(tslip.__all__)
+
+
+def test_unknown_attribute_is_an_attribute_error():
+    try:
+        tslip.no_such_name  # noqa: B018
+    except AttributeError as e:
+        assert "no_such_name" in str(e)
+    else:
+        raise AssertionError("tslip.no_such_name did not raise")
