@@ -20,6 +20,15 @@ ratio is what counts on a shared, noisy machine:
   fall events of eqs 2.10-2.11. The scipy triple runs at a coarser search
   tolerance (``--scipy-search-tol``, default 1e-2) and is scaled to the full
   search by the ratio of simulated strides (both counted here).
+
+Then (issue 12 item 3) each analysis again against *today's* code, revision
+``_baseline.BASELINE_REV`` timed by ``_baseline.run_at`` in a subprocess of
+the same run (one numba thread on both sides): gait search from the automatic
+guesses, from the gait itself and from a neighbour (``v0`` + 2 %), a
+five-point continuation with multipliers, both Floquet methods and the
+robustness triple. Printed as new / old time and the speed-up old / new
+(target 4x for gait search, Floquet and the robustness triple). Skip it
+with ``--no-today``.
 """
 
 from __future__ import annotations
@@ -44,6 +53,7 @@ from tslip.model import _pack as pk
 from tslip.simulation import _kernels as kn
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _baseline import BASELINE_REV, run_at  # noqa: E402
 from bench_step import scipy_stride  # noqa: E402
 
 TIGHT = 1e-12  # find_gait / floquet default tolerance
@@ -192,6 +202,52 @@ def package_strides(gait: tslip.Gait, search_tol: float) -> tuple[int, list[floa
 
 
 # ---------------------------------------------------------------------------
+# against today's code (revision BASELINE_REV)
+# ---------------------------------------------------------------------------
+
+TODAY_SETUP = """
+import dataclasses, numba, numpy as np, tslip
+numba.set_num_threads(1)
+from tslip.gait.continuation import continue_gait
+from tslip.gait.fixed_point import GaitProblem
+from tslip.gait.robustness import robustness_report
+from tslip.gait.stability import floquet
+p = tslip.preset("table6.1")
+g = tslip.find_gait(p)
+z = GaitProblem.from_params(p).encode(g)
+pn = dataclasses.replace(p, v0=p.v0 * 1.02)
+"""
+
+#: (name, statement, whether it is one of item 3's 4x targets)
+TODAY_TASKS = [
+    ("gait search (find_gait)", "tslip.find_gait(p)", True),
+    ("gait search from the gait", "tslip.find_gait(p, guess=z)", False),
+    ("gait search from a neighbour", "tslip.find_gait(pn, guess=z)", False),
+    ("continuation, 5 points", "continue_gait(g, 'v0', np.linspace(1.8, 2.0, 5))", False),
+    ("multipliers, exact (floquet)", "floquet(g, method='exact')", True),
+    ("multipliers, fd (floquet)", "floquet(g, method='fd')", True),
+    ("robustness triple", "robustness_report(g)", True),
+]
+
+
+def today_ratios(repeat: int) -> None:
+    """Each task on this tree (in process) and on BASELINE_REV (subprocess), best of ``repeat``."""
+    ns: dict = {}
+    exec(TODAY_SETUP, ns)
+    print(f"against today's code (revision {BASELINE_REV}), one thread, best of {repeat}")
+    print(f"{'task':<34}{'new':>12}{'old':>12}{'speed-up':>10}{'target':>8}")
+    for name, stmt, target in TODAY_TASKS:
+        code = compile(stmt, "<stmt>", "exec")
+        exec(code, ns)  # warm
+        t_new = best(lambda code=code: exec(code, ns), repeat)
+        t_old = run_at(BASELINE_REV, TODAY_SETUP, stmt, repeat=repeat, threads=1)
+        t_new = min(t_new, best(lambda code=code: exec(code, ns), repeat))  # either side of old
+        tgt = ("met" if t_old / t_new >= 4.0 else "MISSED") if target else ""
+        print(f"{name:<34}{t_new * 1e3:>10.2f}ms{t_old * 1e3:>10.2f}ms{t_old / t_new:>9.1f}x"
+              f"{tgt:>8}")
+
+
+# ---------------------------------------------------------------------------
 
 
 def main() -> None:
@@ -199,7 +255,16 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--scipy-search-tol", type=float, default=1e-2,
                     help="search tolerance of the scipy robustness triple (scaled to 1e-4)")
+    ap.add_argument("--no-today", action="store_true",
+                    help=f"skip the comparison with today's code ({BASELINE_REV})")
+    ap.add_argument("--only-today", action="store_true",
+                    help="only the comparison with today's code")
     args = ap.parse_args()
+    if not args.no_today:
+        today_ratios(args.repeat)
+        print()
+    if args.only_today:
+        return
 
     params = tslip.preset("table6.1")
     gait = tslip.find_gait(params)  # compile / load caches

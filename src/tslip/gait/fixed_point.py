@@ -75,6 +75,10 @@ C1_THRESHOLD = 1e-4
 #: Offset added to ``C1`` in eq. 2.22 so it exceeds ``C2`` for ``|lambda| < 5``.
 C1_OFFSET = 25.0
 
+#: Default options of gait search and Floquet multipliers, built (and checked) once:
+#: tolerance 1e-12 with DOP853.
+TIGHT = IntegratorOptions.tight("dop853")
+
 _FALL_PENALTY = 10.0
 _MAX_STARTS = 13  # automatic guesses tried by Newton: the first 5 plus the 8 best of the scan
 _TWO_PI = 2.0 * math.pi
@@ -276,7 +280,7 @@ class GaitProblem:
         Default options: tolerance 1e-12 with DOP853, which needs about a
         third of dopri5's right-hand sides there (``IntegratorOptions.tight``).
         """
-        return cls(params=params, options=options or IntegratorOptions.tight("dop853"))
+        return cls(params=params, options=options or TIGHT)
 
     @property
     def size(self) -> int:
@@ -620,11 +624,12 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
 
     Each iteration solves ``J dz = -r`` (least squares where ``J`` is
     singular, as at ``r = 0`` where the pitch is undetermined) and halves
-    the step until ``|r|`` decreases (Armijo). It stops at ``max|r| <= tol``
-    after one more step with the Jacobian already at hand, kept only if it
-    lowers the residual (one stride; it usually leaves a residual near
-    rounding). It gives up after ``_NEWTON_MAX_ITER`` iterations, at a step
-    shorter than ``_NEWTON_MIN_STEP``, or at a non-finite Jacobian (a fall).
+    the step until ``|r|`` decreases (Armijo). It stops at ``max|r| <= tol``;
+    unless the residual is already below ``tol / 1000`` (the usual case, as
+    convergence is quadratic) it takes one more step with the Jacobian at
+    hand, kept only if it lowers the residual (one stride). It gives up
+    after ``_NEWTON_MAX_ITER`` iterations, at a step shorter than
+    ``_NEWTON_MIN_STEP``, or at a non-finite Jacobian (a fall).
     """
     try:
         r, J = fj(z0)
@@ -639,8 +644,10 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
         if err > tol and it == _NEWTON_MAX_ITER:
             return None, math.inf
         dz = np.linalg.lstsq(J, -r, rcond=None)[0]
-        if err <= tol:  # converged: one polishing step with the Jacobian at hand
-            try:
+        if err <= tol:
+            if err <= 1e-3 * tol:  # done (the map's Jacobian at z is kept for floquet)
+                return z, err
+            try:  # one polishing step with the Jacobian at hand
                 rp = residual(z + dz)
             except ValueError:
                 return z, err
@@ -777,7 +784,7 @@ def _wrap(prob: GaitProblem, z: np.ndarray) -> np.ndarray:
 def _make_gait(prob: GaitProblem, z: np.ndarray, tol: float, message: str,
                method: str = "newton", cma: CMAReport | None = None) -> Gait:
     p, s = prob.decode(z)
-    r, ts, tf = gait_residual(p, s, prob.options)
+    r, ts, tf = prob.evaluate(z)
     err = float(np.max(np.abs(r)))
     return Gait(state=s, params=p, residual=err, stance_time=ts, flight_time=tf,
                 converged=bool(err <= tol), message=message, method=method, cma=cma)

@@ -49,17 +49,36 @@ def stride_map(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E
     return int(kn.stride_simple(P, O, touchdown(q, h), _TX, th, out))
 
 
+#: The last exact Jacobians, keyed by their exact inputs (P, O, q, h): gait search
+#: computes the Jacobian at the gait it returns, and the Floquet multipliers of that
+#: gait (also in continuation and the robustness check) need the same one.
+_JACOBIANS: dict[bytes, tuple[int, np.ndarray, np.ndarray]] = {}
+_JACOBIANS_KEPT = 64
+
+
 def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E741
                     J: np.ndarray, out: np.ndarray) -> int:
     """As :func:`stride_map`, and the exact Jacobian ``dq'/dq`` (5 x 5) into ``J``.
 
     Variational equations through the stance steps plus the saltation terms
-    (:mod:`._variational`); as :func:`tslip.step_jacobian`.
+    (:mod:`._variational`); as :func:`tslip.step_jacobian`. The kernel is
+    deterministic, so a call with the same inputs as one of the last
+    ``_JACOBIANS_KEPT`` returns its stored result (identical bits).
     """
     from . import _variational as va
 
-    th = np.array([h])
-    return int(va.stride_jacobian(P, O, touchdown(q, h), _TX, th, J, out))
+    td = touchdown(q, h)
+    key = P.tobytes() + O.tobytes() + td.tobytes()
+    hit = _JACOBIANS.get(key)
+    if hit is not None:
+        J[:] = hit[1]
+        out[:] = hit[2]
+        return hit[0]
+    st = int(va.stride_jacobian(P, O, td, _TX, np.array([h]), J, out))
+    if len(_JACOBIANS) >= _JACOBIANS_KEPT:
+        del _JACOBIANS[next(iter(_JACOBIANS))]  # the oldest
+    _JACOBIANS[key] = (st, J.copy(), out.copy())
+    return st
 
 
 def alpha_r_column(P: np.ndarray, out: np.ndarray) -> np.ndarray:
