@@ -138,6 +138,14 @@ def test_newton_stops_at_the_gait_without_least_squares(fit, monkeypatch):
                      prob2.residual_jacobian(zz)))
     assert len(errs) <= 6 and errs[-1] <= 1e-12
     assert all(b < a for a, b in zip(errs, errs[1:]))
+    # a loose tolerance stops earlier, at the first iterate that meets it
+    loose = []
+    z3, err3, _ = newton_solve(
+        prob2.residual, [z], tol=1e-3,
+        jacobian=lambda zz: (lambda rj: (loose.append(np.abs(rj[0]).max()), rj)[1])(
+            prob2.residual_jacobian(zz)))
+    k = next(i for i, e in enumerate(errs) if e <= 1e-3)
+    assert loose == errs[: k + 1] and err3 <= 1e-3
 
 
 def test_newton_failure_falls_back_to_least_squares(monkeypatch):
