@@ -58,11 +58,18 @@ def test_packed_map_and_jacobian_equal_the_public_ones_bit_for_bit(fit, method):
             np.testing.assert_array_equal(out[pk.OUT_TD : pk.OUT_TD + 5], rj.q)
 
 
-@pytest.mark.parametrize("name", PRESETS + ["table2.1-global-pd"])
+@pytest.mark.parametrize("name", PRESETS + ["table2.1-global-pd", "undamped-torque"])
 def test_packed_residual_equals_gait_residual_bit_for_bit(name):
-    prob = GaitProblem.from_params(tslip.preset(name))
-    z0 = prob.encode(tslip.find_gait(prob.params)) if name != "table2.1-global-pd" else \
-        next(prob.guesses())
+    if name == "undamped-torque":  # no damping: the search sets tau_c = 0 (Section 2.4)
+        p = dataclasses.replace(tslip.preset("table2.1"),
+                                controller=tslip.ConstantTorque(tau_c=0.3, c_h=0.0))
+        assert p.c_l == 0.0
+    else:
+        p = tslip.preset(name)
+    prob = GaitProblem.from_params(p)
+    z0 = next(prob.guesses())
+    if name not in ("table2.1-global-pd", "undamped-torque"):
+        z0 = prob.encode(tslip.find_gait(prob.params))
     for z in (z0, z0 + 1e-3, z0 - 0.3):
         p, s = prob.decode(z)
         r_old, ts, tf = gait_residual(p, s, prob.options)

@@ -266,11 +266,16 @@ class GaitProblem:
     def __post_init__(self) -> None:
         if not self.names:
             object.__setattr__(self, "names", _unknown_names(self.params))
-        base, _ = self.decode(self.encode_params())
-        object.__setattr__(self, "_P", pk.pack_params(base))
+        # as pack_params(decode(z)[0]) but for alpha_r and the reference, which
+        # _stride writes in: tau = P[P_C0] + ..., P_C0 = Kd * alphad_ref (eq. 2.14)
+        # or tau_c (eq. 2.15; 0 without damping, as in decode)
+        P = pk.pack_params(self.params)
+        ctrl = self.params.controller
+        if isinstance(ctrl, ConstantTorque) and "tau_c" not in self.names:
+            P[pk.P_C0] = 0.0
+        object.__setattr__(self, "_P", P)
         object.__setattr__(self, "_O", self.options.packed())
-        # tau = P[P_C0] + ...: P_C0 = Kd * alphad_ref (eq. 2.14) or tau_c (eq. 2.15)
-        gain = getattr(base.controller, "Kd", 1.0) if "alphad_ref" in self.names else 1.0
+        gain = getattr(ctrl, "Kd", 1.0) if "alphad_ref" in self.names else 1.0
         object.__setattr__(self, "_ref_gain", float(gain))
 
     @classmethod
@@ -294,32 +299,18 @@ class GaitProblem:
             raise ValueError(f"guess must have {self.size} entries {list(self.names)}, "
                              f"got {len(z)}")
         values = dict(zip(self.names, map(float, z)))
-        p = dataclasses.replace(self.params, alpha_r=values["alpha_r"])
-        ctrl = p.controller
+        ctrl = self.params.controller
         if "alphad_ref" in values:
             ctrl = dataclasses.replace(ctrl, alphad_ref=values["alphad_ref"])
         if "tau_c" in values:
             ctrl = dataclasses.replace(ctrl, tau_c=values["tau_c"])
         elif isinstance(ctrl, ConstantTorque) and ctrl.tau_c != 0.0:
             ctrl = dataclasses.replace(ctrl, tau_c=0.0)  # no damping: no torque
-        if ctrl is not p.controller:
-            p = dataclasses.replace(p, controller=ctrl)
+        p = dataclasses.replace(self.params, alpha_r=values["alpha_r"], controller=ctrl)
         s = TouchdownState.from_velocity(
             v=p.v0, delta=values["delta"], beta=p.beta0, phi=values["phi"], phid=values["phid"]
         )
         return p, s
-
-    def encode_params(self) -> np.ndarray:
-        """``z`` of ``params`` itself with a level, non-rotating start (``delta = -0.1``).
-
-        Only its ``alpha_r`` and controller reference entries come from the
-        parameters; it is the point at which the problem packs ``params``.
-        """
-        p = self.params
-        vals = {"delta": -0.1, "phi": 0.0, "phid": 0.0, "alpha_r": p.alpha_r,
-                "alphad_ref": getattr(p.controller, "alphad_ref", 0.0),
-                "tau_c": getattr(p.controller, "tau_c", 0.0)}
-        return np.array([vals[n] for n in self.names])
 
     def encode(self, gait: Gait) -> np.ndarray:
         """Free variables of a gait (a warm start for nearby parameters)."""
