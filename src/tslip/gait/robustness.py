@@ -57,8 +57,13 @@ algorithm. Survival need not be monotone in the magnitude, so the limit is
 
 The reported limit is ``lo``: a magnitude that survives, within ``tol`` of a
 magnitude ``hi`` that fails. Larger surviving islands beyond the first
-failure are not searched for. Every batch is one :func:`tslip.run_batch`
-call (parallel over rows), which keeps Python round trips few.
+failure are not searched for.
+
+Since only the first failure of a batch matters, :func:`robustness` runs a
+batch's magnitudes in ascending order, one after another on arrays packed
+once (:func:`tslip.simulation._packed.run`), and stops at the first that
+fails: the limit is the same as with every point run, with fewer runs (the
+flight placements still run each batch as one :func:`tslip.run_batch`).
 
 Runs that end in an integration error (:class:`Status` >= 10) are not falls;
 they count as failures of the disturbance, and the result records the reason.
@@ -434,9 +439,9 @@ class RobustnessLimit:
         How it ended: a fall (``status.fell``) or an integration error
         (``status.is_error``), which is not a fall but counts as a failure.
     n_batches : int
-        Batched evaluations (:func:`tslip.run_batch` calls).
+        Batches of the search (:func:`limit_search` calls of its predicate).
     n_runs : int
-        Disturbed runs simulated.
+        Disturbed runs simulated (a batch stops at its first failure).
     n_errors : int
         Runs of the search that ended in an integration error.
     """

@@ -20,6 +20,7 @@ same as the public functions', so the results are identical bit for bit.
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 
@@ -54,6 +55,7 @@ def stride_map(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E
 #: gait (also in continuation and the robustness check) need the same one.
 _JACOBIANS: dict[bytes, tuple[int, np.ndarray, np.ndarray]] = {}
 _JACOBIANS_KEPT = 64
+_JACOBIANS_LOCK = threading.Lock()
 
 
 def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E741
@@ -69,15 +71,17 @@ def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # no
 
     td = touchdown(q, h)
     key = P.tobytes() + O.tobytes() + td.tobytes()
-    hit = _JACOBIANS.get(key)
+    with _JACOBIANS_LOCK:
+        hit = _JACOBIANS.get(key)
     if hit is not None:
         J[:] = hit[1]
         out[:] = hit[2]
         return hit[0]
     st = int(va.stride_jacobian(P, O, td, _TX, np.array([h]), J, out))
-    if len(_JACOBIANS) >= _JACOBIANS_KEPT:
-        del _JACOBIANS[next(iter(_JACOBIANS))]  # the oldest
-    _JACOBIANS[key] = (st, J.copy(), out.copy())
+    with _JACOBIANS_LOCK:
+        if len(_JACOBIANS) >= _JACOBIANS_KEPT:
+            del _JACOBIANS[next(iter(_JACOBIANS))]  # the oldest
+        _JACOBIANS[key] = (st, J.copy(), out.copy())
     return st
 
 
