@@ -235,18 +235,24 @@ TODAY_TASKS = [
 ]
 
 
-def today_ratios(repeat: int) -> None:
-    """Each task on this tree (in process) and on BASELINE_REV (subprocess), best of ``repeat``."""
+def today_ratios(repeat: int, rounds: int = 3) -> None:
+    """Each task on this tree (in process) and on BASELINE_REV (subprocess).
+
+    Best of ``rounds`` alternating rounds of ``repeat`` calls on each side.
+    """
     ns: dict = {}
     exec(TODAY_SETUP, ns)
-    print(f"against today's code (revision {BASELINE_REV}), one thread, best of {repeat}")
+    print(f"against today's code (revision {BASELINE_REV}), one thread, best of {rounds} "
+          f"x {repeat}")
     print(f"{'task':<38}{'new':>11}{'old':>11}{'speed-up':>10}{'target':>8}")
     for name, stmt, stmt_old, target in TODAY_TASKS:
         code = compile(stmt, "<stmt>", "exec")
         exec(code, ns)  # warm
-        t_new = best(lambda code=code: exec(code, ns), repeat)
-        t_old = run_at(BASELINE_REV, TODAY_SETUP, stmt_old or stmt, repeat=repeat, threads=1)
-        t_new = min(t_new, best(lambda code=code: exec(code, ns), repeat))  # either side of old
+        t_new = t_old = math.inf
+        for _ in range(rounds):  # interleaved: a busy spell slows both sides alike
+            t_new = min(t_new, best(lambda code=code: exec(code, ns), repeat))
+            t_old = min(t_old, run_at(BASELINE_REV, TODAY_SETUP, stmt_old or stmt,
+                                      repeat=repeat, threads=1))
         tgt = ("met" if t_old / t_new >= 4.0 else "MISSED") if target else ""
         print(f"{name:<38}{t_new * 1e3:>9.2f}ms{t_old * 1e3:>9.2f}ms{t_old / t_new:>9.1f}x"
               f"{tgt:>8}")
@@ -264,9 +270,11 @@ def main() -> None:
                     help=f"skip the comparison with today's code ({BASELINE_REV})")
     ap.add_argument("--only-today", action="store_true",
                     help="only the comparison with today's code")
+    ap.add_argument("--rounds", type=int, default=3,
+                    help="alternating new/old rounds of the comparison with today's code")
     args = ap.parse_args()
     if not args.no_today:
-        today_ratios(args.repeat)
+        today_ratios(args.repeat, args.rounds)
         print()
     if args.only_today:
         return
