@@ -217,3 +217,16 @@ def test_robustness_limit_matches_a_plain_bisection_over_simulate(fit, report, k
         lo, hi = (mid, hi) if _survives_simulate(fit, kind, -mid) else (lo, mid)
     lim = report.get(kind).limit
     assert abs(lim + lo) <= 1e-4 and _survives_simulate(fit, kind, lim)
+
+
+def test_continuation_multipliers_equal_fresh_floquet_bit_for_bit():
+    """Multipliers taken right after each solve (kept Jacobians) == a cold floquet."""
+    from tslip.gait.continuation import continue_gait
+
+    b = continue_gait(tslip.preset("table2.1"), "omega_r_bar", np.linspace(0.4, 1.0, 4))
+    assert b.converged.all()
+    _packed._JACOBIANS.clear()
+    for i, g in enumerate(b.gaits):
+        f = floquet(g)
+        np.testing.assert_array_equal(b.multipliers[i], f.multipliers)
+        assert b.stability[i] == f.stability
