@@ -616,7 +616,7 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
     Each iteration solves ``J dz = -r`` (least squares where ``J`` is
     singular, as at ``r = 0`` where the pitch is undetermined) and halves
     the step until ``|r|`` decreases (Armijo). It stops at ``max|r| <= tol``;
-    unless the residual is already below ``tol / 1000`` (the usual case, as
+    unless the residual is already below ``tol / 100`` (the usual case, as
     convergence is quadratic) it takes one more step with the Jacobian at
     hand, kept only if it lowers the residual (one stride). It gives up
     after ``_NEWTON_MAX_ITER`` iterations, at a step shorter than
@@ -636,7 +636,7 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
             return None, math.inf
         dz = np.linalg.lstsq(J, -r, rcond=None)[0]
         if err <= tol:
-            if err <= 1e-3 * tol:  # done (the map's Jacobian at z is kept for floquet)
+            if err <= 1e-2 * tol:  # done (the map's Jacobian at z is kept for floquet)
                 return z, err
             try:  # one polishing step with the Jacobian at hand
                 rp = residual(z + dz)
