@@ -230,3 +230,13 @@ def test_continuation_multipliers_equal_fresh_floquet_bit_for_bit():
         f = floquet(g)
         np.testing.assert_array_equal(b.multipliers[i], f.multipliers)
         assert b.stability[i] == f.stability
+
+
+def test_problem_refuses_unknowns_in_another_order():
+    """The packed residual reads z by position: names must keep the documented order."""
+    with pytest.raises(ValueError, match="names must be"):
+        GaitProblem(params=tslip.preset("table2.1"), options=fp.TIGHT,
+                    names=("phi", "delta", "phid", "alpha_r"))
+    forced = GaitProblem(params=tslip.preset("table6.1"), options=fp.TIGHT,
+                         names=("delta", "phi", "phid", "alpha_r"))  # as reproduce's forced search
+    assert forced.size == 4

@@ -266,6 +266,11 @@ class GaitProblem:
     def __post_init__(self) -> None:
         if not self.names:
             object.__setattr__(self, "names", _unknown_names(self.params))
+        base = ("delta", "phi", "phid", "alpha_r")
+        if self.names[:4] != base or not (
+                len(self.names) == 4 or self.names[4:] in (("alphad_ref",), ("tau_c",))):
+            raise ValueError(f"names must be {base} and at most one of 'alphad_ref', 'tau_c', "
+                             f"got {self.names}")
         # as pack_params(decode(z)[0]) but for alpha_r and the reference, which
         # _stride writes in: tau = P[P_C0] + ..., P_C0 = Kd * alphad_ref (eq. 2.14)
         # or tau_c (eq. 2.15; 0 without damping, as in decode)
