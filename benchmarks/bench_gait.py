@@ -20,6 +20,15 @@ ratio is what counts on a shared, noisy machine:
   fall events of eqs 2.10-2.11. The scipy triple runs at a coarser search
   tolerance (``--scipy-search-tol``, default 1e-2) and is scaled to the full
   search by the ratio of simulated strides (both counted here).
+
+Then (issue 12 item 3) each analysis again against *today's* code, revision
+``_baseline.BASELINE_REV`` timed by ``_baseline.run_at`` in a subprocess of
+the same run (one numba thread on both sides): gait search from the automatic
+guesses, from the gait itself and from a neighbour (``v0`` + 2 %), a
+five-point continuation with multipliers, both Floquet methods and the
+robustness triple. Printed as new / old time and the speed-up old / new
+(target 4x for gait search, Floquet and the robustness triple). Skip it
+with ``--no-today``.
 """
 
 from __future__ import annotations
@@ -42,8 +51,10 @@ from tslip.gait.robustness import KINDS, limit_search, robustness_report, run_di
 from tslip.gait.stability import floquet
 from tslip.model import _pack as pk
 from tslip.simulation import _kernels as kn
+from tslip.simulation import _packed
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _baseline import BASELINE_REV, run_at  # noqa: E402
 from bench_step import scipy_stride  # noqa: E402
 
 TIGHT = 1e-12  # find_gait / floquet default tolerance
@@ -192,6 +203,63 @@ def package_strides(gait: tslip.Gait, search_tol: float) -> tuple[int, list[floa
 
 
 # ---------------------------------------------------------------------------
+# against today's code (revision BASELINE_REV)
+# ---------------------------------------------------------------------------
+
+TODAY_SETUP = """
+import dataclasses, numba, numpy as np, tslip
+numba.set_num_threads(1)
+from tslip.gait.continuation import continue_gait
+from tslip.gait.fixed_point import GaitProblem
+from tslip.gait.robustness import robustness_report
+from tslip.gait.stability import floquet
+p = tslip.preset("table6.1")
+g = tslip.find_gait(p)
+z = GaitProblem.from_params(p).encode(g)
+pn = dataclasses.replace(p, v0=p.v0 * 1.02)
+"""
+
+#: (name, statement on this tree, statement on today's code, one of item 3's 4x targets?)
+#: Floquet "exact" on this tree reuses the Jacobian that find_gait computed at the
+#: gait (simulation._packed keeps it); the "cold" row clears that store first.
+_COLD = "from tslip.simulation import _packed; _packed._JACOBIANS.clear(); "
+TODAY_TASKS = [
+    ("gait search (find_gait)", "tslip.find_gait(p)", None, True),
+    ("gait search from the gait", "tslip.find_gait(p, guess=z)", None, False),
+    ("gait search from a neighbour", "tslip.find_gait(pn, guess=z)", None, False),
+    ("continuation, 5 points", "continue_gait(g, 'v0', np.linspace(1.8, 2.0, 5))", None,
+     False),
+    ("multipliers, exact, cold (floquet)", _COLD + "floquet(g)", "floquet(g)", True),
+    ("multipliers, exact, after find_gait", "floquet(g)", None, False),
+    ("multipliers, fd (floquet)", "floquet(g, method='fd')", None, True),
+    ("robustness triple", "robustness_report(g)", None, True),
+]
+
+
+def today_ratios(repeat: int, rounds: int = 3) -> None:
+    """Each task on this tree (in process) and on BASELINE_REV (subprocess).
+
+    Best of ``rounds`` alternating rounds of ``repeat`` calls on each side.
+    """
+    ns: dict = {}
+    exec(TODAY_SETUP, ns)
+    print(f"against today's code (revision {BASELINE_REV}), one thread, best of {rounds} "
+          f"x {repeat}")
+    print(f"{'task':<38}{'new':>11}{'old':>11}{'speed-up':>10}{'target':>8}")
+    for name, stmt, stmt_old, target in TODAY_TASKS:
+        code = compile(stmt, "<stmt>", "exec")
+        exec(code, ns)  # warm
+        t_new = t_old = math.inf
+        for _ in range(rounds):  # interleaved: a busy spell slows both sides alike
+            t_new = min(t_new, best(lambda code=code: exec(code, ns), repeat))
+            t_old = min(t_old, run_at(BASELINE_REV, TODAY_SETUP, stmt_old or stmt,
+                                      repeat=repeat, threads=1))
+        tgt = ("met" if t_old / t_new >= 4.0 else "MISSED") if target else ""
+        print(f"{name:<38}{t_new * 1e3:>9.2f}ms{t_old * 1e3:>9.2f}ms{t_old / t_new:>9.1f}x"
+              f"{tgt:>8}")
+
+
+# ---------------------------------------------------------------------------
 
 
 def main() -> None:
@@ -199,7 +267,18 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--scipy-search-tol", type=float, default=1e-2,
                     help="search tolerance of the scipy robustness triple (scaled to 1e-4)")
+    ap.add_argument("--no-today", action="store_true",
+                    help=f"skip the comparison with today's code ({BASELINE_REV})")
+    ap.add_argument("--only-today", action="store_true",
+                    help="only the comparison with today's code")
+    ap.add_argument("--rounds", type=int, default=3,
+                    help="alternating new/old rounds of the comparison with today's code")
     args = ap.parse_args()
+    if not args.no_today:
+        today_ratios(args.repeat, args.rounds)
+        print()
+    if args.only_today:
+        return
 
     params = tslip.preset("table6.1")
     gait = tslip.find_gait(params)  # compile / load caches
@@ -219,7 +298,11 @@ def main() -> None:
 
     # multipliers
     t_fd = best(lambda: floquet(gait, method="fd"), args.repeat)
-    t_ex = best(lambda: floquet(gait, method="exact"), args.repeat)
+    def cold_exact():  # without the Jacobian find_gait kept for this gait
+        _packed._JACOBIANS.clear()
+        floquet(gait, method="exact")
+
+    t_ex = best(cold_exact, args.repeat)
     q = gait.state.section()
     lam_sp = scipy_multipliers(gait.params, q)
     t_fd_sp = best(lambda: scipy_multipliers(gait.params, q), 3)

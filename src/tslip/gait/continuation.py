@@ -7,7 +7,9 @@ damping ``c_h``, mass offset ``r``, stiffness ``k``, touch-down angle
 solved by :func:`~tslip.gait.fixed_point.find_gait`, warm-started from its
 neighbours (a secant predictor through the last two points), with the
 automatic guesses as a fallback; the multipliers are
-:func:`~tslip.gait.stability.floquet` (exact Jacobian). Natural continuation
+:func:`~tslip.gait.stability.floquet` (exact Jacobian), computed right after
+each point is solved, usually from the Jacobian the Newton search left at the
+gait (:mod:`tslip.simulation._packed` keeps it). Natural continuation
 cannot turn around a fold: the branch ends where the gait ceases to exist,
 which is what the thesis reports as "no periodic limit cycles are found".
 
@@ -340,6 +342,22 @@ def continue_gait(
     msgs = ["not attempted: past the end of the branch"] * n
     seconds = np.full(n, math.nan)
 
+    lam = np.full((n, 5), np.nan, dtype=complex)
+    triv = np.zeros((n, 5), dtype=bool)
+    mnt = np.full(n, math.nan)
+    stab = ["none"] * n
+
+    def multipliers_at(i: int, g: Gait) -> None:
+        # right after the solve: the exact Jacobian Newton computed at the gait is
+        # still kept (tslip.simulation._packed), so this costs no stride
+        try:
+            f = floquet(g, method="exact", options=options)
+        except ValueError:
+            stab[i] = "unknown"
+        else:
+            lam[i], triv[i], mnt[i], stab[i] = f.multipliers, f.trivial, f.max_nontrivial, \
+                f.stability
+
     anchor = gait_or_params if isinstance(gait_or_params, Gait) else None
     if anchor is None or not anchor.converged:
         anchor = find_gait(params, tol=tol, options=options)
@@ -356,14 +374,16 @@ def continue_gait(
             t0 = time.perf_counter()
             g, msg = _solve_point(params, param, float(vals[i]), history, tol, options,
                                   predictor)
-            seconds[i] = time.perf_counter() - t0
             best[i], msgs[i] = g, msg
             if g.converged:
                 gaits[i] = g
+                if multipliers:
+                    multipliers_at(i, g)
                 history = (history + [(float(vals[i]), g)])[-2:]
                 failures = 0
             else:
                 failures += 1
+            seconds[i] = time.perf_counter() - t0
             done += 1
             if progress is not None:
                 progress(done, n, float(vals[i]), gaits[i])
@@ -371,23 +391,6 @@ def continue_gait(
     walk(range(i0, n), list(start))
     first = [(float(vals[i0]), gaits[i0])] if gaits[i0] is not None else []
     walk(range(i0 - 1, -1, -1), (start + first)[-2:] if first else list(start))
-
-    lam = np.full((n, 5), np.nan, dtype=complex)
-    triv = np.zeros((n, 5), dtype=bool)
-    mnt = np.full(n, math.nan)
-    stab = ["none"] * n
-    for i, g in enumerate(gaits):
-        if g is None or not multipliers:
-            continue
-        t0 = time.perf_counter()
-        try:
-            f = floquet(g, method="exact", options=options)
-        except ValueError:
-            stab[i] = "unknown"
-        else:
-            lam[i], triv[i], mnt[i], stab[i] = f.multipliers, f.trivial, f.max_nontrivial, \
-                f.stability
-        seconds[i] += time.perf_counter() - t0
 
     def arr(attr: str) -> np.ndarray:
         return np.array([getattr(g, attr) if g is not None else math.nan for g in gaits])

@@ -12,9 +12,13 @@ variables ``z``: the residual, the thesis's cost ``C1`` (eq. 2.20) and the
 two-stage cost ``C`` (eqs 2.21-2.22) within bounds (eqs 2.23-2.24). Two
 searches work on it, both outside the simulation:
 
-* ``method="newton"`` (default): Levenberg-Marquardt least squares on the
-  residual with finite differences, from automatic starting guesses. It
-  reaches the exact fixed point (residual about 1e-12) in about 10 ms.
+* ``method="newton"`` (default): damped Newton on the residual with its
+  exact Jacobian (variational equations, :meth:`GaitProblem.residual_jacobian`),
+  from automatic starting guesses, stopping at the requested residual; where
+  Newton fails from a start, Levenberg-Marquardt least squares with finite
+  differences takes over from the same start. The problem is packed once
+  per call (:mod:`tslip.simulation._packed`), so a residual costs about one
+  compiled stride. It reaches the exact fixed point in a few milliseconds.
 * ``method="cma"``: the thesis's own method, CMA-ES (Hansen's ``cma``
   package) on eq. 2.22. It returns a *near*-fixed point, ``C1 < 1e-4``,
   with the smallest non-trivial Floquet multiplier it found there; by
@@ -43,9 +47,11 @@ from typing import Literal
 import numpy as np
 from scipy.optimize import least_squares
 
+from ..model import _pack as pk
 from ..model.controllers import ConstantTorque, GlobalPD, LocalVelocity
 from ..model.parameters import Params
 from ..model.state import TouchdownState
+from ..simulation import _packed
 from ..simulation.integrate import step_map
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status
@@ -68,6 +74,10 @@ Method = Literal["newton", "cma"]
 C1_THRESHOLD = 1e-4
 #: Offset added to ``C1`` in eq. 2.22 so it exceeds ``C2`` for ``|lambda| < 5``.
 C1_OFFSET = 25.0
+
+#: Default options of gait search and Floquet multipliers, built (and checked) once:
+#: tolerance 1e-12 with DOP853.
+TIGHT = IntegratorOptions.tight("dop853")
 
 _FALL_PENALTY = 10.0
 _MAX_STARTS = 13  # automatic guesses tried by Newton: the first 5 plus the 8 best of the scan
@@ -191,17 +201,27 @@ def gait_residual(params: Params, state: TouchdownState,
     """
     q = state.section()
     res = step_map(params, q, h=0.0, options=options)
-    if res.status != Status.OK:
-        return np.full(5, _FALL_PENALTY), res.stance_time, res.flight_time
-    b, ph, xd, yd, phd = res.q
+    out = np.full(pk.NOUT, math.nan)
+    out[pk.OUT_TD : pk.OUT_TD + 5] = res.q
+    out[pk.OUT_TS], out[pk.OUT_TF] = res.stance_time, res.flight_time
+    return _section_residual(q, int(res.status), out, params)
+
+
+def _section_residual(q: np.ndarray, status: int, out: np.ndarray,
+                      params: Params) -> tuple[np.ndarray, float, float]:
+    """:func:`gait_residual` of the stride from section ``q`` that filled ``out``."""
+    ts, tf = float(out[pk.OUT_TS]), float(out[pk.OUT_TF])
+    if status != Status.OK:
+        return np.full(5, _FALL_PENALTY), ts, tf
+    b, ph, xd, yd, phd = out[pk.OUT_TD : pk.OUT_TD + 5].tolist()
     r = np.array([
         b - params.beta0,
-        ph - state.phi,
-        phd - state.phid,
-        math.atan2(yd, xd) - state.delta,
+        ph - q[1],
+        phd - q[4],
+        math.atan2(yd, xd) - math.atan2(q[3], q[2]),
         math.hypot(xd, yd) - params.v0,
     ])
-    return r, res.stance_time, res.flight_time
+    return r, ts, tf
 
 
 @dataclass(frozen=True, slots=True)
@@ -237,15 +257,40 @@ class GaitProblem:
     params: Params
     options: IntegratorOptions
     names: tuple[str, ...] = ()
+    # packed once (validation happened when params and options were built):
+    # P with z's alpha_r and controller reference written in per evaluation
+    _P: np.ndarray = field(init=False, repr=False, compare=False)
+    _O: np.ndarray = field(init=False, repr=False, compare=False)
+    _ref_gain: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not self.names:
             object.__setattr__(self, "names", _unknown_names(self.params))
+        base = ("delta", "phi", "phid", "alpha_r")
+        if self.names[:4] != base or not (
+                len(self.names) == 4 or self.names[4:] in (("alphad_ref",), ("tau_c",))):
+            raise ValueError(f"names must be {base} and at most one of 'alphad_ref', 'tau_c', "
+                             f"got {self.names}")
+        # as pack_params(decode(z)[0]) but for alpha_r and the reference, which
+        # _stride writes in: tau = P[P_C0] + ..., P_C0 = Kd * alphad_ref (eq. 2.14)
+        # or tau_c (eq. 2.15; 0 without damping, as in decode)
+        P = pk.pack_params(self.params)
+        ctrl = self.params.controller
+        if isinstance(ctrl, ConstantTorque) and "tau_c" not in self.names:
+            P[pk.P_C0] = 0.0
+        object.__setattr__(self, "_P", P)
+        object.__setattr__(self, "_O", self.options.packed())
+        gain = getattr(ctrl, "Kd", 1.0) if "alphad_ref" in self.names else 1.0
+        object.__setattr__(self, "_ref_gain", float(gain))
 
     @classmethod
     def from_params(cls, params: Params, options: IntegratorOptions | None = None) -> GaitProblem:
-        """Problem for ``params`` (default options: tolerance 1e-12)."""
-        return cls(params=params, options=options or IntegratorOptions.tight())
+        """Problem for ``params``.
+
+        Default options: tolerance 1e-12 with DOP853, which needs about a
+        third of dopri5's right-hand sides there (``IntegratorOptions.tight``).
+        """
+        return cls(params=params, options=options or TIGHT)
 
     @property
     def size(self) -> int:
@@ -259,16 +304,14 @@ class GaitProblem:
             raise ValueError(f"guess must have {self.size} entries {list(self.names)}, "
                              f"got {len(z)}")
         values = dict(zip(self.names, map(float, z)))
-        p = dataclasses.replace(self.params, alpha_r=values["alpha_r"])
-        ctrl = p.controller
+        ctrl = self.params.controller
         if "alphad_ref" in values:
             ctrl = dataclasses.replace(ctrl, alphad_ref=values["alphad_ref"])
         if "tau_c" in values:
             ctrl = dataclasses.replace(ctrl, tau_c=values["tau_c"])
         elif isinstance(ctrl, ConstantTorque) and ctrl.tau_c != 0.0:
             ctrl = dataclasses.replace(ctrl, tau_c=0.0)  # no damping: no torque
-        if ctrl is not p.controller:
-            p = dataclasses.replace(p, controller=ctrl)
+        p = dataclasses.replace(self.params, alpha_r=values["alpha_r"], controller=ctrl)
         s = TouchdownState.from_velocity(
             v=p.v0, delta=values["delta"], beta=p.beta0, phi=values["phi"], phid=values["phid"]
         )
@@ -286,10 +329,84 @@ class GaitProblem:
         return z
 
     # -- costs ----------------------------------------------------------------
+    def _stride(self, z: Sequence[float] | np.ndarray, jacobian: bool = False,
+                ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray | None]:
+        """``P``, section ``q`` and one stride at ``z`` on the packed arrays.
+
+        Writes ``alpha_r`` and the controller reference of ``z`` into ``P``
+        exactly as :meth:`decode` followed by ``pack_params`` would.
+        """
+        if len(z) != self.size:
+            raise ValueError(f"guess must have {self.size} entries {list(self.names)}, "
+                             f"got {len(z)}")
+        zf = [float(v) for v in z]
+        if not all(map(math.isfinite, zf)):
+            raise ValueError(f"z must be finite, got {zf}")
+        P = self._P.copy()
+        P[pk.P_ALPHA] = zf[3]
+        if self.size == 5:
+            P[pk.P_C0] = self._ref_gain * zf[4]
+        p = self.params
+        delta = zf[0]
+        q = np.array([p.beta0, zf[1], p.v0 * math.cos(delta), p.v0 * math.sin(delta), zf[2]])
+        out = np.empty(pk.NOUT)
+        if jacobian:
+            J = np.empty((5, 5))
+            return P, q, _packed.stride_jacobian(P, self._O, q, 0.0, J, out), out, J
+        return P, q, _packed.stride_map(P, self._O, q, 0.0, out), out, None
+
     def evaluate(self, z: Sequence[float] | np.ndarray) -> tuple[np.ndarray, float, float]:
         """Residual, stance and flight time at ``z`` (see :func:`gait_residual`)."""
-        p, s = self.decode(z)
-        return gait_residual(p, s, self.options)
+        _, q, st, out, _ = self._stride(z)
+        return _section_residual(q, st, out, self.params)
+
+    def residual_jacobian(self, z: Sequence[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Residual (5,) and its Jacobian ``dr/dz`` (5 x size) at ``z``.
+
+        The chain ``z -> q -> q' -> r``: ``dq'/dq`` exact from the variational
+        equations (:func:`tslip.step_jacobian`), ``dq'/d alpha_r`` exact from
+        the flight's touch-down time, ``dq'/d(alphad_ref | tau_c)`` by a
+        central difference (the reference acts in stance, outside the
+        variational equations). After a fall the Jacobian is NaN.
+        """
+        P, q, st, out, Jq = self._stride(z, jacobian=True)
+        r, _, _ = _section_residual(q, st, out, self.params)
+        n = self.size
+        if st != Status.OK or Jq is None or not np.all(np.isfinite(Jq)):
+            return r, np.full((5, n), math.nan)
+        delta = float(z[0])
+        v0 = self.params.v0
+        dq = np.zeros((5, n))  # dq/dz, q = (beta0, phi, v0 cos delta, v0 sin delta, phid)
+        dq[2, 0], dq[3, 0] = -v0 * math.sin(delta), v0 * math.cos(delta)
+        dq[1, 1] = 1.0
+        dq[4, 2] = 1.0
+        dqn = Jq @ dq  # dq'/dz through the state
+        dqn[:, 3] += _packed.alpha_r_column(P, out)
+        if n == 5:
+            ref = float(z[4])
+            h = 1e-5 * max(1.0, abs(ref))
+            cols = []
+            for sgn in (1.0, -1.0):
+                zz = np.array(z, dtype=float)
+                zz[4] = ref + sgn * h
+                _, _, s2, o2, _ = self._stride(zz)
+                if s2 != Status.OK:
+                    return r, np.full((5, n), math.nan)
+                cols.append(o2[pk.OUT_TD : pk.OUT_TD + 5].copy())
+            dqn[:, 4] += (cols[0] - cols[1]) / (2.0 * h)
+        # r = (beta', phi' - phi, phid' - phid, atan2(yd', xd') - delta, |v'| - v0)
+        _, _, xd, yd, _ = out[pk.OUT_TD : pk.OUT_TD + 5]
+        v2 = xd * xd + yd * yd
+        v = math.sqrt(v2)
+        D = np.zeros((5, 5))  # dr/dq'
+        D[0, 0] = D[1, 1] = D[2, 4] = 1.0
+        D[3, 2], D[3, 3] = -yd / v2, xd / v2
+        D[4, 2], D[4, 3] = xd / v, yd / v
+        Jr = D @ dqn
+        Jr[1, 1] -= 1.0
+        Jr[2, 2] -= 1.0
+        Jr[3, 0] -= 1.0
+        return r, Jr
 
     def residual(self, z: Sequence[float] | np.ndarray) -> np.ndarray:
         """Periodicity residual (5,) at ``z``; the Newton search's function."""
@@ -435,8 +552,9 @@ def newton_solve(
     *,
     tol: float = 1e-10,
     max_starts: int | None = None,
+    jacobian: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
 ) -> tuple[np.ndarray | None, float, int]:
-    """Levenberg-Marquardt least squares on ``residual`` from each start.
+    """Solve ``residual(z) = 0`` from each start: Newton, then least squares.
 
     Parameters
     ----------
@@ -448,6 +566,13 @@ def newton_solve(
         Max-norm residual that counts as solved.
     max_starts : int, optional
         Try at most this many starts.
+    jacobian : callable, optional
+        ``z -> (r(z), dr/dz)``. With it and as many equations as unknowns,
+        each start first runs a damped Newton iteration (:func:`_newton`)
+        that stops as soon as the residual reaches ``tol``; where it fails,
+        the start falls back to Levenberg-Marquardt least squares with
+        finite differences (``scipy.optimize.least_squares``, tolerances
+        1e-15), the only method used without ``jacobian``.
 
     Returns
     -------
@@ -465,6 +590,10 @@ def newton_solve(
             break
         n += 1
         z0 = np.asarray(z0, dtype=float)
+        if jacobian is not None:
+            z, err = _newton(residual, jacobian, z0, tol)
+            if z is not None and err <= tol:
+                return z, err, n
         try:
             sol = least_squares(residual, z0, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
                                 max_nfev=400 * len(z0), diff_step=1e-7)
@@ -478,6 +607,63 @@ def newton_solve(
     if best is None:
         return None, math.inf, n
     return best[1], best[0], n
+
+
+_NEWTON_MAX_ITER = 25
+_NEWTON_MIN_STEP = 1.0 / 64
+
+
+def _newton(residual: Callable[[np.ndarray], np.ndarray],
+            fj: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], z0: np.ndarray,
+            tol: float) -> tuple[np.ndarray | None, float]:
+    """Damped Newton on a square system; ``(z, max-norm residual)`` or ``(None, inf)``.
+
+    Each iteration solves ``J dz = -r`` (least squares where ``J`` is
+    singular, as at ``r = 0`` where the pitch is undetermined) and halves
+    the step until ``|r|`` decreases (Armijo). It stops at ``max|r| <= tol``;
+    unless the residual is already below ``tol / 100`` (the usual case, as
+    convergence is quadratic) it takes one more step with the Jacobian at
+    hand, kept only if it lowers the residual (one stride). It gives up
+    after ``_NEWTON_MAX_ITER`` iterations, at a step shorter than
+    ``_NEWTON_MIN_STEP``, or at a non-finite Jacobian (a fall).
+    """
+    try:
+        r, J = fj(z0)
+    except ValueError:
+        return None, math.inf
+    z = z0
+    nrm = float(np.linalg.norm(r))
+    for it in range(_NEWTON_MAX_ITER + 1):
+        if not (np.all(np.isfinite(J)) and math.isfinite(nrm)):
+            return None, math.inf
+        err = float(np.max(np.abs(r)))
+        if err > tol and it == _NEWTON_MAX_ITER:
+            return None, math.inf
+        dz = np.linalg.lstsq(J, -r, rcond=None)[0]
+        if err <= tol:
+            if err <= 1e-2 * tol:  # done (the map's Jacobian at z is kept for floquet)
+                return z, err
+            try:  # one polishing step with the Jacobian at hand
+                rp = residual(z + dz)
+            except ValueError:
+                return z, err
+            errp = float(np.max(np.abs(rp)))
+            return (z + dz, errp) if errp < err else (z, err)
+        t = 1.0
+        while True:
+            zn = z + t * dz
+            try:
+                rn, Jn = fj(zn)
+                nn = float(np.linalg.norm(rn))
+            except ValueError:
+                nn = math.inf
+            if nn <= (1.0 - 1e-4 * t) * nrm:
+                break
+            t *= 0.5
+            if t < _NEWTON_MIN_STEP:
+                return None, math.inf
+        z, r, J, nrm = zn, rn, Jn, nn
+    return None, math.inf  # not reached
 
 
 def _cma_seed(seed: int) -> int:
@@ -594,7 +780,7 @@ def _wrap(prob: GaitProblem, z: np.ndarray) -> np.ndarray:
 def _make_gait(prob: GaitProblem, z: np.ndarray, tol: float, message: str,
                method: str = "newton", cma: CMAReport | None = None) -> Gait:
     p, s = prob.decode(z)
-    r, ts, tf = gait_residual(p, s, prob.options)
+    r, ts, tf = prob.evaluate(z)
     err = float(np.max(np.abs(r)))
     return Gait(state=s, params=p, residual=err, stance_time=ts, flight_time=tf,
                 converged=bool(err <= tol), message=message, method=method, cma=cma)
@@ -613,8 +799,11 @@ def _newton_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float,
                  max_starts: int | None) -> Gait:
     starts = iter(starts)
     first = next(starts)
+    # global PD has more equations than unknowns and no exact fixed point: least squares only
+    exact = not isinstance(prob.params.controller, GlobalPD)
     z, err, n = newton_solve(prob.residual, itertools.chain([first], starts), tol=tol,
-                             max_starts=max_starts)
+                             max_starts=max_starts,
+                             jacobian=prob.residual_jacobian if exact else None)
     if z is None:  # every start failed inside the solver
         g = _make_gait(prob, first, tol, "")
         return dataclasses.replace(
@@ -659,7 +848,7 @@ def _cma_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float, seed:
     head += f", residual {r_cma:.2e}"
     if not polish:
         return _make_gait(prob, x, tol, head, "cma", report)
-    z, err, _ = newton_solve(prob.residual, [x], tol=tol)
+    z, err, _ = newton_solve(prob.residual, [x], tol=tol, jacobian=prob.residual_jacobian)
     if z is None or err > r_cma:  # polishing did not help: keep the CMA-ES point
         return _make_gait(prob, x, tol, head + "; Newton polish failed", "cma", report)
     z = _wrap(prob, z)
@@ -695,9 +884,10 @@ def find_gait(
     tol : float
         Max-norm residual for ``converged``.
     options : IntegratorOptions, optional
-        Defaults to tolerance 1e-12 so the residual can reach ``tol``.
+        Defaults to tolerance 1e-12 with DOP853 so the residual can reach ``tol``.
     method : {"newton", "cma"}
-        ``"newton"``: Levenberg-Marquardt on the residual (exact fixed point).
+        ``"newton"``: Newton on the residual (exact fixed point), with
+        Levenberg-Marquardt as the fallback from each start.
         ``"cma"``: CMA-ES on the two-stage cost of eqs 2.20-2.22, as in the
         thesis: it minimises the largest non-trivial multiplier among points
         with ``C1 < 1e-4``, so its result is a near-fixed point (reported in

@@ -1,0 +1,124 @@
+"""The touch-down map on packed arrays, for the analyses' inner loops.
+
+:func:`tslip.step_map` and :func:`tslip.step_jacobian` check their inputs and
+pack ``Params`` and ``IntegratorOptions`` on every call; gait search,
+continuation, Floquet multipliers and robustness call the map thousands of
+times with the same parameters. They validate and pack once per public call
+(``pack_params``, ``IntegratorOptions.packed``) and then call these entry
+points, which take
+
+* ``P``: packed parameters (``model._pack.pack_params``), possibly with the
+  gait search's unknowns written into it (``P_ALPHA``, ``P_C0``);
+* ``O``: packed integrator options;
+* ``q``: the 5-D section ``(beta, phi, xd, yd, phid)``, finite;
+* ``h``: the ground height of the touch-down and of the whole stride.
+
+Nothing here checks its arguments: the callers have. The kernels are the
+same as the public functions', so the results are identical bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+
+import numpy as np
+
+from ..model import _pack as pk
+from . import _kernels as kn
+
+__all__ = ["touchdown", "stride_map", "stride_jacobian", "alpha_r_column", "run"]
+
+_TX = np.empty(0)  # flat ground: no terrain breakpoints
+
+
+def touchdown(q: np.ndarray, h: float = 0.0) -> np.ndarray:
+    """The kernels' touch-down vector ``(beta, phi, xd, yd, phid, x=0, h)``."""
+    td = np.zeros(pk.NTD)
+    td[:5] = q
+    td[pk.TD_H] = h
+    return td
+
+
+def stride_map(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E741
+               out: np.ndarray) -> int:
+    """One stride on flat ground at height ``h``; fills ``out`` (``OUT_*``), returns the status.
+
+    The next section is ``out[OUT_TD:OUT_TD + 5]``; as :func:`tslip.step_map`.
+    """
+    th = np.array([h])
+    return int(kn.stride_simple(P, O, touchdown(q, h), _TX, th, out))
+
+
+#: The last exact Jacobians, keyed by their exact inputs (P, O, q, h): gait search
+#: computes the Jacobian at the gait it returns, and the Floquet multipliers of that
+#: gait (also in continuation and the robustness check) need the same one.
+_JACOBIANS: dict[bytes, tuple[int, np.ndarray, np.ndarray]] = {}
+_JACOBIANS_KEPT = 64
+_JACOBIANS_LOCK = threading.Lock()
+
+
+def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E741
+                    J: np.ndarray, out: np.ndarray) -> int:
+    """As :func:`stride_map`, and the exact Jacobian ``dq'/dq`` (5 x 5) into ``J``.
+
+    Variational equations through the stance steps plus the saltation terms
+    (:mod:`._variational`); as :func:`tslip.step_jacobian`. The kernel is
+    deterministic, so a call with the same inputs as one of the last
+    ``_JACOBIANS_KEPT`` returns its stored result (identical bits).
+    """
+    from . import _variational as va
+
+    td = touchdown(q, h)
+    key = P.tobytes() + O.tobytes() + td.tobytes()
+    with _JACOBIANS_LOCK:
+        hit = _JACOBIANS.get(key)
+    if hit is not None:
+        J[:] = hit[1]
+        out[:] = hit[2]
+        return hit[0]
+    st = int(va.stride_jacobian(P, O, td, _TX, np.array([h]), J, out))
+    with _JACOBIANS_LOCK:
+        if len(_JACOBIANS) >= _JACOBIANS_KEPT:
+            del _JACOBIANS[next(iter(_JACOBIANS))]  # the oldest
+        _JACOBIANS[key] = (st, J.copy(), out.copy())
+    return st
+
+
+def alpha_r_column(P: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """``dq'/d alpha_r`` of a completed stride (5,), from its ``out`` vector.
+
+    ``alpha_r`` only moves the swing leg in flight (eq. 2.17): the leg angle
+    ``beta(t) = alpha_r + omega_r t [- phi(t)]`` and so the touch-down time
+    ``t_TD``, a root of the foot height ``f(t) = y_hip(t) - l0 sin beta(t) - H``.
+    With ``df/d alpha_r = -l0 cos beta`` the implicit derivative is
+    ``dt_TD/d alpha_r = l0 cos beta / f'(t_TD)``, and ``q' = (beta(t),
+    phi(t), xd, yd - g t, phid)`` moves by its time derivative times that,
+    plus 1 in ``beta``.
+    """
+    g, r, l0 = P[pk.P_G], P[pk.P_R], P[pk.P_L0]
+    tf = out[pk.OUT_TF]
+    phi0, yd0, phid0 = out[pk.OUT_LO + 4], out[pk.OUT_LO + 3], out[pk.OUT_LO + 5]
+    b = out[pk.OUT_TD]  # beta(t_TD)
+    bdot = P[pk.P_OMEGA] if P[pk.P_GLOBAL] != 0.0 else P[pk.P_OMEGA] - phid0
+    ph = phi0 + phid0 * tf
+    dfdt = yd0 - g * tf - r * math.sin(ph) * phid0 - l0 * math.cos(b) * bdot
+    dt = l0 * math.cos(b) / dfdt
+    return np.array([1.0 + bdot * dt, phid0 * dt, 0.0, -g * dt, 0.0])
+
+
+def run(P: np.ndarray, O: np.ndarray, td: np.ndarray, n_steps: int,  # noqa: E741
+        tx: np.ndarray, th: np.ndarray) -> tuple[int, int]:
+    """Up to ``n_steps`` strides from the touch-down vector ``td`` on terrain ``(tx, th)``.
+
+    Stops at the first stride that does not end in a touch-down. Returns
+    ``(status, strides completed)``, as one row of :func:`tslip.run_batch`.
+    """
+    out = np.empty(pk.NOUT)
+    td = td.copy()
+    for i in range(n_steps):
+        st = int(kn.stride_simple(P, O, td, tx, th, out))
+        if st != pk.ST_OK:
+            return st, i
+        td[:] = out[pk.OUT_TD : pk.OUT_TD + pk.NTD]
+    return pk.ST_OK, n_steps
