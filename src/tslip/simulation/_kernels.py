@@ -680,20 +680,13 @@ def stride(P, O, td, tx, th, rec, rec_dt, out):
     return ST_OK
 
 
-@njit(**_JIT)
-def stride_simple(P, O, td, tx, th, out):
-    """:func:`stride` without recording (the Poincare map)."""
-    rec = np.empty((0, NREC))
-    return stride(P, O, td, tx, th, rec, 0.0, out)
-
-
 # Batches: one row's work is a plain kernel; each driver exists twice, a serial
 # loop in the calling thread (small batches: waking threads costs more than a
 # row, and under load a sleeping core is not free) and a ``prange`` loop over
 # numba's thread pool. ``parallel=True`` kernels compile only when first used.
-# They call :func:`stride` directly, not :func:`stride_simple`: every kernel
-# level re-optimises all the code below it, so a wrapper level costs a sixth
-# of the first stride's compile time.
+# They call :func:`stride` directly, with no wrapper kernel: every kernel level
+# re-optimises all the code below it, so a wrapper level costs a sixth of the
+# first stride's compile time.
 _PAR = {"parallel": True, "cache": True, "nogil": True}
 
 

@@ -47,8 +47,8 @@ __all__ = [
 
 _FLAT = Terrain.flat(0.0)
 _REC_ROWS = 4096
-#: ``rec`` of a stride that records nothing (``kn.stride`` straight, not its
-#: ``stride_simple`` wrapper: one kernel level less to compile on first use)
+#: ``rec`` of a stride that records nothing: the map calls ``kn.stride`` itself, as
+#: every caller does (a wrapper kernel would be one more level to compile)
 _NO_REC = np.empty((0, pk.NREC))
 
 
