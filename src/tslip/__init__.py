@@ -12,7 +12,8 @@ __version__ = "0.2.0"
 from typing import TYPE_CHECKING  # noqa: E402
 
 if TYPE_CHECKING:  # the same names, for type checkers and tslip._codehash
-    from .gait import (
+    # mypy: ``robustness`` names both a function and its submodule of tslip.gait
+    from .gait import (  # type: ignore[no-redef]
         Branch,
         Floquet,
         Gait,

@@ -26,6 +26,7 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -110,9 +111,11 @@ def set_param(params: Params, name: str, value: float) -> Params:
     if name == "omega_r_bar":
         return params.with_omega_r_bar(value)
     if name.startswith("controller."):
-        ctrl = dataclasses.replace(params.controller, **{name.split(".", 1)[1]: value})
-        return dataclasses.replace(params, controller=ctrl)
-    return dataclasses.replace(params, **{name: value})
+        gain: dict[str, Any] = {name.split(".", 1)[1]: value}
+        return dataclasses.replace(params, controller=dataclasses.replace(params.controller,
+                                                                          **gain))
+    change: dict[str, Any] = {name: value}
+    return dataclasses.replace(params, **change)
 
 
 # ---------------------------------------------------------------------------
@@ -389,7 +392,8 @@ def continue_gait(
                 progress(done, n, float(vals[i]), gaits[i])
 
     walk(range(i0, n), list(start))
-    first = [(float(vals[i0]), gaits[i0])] if gaits[i0] is not None else []
+    g0 = gaits[i0]
+    first = [(float(vals[i0]), g0)] if g0 is not None else []
     walk(range(i0 - 1, -1, -1), (start + first)[-2:] if first else list(start))
 
     def arr(attr: str) -> np.ndarray:

@@ -42,7 +42,7 @@ import time
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -305,9 +305,9 @@ class GaitProblem:
                              f"got {len(z)}")
         values = dict(zip(self.names, map(float, z)))
         ctrl = self.params.controller
-        if "alphad_ref" in values:
+        if "alphad_ref" in values and isinstance(ctrl, LocalVelocity):  # (the name implies it)
             ctrl = dataclasses.replace(ctrl, alphad_ref=values["alphad_ref"])
-        if "tau_c" in values:
+        if "tau_c" in values and isinstance(ctrl, ConstantTorque):
             ctrl = dataclasses.replace(ctrl, tau_c=values["tau_c"])
         elif isinstance(ctrl, ConstantTorque) and ctrl.tau_c != 0.0:
             ctrl = dataclasses.replace(ctrl, tau_c=0.0)  # no damping: no torque
@@ -507,7 +507,7 @@ class GaitProblem:
         first = (-0.05, -0.12, -0.25, -0.4, -0.02)
         for d in first:
             yield self._guess(d)
-        scored = []
+        scored: list[tuple[float, int, np.ndarray]] = []
         for d in (-0.005, -0.01, -0.02, -0.035, -0.05, -0.075, -0.1, -0.15, -0.2, -0.3, -0.4,
                   -0.5, -0.65, -0.8, -1.0, -1.2):
             for da in (0.0, -0.15, 0.15):
@@ -536,7 +536,8 @@ class GaitProblem:
             # at the hip
             dalpha = max(math.pi - 2 * p.beta0, 0.1)
             ldot0 = p.v0 * math.cos(p.beta0 + delta)
-            loss = p.c_l * ldot0**2 * ts / 2 + p.controller.c_h * dalpha**2 / ts
+            c_h = p.controller.c_h if isinstance(p.controller, ConstantTorque) else 0.0
+            loss = p.c_l * ldot0**2 * ts / 2 + c_h * dalpha**2 / ts
             z.append(0.1 if loss == 0 else factor * loss / dalpha)
         return np.array(z)
 
@@ -723,7 +724,7 @@ def cma_minimize(
     import cma
 
     x0 = np.asarray(x0, dtype=float)
-    opts = {
+    opts: dict[str, Any] = {
         "seed": _cma_seed(seed), "verbose": -9, "verb_disp": 0, "verb_log": 0,
         "maxfevals": int(max_evals), "tolfun": 1e-13, "tolfunhist": 1e-14, "tolx": 1e-14,
         "tolflatfitness": 20,
@@ -818,7 +819,7 @@ def _newton_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float,
 def _cma_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float, seed: int | None,
               max_evals: int, polish: bool, jacobian: Literal["fd", "exact"]) -> Gait:
     if seed is None:
-        seed = int(np.random.SeedSequence().entropy % (2**32))
+        seed = int(np.random.default_rng().integers(2**32))
     starts = list(starts)
     if len(starts) == 1:
         x0 = starts[0]
