@@ -6,9 +6,10 @@ Appendix E) is a :class:`Task`: a picklable function, its arguments, and an
 estimate of its cost in seconds. :func:`run_tasks` runs them
 
 * largest first: the ready task with the highest ``priority`` (its cost
-  plus the work that waits for it) goes next, and no more tasks are handed to
-  the pool than it has workers, so a large task that becomes ready later
-  (the next line of a 2-D continuation) is not queued behind small ones;
+  plus the work that waits for it) goes next, and at most one task more than
+  the pool has workers is handed to it (one queued, so that no worker waits
+  while this process handles a result), so a large task that becomes ready
+  later (the next line of a 2-D continuation) is not queued behind small ones;
 * on one pool (:func:`tslip.sweeps._pool.process_pool`) of
   :func:`choose_workers` processes, or serially in this process when the
   work is too small to pay for starting them;
@@ -142,7 +143,7 @@ def run_tasks(tasks: Iterable[Task], on_done: OnDone, workers: int = 1,
         with _pool.process_pool(workers, queue) as pool:
             running: dict[cf.Future, Task] = {}
             while ready or running:
-                while ready and len(running) < workers:
+                while ready and len(running) <= workers:
                     task = heapq.heappop(ready)[2]
                     running[pool.submit(_timed, task.fn, task.args, None)] = task
                 done = cf.wait(running, timeout=0.2, return_when=cf.FIRST_COMPLETED).done
