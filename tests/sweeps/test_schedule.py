@@ -160,6 +160,30 @@ def test_parallel_reproduction_equals_serial_bit_for_bit(serial_tiny, tmp_path, 
                                                                   "converged_floquet"}
 
 
+def test_pieces_land_under_their_own_names(serial_tiny):
+    """Table 6.1's variants and Appendix E's perturbed starts, each against a direct call."""
+    from tslip.biped import BipedParams, simulate
+    from tslip.gait import find_gait
+    from tslip.gait.robustness import robustness
+    from tslip.model.parameters import preset
+    from tslip.sweeps.appendix_e import table_e2_perturbations
+    from tslip.sweeps.reproduce import APPENDIX_E_SETTINGS
+
+    data = serial_tiny[0]
+    g = find_gait(preset("table6.1"))
+    variants = data["table6.1"]["pitch_rate_variants"]
+    assert variants["apex, +"] == robustness(g, "pitch_rate", sign=1, placement="apex",
+                                             check=False)
+    assert variants["liftoff, -"] == robustness(g, "pitch_rate", sign=-1, placement="liftoff",
+                                                check=False)
+    e2 = data["E"]["e2"]
+    st = APPENDIX_E_SETTINGS["tiny"]
+    starts = table_e2_perturbations(st["n_random"], one_at_a_time=st["one_at_a_time"])
+    assert e2["strides_perturbed"] == [
+        simulate(BipedParams(), y, st["n_strides"]).count_strides(e2["min_contact"])
+        for y in starts]
+
+
 def test_interrupted_reproduction_resumes_to_the_same_result(serial_tiny, tmp_path,
                                                               monkeypatch):
     from tslip.sweeps.reproduce import run_all

@@ -12,7 +12,8 @@ estimate of its cost in seconds. :func:`run_tasks` runs them
   later (the next line of a 2-D continuation) is not queued behind small ones;
 * on one pool (:func:`tslip.sweeps._pool.process_pool`) of
   :func:`choose_workers` processes, or serially in this process when the
-  work is too small to pay for starting them;
+  work is too small to pay for starting them (numba on one thread then, as
+  in the workers: the tasks' small batches are slower on more);
 * with ``on_done(task, result)`` called here as each result arrives; it
   returns the tasks that result made ready (e.g. the next line, seeded
   with this one's gaits).
@@ -35,7 +36,8 @@ import itertools
 import os
 import queue as queue_mod
 import time
-from collections.abc import Callable, Hashable, Iterable
+from collections.abc import Callable, Hashable, Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -85,10 +87,24 @@ def choose_workers(cost: float, workers: int | None = None, width: int | None = 
     cap = workers if workers is not None else (os.cpu_count() or 1)
     if cap < 1:
         raise ValueError(f"workers must be >= 1, got {cap}")
-    n = min(cap, int(cost // (4 * STARTUP_SECONDS)) or 1)
+    per_worker = 4 * STARTUP_SECONDS
+    n = min(cap, int(cost // per_worker) or 1) if per_worker > 0 else cap
     if width is not None:
         n = min(n, max(1, width))
     return max(1, n)
+
+
+@contextmanager
+def _one_thread() -> Iterator[None]:
+    """Numba on one thread for the block, as in the pool's workers (one process per core)."""
+    import numba
+
+    old = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(old)
 
 
 def _timed(fn: Callable[..., Any], args: tuple[Any, ...],
@@ -132,9 +148,10 @@ def run_tasks(tasks: Iterable[Task], on_done: OnDone, workers: int = 1,
         _run_dask(scheduler, ready, finish)
         return
     if workers <= 1:
-        while ready:
-            task = heapq.heappop(ready)[2]
-            finish(task, _timed(task.fn, task.args, tick))
+        with _one_thread():
+            while ready:
+                task = heapq.heappop(ready)[2]
+                finish(task, _timed(task.fn, task.args, tick))
         return
     if not ready:
         return

@@ -94,8 +94,8 @@ def _converged_metacentric() -> Any:
 
 
 #: Seconds each piece takes, about (warm compile cache, one core), by name prefix.
-PIECE_SECONDS = {"e2_run": 1.5, "e2_floquet": 3.0, "perturbed": 3.0, "converged_floquet": 3.0,
-                 "converged_run": 3.0, "converged_metacentric": 0.5}
+PIECE_SECONDS = {"e2_run": 3.2, "e2_floquet": 4.5, "perturbed": 3.2, "converged_floquet": 4.5,
+                 "converged_run": 1.6, "converged_metacentric": 0.3}
 
 
 def pieces(n_strides: int = 20, n_converged: int = 50, n_random: int = 0,

@@ -146,10 +146,10 @@ def _table61_core(g: Gait) -> dict[str, Any]:
 #: Table 6.1's independent pieces (:func:`table61`), each a task of ``tslip reproduce``:
 #: name -> (function of the gait, estimated seconds).
 TABLE61_PIECES: dict[str, tuple[Callable[[Gait], Any], float]] = {
-    "core": (_table61_core, 1.5),
-    **{f"pitch_rate/{label}": ((lambda g, label=label: pitch_rate_variant(g, label)), 0.4)
+    "core": (_table61_core, 0.2),
+    **{f"pitch_rate/{label}": ((lambda g, label=label: pitch_rate_variant(g, label)), 0.02)
        for label in PITCH_RATE_VARIANTS},
-    "alphad_ref_forced": (alphad_ref_forced, 0.5),
+    "alphad_ref_forced": (alphad_ref_forced, 0.15),
 }
 
 
@@ -231,9 +231,9 @@ def _figure_jobs(res: str) -> dict[str, Callable[[], Any]]:
     }
 
 
-#: Estimated seconds of each figure of :func:`_figure_jobs` (full resolution).
-FIGURE_SECONDS = {"4.1": 0.5, "4.2": 0.1, "4.3": 0.1, "6.2": 0.1, "4.4": 5.0, "4.5": 0.3,
-                  "4.7": 0.3, "C.1": 0.3}
+#: Estimated seconds of each figure of :func:`_figure_jobs` (warm compile cache, one core).
+FIGURE_SECONDS = {"4.1": 0.02, "4.2": 0.04, "4.3": 0.02, "6.2": 0.02, "4.4": 1.5, "4.5": 0.02,
+                  "4.7": 0.02, "C.1": 0.03}
 
 
 def single_figures(quick: bool | str = False, progress: Progress | None = None,
@@ -281,13 +281,14 @@ class _Figures:
     Appendix E is taken from its cache when valid and cached when computed.
     """
 
-    def __init__(self, res: str, out: Path, progress: Progress | None) -> None:
+    def __init__(self, res: str, out: Path, progress: Progress | None,
+                 arrived: Callable[[], None]) -> None:
         from . import appendix_e
 
         self.res, self.progress, self.t0 = res, progress, time.perf_counter()
+        self.arrived: Callable[[], None] = lambda: None
         self.data: dict[str, Any] = {}
-        scale = 0.3 if res != "full" else 1.0
-        self.tasks = [Task(("figure", k), _figure_task, (res, k), FIGURE_SECONDS[k] * scale)
+        self.tasks = [Task(("figure", k), _figure_task, (res, k), FIGURE_SECONDS[k])
                       for k in _figure_jobs(res)]
         self.tasks += [Task(("figure", "table6.1", k), _table61_task, (k,), sec)
                        for k, (_, sec) in TABLE61_PIECES.items()]
@@ -304,6 +305,7 @@ class _Figures:
             self.tasks += [Task(("figure", "E", k), _piece_task, (fn, args),
                                 appendix_e.PIECE_SECONDS[k.split("/")[0]])
                            for k, (fn, args) in self.e_pieces.items()]
+        self.arrived = arrived
 
     @property
     def cost(self) -> float:
@@ -313,6 +315,7 @@ class _Figures:
         self.data[key] = value
         if self.progress:
             self.progress("figure", key, time.perf_counter() - self.t0)
+        self.arrived()
 
     def on_done(self, task: Task, result: Any) -> list[Task]:
         from . import appendix_e
@@ -336,7 +339,8 @@ class _Figures:
 def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = None,
             scheduler: str | None = None, progress: Progress | None = None,
             resolution: str | None = None,
-            timing: dict[Any, tuple[float, float, Any]] | None = None
+            timing: dict[Any, tuple[float, float, Any]] | None = None,
+            on_result: Callable[[dict[str, Any]], None] | None = None,
             ) -> tuple[dict[str, Any], list[ClaimResult], float]:
     """Run every thesis study and figure; return the data, the claims and the seconds.
 
@@ -363,6 +367,9 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
         short Appendix E) tests the pipeline, its numbers are not meant to be read.
     timing : dict, optional
         Filled with each task's CPU and wall seconds (see :func:`run_catalogue`).
+    on_result : callable, optional
+        ``on_result(data)`` here after each study and figure, with the data so
+        far (e.g. to plot while the rest is computed).
 
     Returns
     -------
@@ -377,7 +384,7 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     results = run_catalogue(out, res, workers=workers, scheduler=scheduler, progress=progress,
-                            timing=timing)
+                            timing=timing, on_result=on_result)
     order = [*catalogue.STUDIES, *_figure_jobs(res), "table6.1", "E"]
     data: dict[str, Any] = {**{k: results[k] for k in order},
                             "quick": res != "full", "resolution": res}
@@ -387,12 +394,14 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
 def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
                   workers: int | None = None, scheduler: str | None = None,
                   progress: Progress | None = None,
-                  timing: dict[Any, tuple[float, float, Any]] | None = None) -> dict[str, Any]:
+                  timing: dict[Any, tuple[float, float, Any]] | None = None,
+                  on_result: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
     """Every study and single-gait figure as tasks of one scheduler; results by key.
 
     Each study folder is locked (:func:`tslip.sweeps._lock.folder_lock`)
     for the run. ``timing`` receives each task's CPU and wall seconds and
-    the task that made it ready (:func:`tslip.sweeps._schedule.run_tasks`).
+    the task that made it ready (:func:`tslip.sweeps._schedule.run_tasks`);
+    ``on_result(data so far)`` is called after each study and figure.
     """
     res = catalogue.resolution_name(resolution)
     out = Path(out_dir)
@@ -404,7 +413,12 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
             folder = out / "studies" / name
             locks.enter_context(folder_lock(folder))
             jobs[name] = StudyJob(spec, folder, writes=scheduler is None)
-        figures = _Figures(res, out, progress)
+
+        def arrived() -> None:
+            if on_result is not None:
+                on_result({**results, **figures.data})
+
+        figures = _Figures(res, out, progress, arrived)
         cost = sum(j.cost for j in jobs.values()) + figures.cost
         n = 1 if scheduler is not None else choose_workers(cost, workers)
         t0 = time.perf_counter()
@@ -413,6 +427,7 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
             results[name] = jobs.pop(name).result(n, scheduler)
             if progress:
                 progress("study", name, time.perf_counter() - t0)
+            arrived()
 
         def on_done(task: Task, result: Any) -> list[Task]:
             owner = task.key[0]
@@ -425,6 +440,7 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
 
         for name in [n for n, j in jobs.items() if j.finished]:
             study_done(name)
+        arrived()  # what was cached
         tasks = [t for j in jobs.values() for t in j.start()] + figures.tasks
         run_tasks(tasks, on_done, n, timing=timing, scheduler=scheduler)
     return {**results, **figures.data}

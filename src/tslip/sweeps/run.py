@@ -235,8 +235,8 @@ def _run(spec: StudySpec, out: Path | None, n_workers: int, scheduler: str | Non
 #: Estimated seconds per point (warm compile cache, one core): its gait
 #: solve, and each analysis. They order the tasks (largest first) and size
 #: the analysis chunks and the worker count; they need not be exact.
-COST_SECONDS: dict[str, float] = {"solve": 0.02, "floquet": 0.01, "stride": 0.005,
-                                  "robustness": 0.25}
+COST_SECONDS: dict[str, float] = {"solve": 0.12, "floquet": 0.005, "stride": 0.001,
+                                  "robustness": 0.025}
 #: Aimed-at seconds of one task of analyses: points are analysed in chunks
 #: about this long (one point at least).
 CHUNK_SECONDS = 0.4
