@@ -83,14 +83,16 @@ def test_a_failing_task_stops_the_run_and_raises(tmp_path):
             run_tasks(tasks, lambda t, r: [], workers=workers)
 
 
-def test_worker_count_follows_the_work():
+def test_worker_count_follows_the_work_unless_given(monkeypatch):
     s = _schedule.STARTUP_SECONDS
-    assert choose_workers(0.5 * s, 2) == 1  # start-up would dominate: serial
-    assert choose_workers(7.9 * s, 2) == 1  # less than 4 start-ups of work per worker
-    assert choose_workers(8.1 * s, 2) == 2
-    assert choose_workers(1000 * s, 2, width=1) == 1  # one task at a time
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    assert choose_workers(0.5 * s) == 1  # start-up would dominate: serial
+    assert choose_workers(7.9 * s) == 1  # less than 4 start-ups of work per worker
+    assert choose_workers(8.1 * s) == 2
+    assert choose_workers(1000 * s) == 2  # all cores, no more
+    assert choose_workers(1000 * s, width=1) == 1  # one task at a time
+    assert choose_workers(0.5 * s, 3) == 3  # the caller's choice
     assert choose_workers(1000 * s, 1) == 1
-    assert choose_workers(1000 * s, 3) == 3
     with pytest.raises(ValueError, match="workers must be >= 1"):
         choose_workers(10.0, 0)
 
@@ -139,10 +141,9 @@ def serial_tiny(tmp_path_factory):
     return data, claims
 
 
-def test_parallel_reproduction_equals_serial_bit_for_bit(serial_tiny, tmp_path, monkeypatch):
+def test_parallel_reproduction_equals_serial_bit_for_bit(serial_tiny, tmp_path):
     from tslip.sweeps.reproduce import run_all
 
-    monkeypatch.setattr(_schedule, "STARTUP_SECONDS", 0.0)  # two workers even for tiny work
     timing: dict = {}
     data, claims, _ = run_all(tmp_path, resolution="tiny", workers=2, timing=timing)
     _same(serial_tiny[0], data)
@@ -205,7 +206,6 @@ def test_interrupted_reproduction_resumes_to_the_same_result(serial_tiny, tmp_pa
     assert saved == k
     locks = list(tmp_path.glob("studies/*/.lock"))
     assert len(locks) == len(specs) and all(f.read_text() == "" for f in locks)  # released
-    monkeypatch.setattr(_schedule, "STARTUP_SECONDS", 0.0)
     data, claims, _ = run_all(tmp_path, resolution="tiny", workers=2)
     assert sum(data[n].meta["cached"] for n in specs) == k
     assert sum(data[n].meta["computed"] for n in specs) == sum(s.n_points

@@ -77,21 +77,25 @@ OnDone = Callable[[Task, Any], Iterable[Task]]
 
 
 def choose_workers(cost: float, workers: int | None = None, width: int | None = None) -> int:
-    """Worker processes for ``cost`` seconds of work: 1 (serial) when start-up would dominate.
+    """Worker processes for ``cost`` seconds of work.
 
-    ``workers`` caps it (default all cores); ``width`` is how many tasks can
-    run at once at most. Parallel only when each worker gets at least
-    ``4 * STARTUP_SECONDS`` of work: the start-up then costs a quarter of
-    what it saves at most.
+    ``workers`` given: that many (the caller's choice). Otherwise up to all
+    cores, but parallel only when each worker gets at least
+    ``4 * STARTUP_SECONDS`` of work (the start-up then costs a quarter of
+    what it saves at most): 1, serial, when start-up would dominate.
+    ``width`` is how many tasks can run at once at most.
     """
-    cap = workers if workers is not None else (os.cpu_count() or 1)
-    if cap < 1:
-        raise ValueError(f"workers must be >= 1, got {cap}")
-    per_worker = 4 * STARTUP_SECONDS
-    n = min(cap, int(cost // per_worker) or 1) if per_worker > 0 else cap
+    if workers is not None:
+        if workers < 1:
+            raise ValueError(f"workers must be >= 1, got {workers}")
+        n = workers
+    else:
+        per_worker = 4 * STARTUP_SECONDS
+        cores = os.cpu_count() or 1
+        n = min(cores, int(cost // per_worker) or 1) if per_worker > 0 else cores
     if width is not None:
         n = min(n, max(1, width))
-    return max(1, n)
+    return n
 
 
 @contextmanager

@@ -356,8 +356,9 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
         Coarse resolution (12 points a line, 6 x 6 grids) instead of the full
         one (50 points, 40 x 40).
     workers : int, optional
-        Most worker processes (default all cores; 1 runs everything here);
-        fewer when the work left is small (:func:`tslip.sweeps._schedule.choose_workers`).
+        Worker processes (1 runs everything here). Default: by the work
+        left, up to all cores, serial when start-up would dominate
+        (:func:`tslip.sweeps._schedule.choose_workers`).
     scheduler : str, optional
         Dask scheduler address to run the tasks on.
     progress : callable, optional

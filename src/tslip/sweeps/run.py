@@ -191,7 +191,8 @@ def run_study(
         (and ``results.csv`` with ``csv=True``), ``run.json`` and ``.lock``.
         Without it nothing is cached or written.
     workers : int, optional
-        Worker processes (default: all cores; 1 runs in this process).
+        Worker processes (1 runs in this process). Default: by the work
+        left, up to all cores (:func:`tslip.sweeps._schedule.choose_workers`).
     scheduler : str, optional
         Address of a Dask distributed scheduler (``tslip[dask]``); the same
         lines then run on that cluster.
@@ -211,20 +212,19 @@ def run_study(
     tslip.sweeps._lock.FolderLocked
         If another live run holds ``out_dir`` (a ValueError).
     """
-    n_workers = workers if workers is not None else (os.cpu_count() or 1)
-    if n_workers < 1:
-        raise ValueError(f"workers must be >= 1, got {n_workers}")
+    if workers is not None and workers < 1:
+        raise ValueError(f"workers must be >= 1, got {workers}")
     try:
         if out_dir is None:
-            return _run(spec, None, n_workers, scheduler, progress, csv)
+            return _run(spec, None, workers, scheduler, progress, csv)
         with folder_lock(out_dir, wait=wait):
-            return _run(spec, Path(out_dir), n_workers, scheduler, progress, csv)
+            return _run(spec, Path(out_dir), workers, scheduler, progress, csv)
     except KeyboardInterrupt:  # the workers are stopped by now
         saved = saved_points(spec, out_dir) if out_dir is not None else 0
         raise StudyInterrupted(saved, spec.n_points) from None
 
 
-def _run(spec: StudySpec, out: Path | None, n_workers: int, scheduler: str | None,
+def _run(spec: StudySpec, out: Path | None, n_workers: int | None, scheduler: str | None,
          progress: Progress | None, csv: bool) -> StudyResult:
     job = StudyJob(spec, out, progress, writes=scheduler is None)
     workers = 1 if scheduler is not None else choose_workers(job.cost, n_workers)
