@@ -1,11 +1,15 @@
 """Run a study: continuation lines in parallel, every point cached as it finishes.
 
-Work is split into continuation lines (:meth:`StudySpec.lines`), solved
-point by point by :func:`tslip.sweeps.point.solve_line`. Lines run in worker
-processes (all cores by default; see :mod:`tslip.sweeps._pool`), or on a
-Dask cluster given its address. Each point is written to ``cache/`` the
-moment it is final, atomically, by the process that computed it, and the
-progress callback advances with it. The cache key is a hash of the study's
+Work is split into continuation lines (:meth:`StudySpec.lines`): each line's
+gaits are found by :func:`tslip.sweeps.point.solve_gaits` (a 2-D study's
+next line starts from them), and its points are analysed in chunks
+(:func:`tslip.sweeps.point.analyse_point`); :class:`StudyJob` makes these
+tasks and :mod:`tslip.sweeps._schedule` runs them, largest first, in worker
+processes (:mod:`tslip.sweeps._pool`; as many as the work pays for, up to
+all cores, unless ``workers`` is given), or on a Dask cluster given its
+address. Each point is written to ``cache/`` the moment it is final,
+atomically, by the process that computed it, and the progress callback
+advances with it. The cache key is a hash of the study's
 base parameters, the point's axis values, the analyses and the code that
 computes them (:func:`tslip.sweeps.point.code_version`), so
 
@@ -19,7 +23,7 @@ One run at a time per output folder (``.lock``, :mod:`tslip.sweeps._lock`).
 Ctrl-C stops the workers and raises :class:`StudyInterrupted` ("N of M
 points saved"). A point without a periodic gait is a record with
 ``converged = False`` and ``stability = "none"``, not an error. On a Dask
-cluster the points of a line are cached when the line is done.
+cluster the points are cached here as their tasks return.
 """
 
 from __future__ import annotations
