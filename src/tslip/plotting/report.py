@@ -24,7 +24,7 @@ from .. import __version__
 from .._io import atomic_write, write_json
 from ..sweeps.claims import Verdict
 
-__all__ = ["reproduce", "write_report", "figure_png", "SECTIONS"]
+__all__ = ["reproduce", "write_report", "figure_png", "render_ready", "SECTIONS"]
 
 
 def figure_png(fig: Figure, dpi: int = 80) -> str:
@@ -286,9 +286,19 @@ def _global_pd_note(data: Mapping[str, Any]) -> str:
             "near-periodic gait.</p>")
 
 
+def render_ready(data: Mapping[str, Any], images: dict[str, str]) -> None:
+    """Add to ``images`` every figure whose data ``data`` holds (for plotting as data arrive)."""
+    for fkey, make in _plots(data).items():
+        if fkey not in images:
+            try:
+                images[fkey] = figure_png(make())
+            except Exception:  # noqa: BLE001 - data not there yet; write_report reports errors
+                pass
+
+
 def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any], *,
                  quick: bool = False, seconds: float | None = None,
-                 workers: int | None = None) -> Path:
+                 workers: int | None = None, images: Mapping[str, str] | None = None) -> Path:
     """Write the report page and ``claims.json`` beside it; return the page's path.
 
     The page: a summary with the count of claims per verdict (holds; holds
@@ -296,8 +306,10 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
     to its section, a table of contents, one section per figure (our plots,
     then each claim with the thesis sentence and its source, our reading,
     our numbers, the verdict, its evidence and a note), and the studies.
+    ``images``: figures already rendered (:func:`render_ready`), by key.
     """
     plots = _plots(data)
+    images = images or {}
     ids = _claim_ids(claims)
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'>"
              f"<title>tslip reproduce</title><style>{_CSS}</style></head><body>",
@@ -315,7 +327,8 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
         for fkey in figs:
             if fkey in plots:
                 try:
-                    parts.append(f"<img alt='Figure {fkey}' src='{figure_png(plots[fkey]())}'>")
+                    src = images.get(fkey) or figure_png(plots[fkey]())
+                    parts.append(f"<img alt='Figure {fkey}' src='{src}'>")
                 except KeyError:
                     parts.append(f"<p class='note'>Figure {fkey}: data not computed.</p>")
                 except Exception as exc:  # noqa: BLE001 - a broken plot must not lose the rest
@@ -364,11 +377,13 @@ def reproduce(out_dir: str | Path, *, quick: bool = False, workers: int | None =
 
     from ..sweeps.reproduce import run_all
 
+    images: dict[str, str] = {}  # plotted as the data arrive, while the rest is computed
     data, claims, seconds = run_all(out_dir, quick=quick, workers=workers,
-                                    scheduler=scheduler, progress=progress)
+                                    scheduler=scheduler, progress=progress,
+                                    on_result=lambda d: render_ready(d, images))
     n = workers if workers is not None else (os.cpu_count() or 1)
     path = write_report(Path(out_dir) / "index.html", data, claims, quick=quick,
-                        seconds=seconds, workers=n)
+                        seconds=seconds, workers=n, images=images)
     if progress:
         progress("report", str(path), seconds)
     return path

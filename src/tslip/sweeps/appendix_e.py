@@ -23,7 +23,8 @@ from ..biped.metacentre import metacentric_test
 from ..biped.simulate import default_min_contact
 from ..biped.stored import load_gait
 
-__all__ = ["TABLE_E2_HALF_UNIT", "fig_appendix_e", "table_e2_perturbations"]
+__all__ = ["PIECE_SECONDS", "TABLE_E2_HALF_UNIT", "assemble", "fig_appendix_e", "pieces",
+           "table_e2_perturbations"]
 
 #: Half a unit of the last printed digit of each Table E.2 entry, in
 #: :data:`tslip.biped.STATE_FIELDS` order: positions to 3 decimals; velocities
@@ -55,6 +56,91 @@ def table_e2_perturbations(n_random: int = 20, seed: int = 0,
     return np.array(rows).reshape(-1, len(y))
 
 
+def _e2_run(n_strides: int, mc: float) -> dict[str, Any]:
+    """The run from Table E.2 and its tracking errors over the first stride (Figure E.2)."""
+    p, s = BipedParams(), BipedState.thesis()
+    run = simulate(p, s, n_strides)
+    t1 = float(run.strides[0, 0]) if run.n_strides else float(run.time[-1])
+    return {"run": run, "strides": run.count_strides(mc), "strides_raw": run.n_strides,
+            "reason": run.status.reason, "tracking": tracking_errors(run, 0, 0.0, t1)}
+
+
+def _e2_floquet() -> tuple[float, float]:
+    """Floquet multipliers at Table E.2's (non-periodic) start: largest, residual."""
+    p = BipedParams()
+    fl = floquet(p, to_section(p, BipedState.thesis().to_array(), 0.0))
+    return fl.largest, fl.residual
+
+
+def _perturbed(y: np.ndarray, n_strides: int, mc: float) -> int:
+    """Full strides from one perturbed Table E.2 start."""
+    return simulate(BipedParams(), y, n_strides).count_strides(mc)
+
+
+def _converged_floquet() -> tuple[float, float]:
+    pc, yc, tc, _ = load_gait("converged-e2")
+    flc = floquet(pc, to_section(pc, yc, tc))
+    return flc.largest, flc.residual
+
+
+def _converged_run(n_converged: int, mc: float) -> int:
+    pc, yc, tc, _ = load_gait("converged-e2")
+    return simulate(pc, yc, n_converged, t0=tc).count_strides(mc)
+
+
+def _converged_metacentric() -> Any:
+    pc, yc, tc, _ = load_gait("converged-e2")
+    return metacentric_test(pc, BipedState.from_array(yc), tc)
+
+
+#: Seconds each piece takes, about (warm compile cache, one core), by name prefix.
+PIECE_SECONDS = {"e2_run": 3.2, "e2_floquet": 4.5, "perturbed": 3.2, "converged_floquet": 4.5,
+                 "converged_run": 1.6, "converged_metacentric": 0.3}
+
+
+def pieces(n_strides: int = 20, n_converged: int = 50, n_random: int = 0,
+           one_at_a_time: bool = False, min_contact: float | None = None
+           ) -> dict[str, tuple[Any, tuple[Any, ...]]]:
+    """:func:`fig_appendix_e`'s independent computations: name -> (function, arguments).
+
+    Each Floquet analysis, each perturbed start and each run is its own
+    piece, so they can run in parallel; :func:`assemble` puts the results
+    together.
+    """
+    mc = _min_contact(min_contact)
+    out: dict[str, tuple[Any, tuple[Any, ...]]] = {
+        "e2_run": (_e2_run, (n_strides, mc)), "e2_floquet": (_e2_floquet, ())}
+    for k, y in enumerate(table_e2_perturbations(n_random, one_at_a_time=one_at_a_time)):
+        out[f"perturbed/{k}"] = (_perturbed, (y, n_strides, mc))
+    out["converged_floquet"] = (_converged_floquet, ())
+    out["converged_run"] = (_converged_run, (n_converged, mc))
+    out["converged_metacentric"] = (_converged_metacentric, ())
+    return out
+
+
+def _min_contact(min_contact: float | None) -> float:
+    return default_min_contact(BipedParams()) if min_contact is None else float(min_contact)
+
+
+def assemble(results: dict[str, Any], n_strides: int = 20, n_converged: int = 50,
+             min_contact: float | None = None, **_: Any) -> dict[str, Any]:
+    """:func:`fig_appendix_e`'s data from its :func:`pieces`' results (by name)."""
+    e2 = results["e2_run"]
+    largest, residual = results["e2_floquet"]
+    clargest, cresidual = results["converged_floquet"]
+    n_pert = sum(k.startswith("perturbed/") for k in results)
+    return {
+        "e2": {"run": e2["run"], "strides": e2["strides"], "strides_raw": e2["strides_raw"],
+               "min_contact": _min_contact(min_contact),
+               "strides_perturbed": [results[f"perturbed/{k}"] for k in range(n_pert)],
+               "of": n_strides, "reason": e2["reason"], "largest": largest,
+               "residual": residual, "tracking": e2["tracking"]},
+        "converged": {"largest": clargest, "residual": cresidual,
+                      "strides": results["converged_run"], "of": n_converged,
+                      "metacentric": results["converged_metacentric"]},
+    }
+
+
 def fig_appendix_e(n_strides: int = 20, n_converged: int = 50, n_random: int = 0,
                    one_at_a_time: bool = False,
                    min_contact: float | None = None) -> dict[str, Any]:
@@ -72,23 +158,10 @@ def fig_appendix_e(n_strides: int = 20, n_converged: int = 50, n_random: int = 0
     periodic gait reached from there (:mod:`tslip.biped.stored`), its
     residual, multipliers and full strides until fall (of ``n_converged``),
     and the metacentric test of Figure E.4 on it.
+
+    Runs its :func:`pieces` one after the other; ``tslip reproduce`` runs
+    them in parallel and calls :func:`assemble`.
     """
-    p, s = BipedParams(), BipedState.thesis()
-    mc = default_min_contact(p) if min_contact is None else float(min_contact)
-    run = simulate(p, s, n_strides)
-    t1 = float(run.strides[0, 0]) if run.n_strides else float(run.time[-1])
-    fl = floquet(p, to_section(p, s.to_array(), 0.0))
-    perturbed = [simulate(p, y, n_strides).count_strides(mc)
-                 for y in table_e2_perturbations(n_random, one_at_a_time=one_at_a_time)]
-    pc, yc, tc, _ = load_gait("converged-e2")
-    flc = floquet(pc, to_section(pc, yc, tc))
-    runc = simulate(pc, yc, n_converged, t0=tc)
-    return {
-        "e2": {"run": run, "strides": run.count_strides(mc), "strides_raw": run.n_strides,
-               "min_contact": mc, "strides_perturbed": perturbed, "of": n_strides,
-               "reason": run.status.reason, "largest": fl.largest, "residual": fl.residual,
-               "tracking": tracking_errors(run, 0, 0.0, t1)},
-        "converged": {"largest": flc.largest, "residual": flc.residual,
-                      "strides": runc.count_strides(mc), "of": n_converged,
-                      "metacentric": metacentric_test(pc, BipedState.from_array(yc), tc)},
-    }
+    work = pieces(n_strides, n_converged, n_random, one_at_a_time, min_contact)
+    return assemble({k: fn(*args) for k, (fn, args) in work.items()}, n_strides, n_converged,
+                    min_contact)

@@ -5,11 +5,15 @@ A line is the last axis of a study at fixed values of the others
 (thesis Section 3.4; :func:`tslip.gait.continuation.continue_gait`'s walk:
 outward from the base value, each point warm-started by the secant through
 its last two neighbours) or, on a 2-D study's later lines, from the
-neighbouring line's solutions. Each gait is analysed right away: Floquet
-multipliers (eq. 3.4) always, stride properties and robustness (Section 6.1)
-when the spec asks, and the point's record is handed to ``emit`` at once:
-the runner caches it, so an interrupted line loses at most the point in
-progress.
+neighbouring line's solutions. Solving and analysing are two steps, so
+that a line's analyses (Floquet multipliers, eq. 3.4, always; stride
+properties and robustness, Section 6.1, when the spec asks: most of a
+point's cost) can run in parallel while the next line is solved from this
+one's gaits: :func:`solve_gaits` walks the line and returns its gaits to
+analyse (:class:`Solved`), :func:`analyse_point` analyses each; the
+runner caches each record as it is final, so an interrupted line loses at
+most the points in progress. :func:`solve_line` does both in
+turn.
 
 Resuming is a replay. The walk's path depends only on which attempts
 succeeded and on the gaits found, so a line given its cached records
@@ -36,6 +40,7 @@ import json
 import math
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -50,7 +55,8 @@ from ..gait.stability import floquet
 from ..gait.stride import stride_properties
 from .spec import StudySpec
 
-__all__ = ["CODE", "MAX_FAILURES", "code_version", "seeds_from_records", "solve_line"]
+__all__ = ["CODE", "MAX_FAILURES", "Pending", "Solved", "analyse_point", "code_version",
+           "seeds_from_records", "solve_gaits", "solve_line"]
 
 #: The modules whose code computes a point, by analysis (``None``: every
 #: point). Their import closures are hashed by :func:`code_version`; a test
@@ -132,6 +138,7 @@ class _Line:
         self.spent = [0.0] * n
         self.failed: list[tuple[float, str]] = [
             (math.nan, "not attempted: past the end of the branch")] * n
+        self.pending: dict[int, Pending] = {}
 
     # -- points -----------------------------------------------------------------
     def point_params(self, i: int) -> Any:
@@ -241,24 +248,92 @@ class _Line:
 
     # -- records ----------------------------------------------------------------
     def finish(self, i: int, g: Gait | None, residual: float, message: str) -> dict[str, Any]:
-        """Analyse point ``i`` and emit its record."""
-        t0 = time.perf_counter()
-        rec = _analyse(self.spec, {**self.assignment, self.inner: float(self.values[i])}, g,
-                       residual, message, self.neutral_tol)
-        rec["seconds"] = self.spent[i] + time.perf_counter() - t0
-        rec["_attempt"] = self.tries[i]
-        rec = json.loads(json.dumps(rec))  # exactly what the cache holds
-        self.records[i] = rec
+        """Point ``i`` is solved: queue its analysis (or, without a gait, emit its record).
+
+        Returns what seeds its neighbours: the point and its unknowns, the
+        same numbers the analysed record will hold.
+        """
+        point = {**self.assignment, self.inner: float(self.values[i])}
+        if g is None:
+            return self.record(Pending(i, point, None, residual, message, self.tries[i],
+                                       self.spent[i]))
+        self.pending[i] = Pending(i, point, g, _num(residual), message, self.tries[i],
+                                  self.spent[i])
+        return json.loads(json.dumps({**point, "converged": True, **_unknowns(g)}))
+
+    def record(self, item: Pending) -> dict[str, Any]:
+        """Analyse one solved point and emit its record."""
+        rec = analyse_point(self.spec, item, self.neutral_tol)
+        self.records[item.index] = rec
         if self.emit is not None:
-            self.emit(i, rec)
+            self.emit(item.index, rec)
         return rec
 
-    def close(self) -> list[dict[str, Any]]:
-        """Emit the points without a gait; all records, by ascending inner value."""
+    def close(self) -> Solved:
+        """Emit the points without a gait; the solved points still to analyse."""
         for i, rec in enumerate(self.records):
-            if rec is None:
+            if rec is None and i not in self.pending:
                 self.finish(i, None, *self.failed[i])
-        return self.records  # type: ignore[return-value]
+        heads = [self.head(i) for i in range(len(self.values))]
+        return Solved(list(self.records), [self.pending[i] for i in sorted(self.pending)],
+                      seeds_from_records(heads, self.inner))
+
+    def head(self, i: int) -> dict[str, Any] | None:
+        """The record of point ``i`` as far as seeding goes (its unknowns)."""
+        if i in self.pending:
+            item = self.pending[i]
+            return {**item.point, "converged": True, **_unknowns(item.gait)}
+        return self.records[i]
+
+
+@dataclass(frozen=True)
+class Pending:
+    """A point solved and not yet analysed: what :func:`analyse_point` needs."""
+
+    index: int
+    point: dict[str, float]
+    gait: Gait | None
+    residual: float
+    message: str
+    attempt: int
+    seconds: float
+
+
+@dataclass(frozen=True)
+class Solved:
+    """A line after :func:`solve_gaits`.
+
+    ``records``: the final records by index (cached points and points
+    without a gait; None for the points still to analyse), ``pending``: the
+    solved points to analyse (:func:`analyse_point`), ``seeds``: the
+    unknowns of every solved point (:func:`seeds_from_records`), for the
+    next line.
+    """
+
+    records: list[dict[str, Any] | None]
+    pending: list[Pending]
+    seeds: dict[float, dict[str, float]]
+
+
+def _unknowns(g: Gait) -> dict[str, float]:
+    """The unknowns a record keeps of gait ``g`` (:data:`UNKNOWNS`), as :func:`_analyse`."""
+    s, ctrl = g.state, g.params.controller
+    return {"delta": _num(s.delta), "phi": _num(s.phi), "phid": _num(s.phid),
+            "alpha_r": _num(g.params.alpha_r),
+            "alphad_ref": _num(getattr(ctrl, "alphad_ref", math.nan)),
+            "tau_c": _num(getattr(ctrl, "tau_c", math.nan))}
+
+
+def analyse_point(spec: StudySpec, item: Pending, neutral_tol: float | None = None
+                  ) -> dict[str, Any]:
+    """The record of one solved point (exactly what the cache holds)."""
+    if neutral_tol is None:
+        neutral_tol = float(spec.meta.get("neutral_tol", 1e-6))
+    t0 = time.perf_counter()
+    rec = _analyse(spec, item.point, item.gait, item.residual, item.message, neutral_tol)
+    rec["seconds"] = item.seconds + time.perf_counter() - t0
+    rec["_attempt"] = item.attempt
+    return json.loads(json.dumps(rec))
 
 
 def _analyse(spec: StudySpec, point: dict[str, float], g: Gait | None, residual: float,
@@ -311,6 +386,25 @@ def _analyse(spec: StudySpec, point: dict[str, float], g: Gait | None, residual:
     return rec
 
 
+def solve_gaits(spec: StudySpec, assignment: dict[str, float], values: Sequence[float], *,
+                seeds: dict[float, dict[str, float]] | None = None,
+                cached: dict[float, dict[str, Any]] | None = None,
+                emit: Emit | None = None) -> Solved:
+    """Find the gaits of one line; the points without a gait are emitted as final.
+
+    Parameters as :func:`solve_line`; the solved points come back unanalysed
+    (:class:`Solved`).
+    """
+    line = _Line(spec, assignment, values, cached or {}, emit)
+    if seeds is not None:
+        line.continue_from(seeds)
+    else:
+        line.walk()
+        if len(spec.axes) == 2 and not any(g is not None for g in line.gaits):
+            line.probe()  # the base value may lie outside the gait's band
+    return line.close()
+
+
 def solve_line(spec: StudySpec, assignment: dict[str, float], values: Sequence[float], *,
                seeds: dict[float, dict[str, float]] | None = None,
                cached: dict[float, dict[str, Any]] | None = None,
@@ -335,11 +429,10 @@ def solve_line(spec: StudySpec, assignment: dict[str, float], values: Sequence[f
     emit : callable, optional
         ``emit(index, record)`` as soon as each point is final.
     """
-    line = _Line(spec, assignment, values, cached or {}, emit)
-    if seeds is not None:
-        line.continue_from(seeds)
-    else:
-        line.walk()
-        if len(spec.axes) == 2 and not any(g is not None for g in line.gaits):
-            line.probe()  # the base value may lie outside the gait's band
-    return line.close()
+    solved = solve_gaits(spec, assignment, values, seeds=seeds, cached=cached, emit=emit)
+    records = list(solved.records)
+    for item in solved.pending:
+        records[item.index] = analyse_point(spec, item)
+        if emit is not None:
+            emit(item.index, records[item.index])
+    return records  # type: ignore[return-value]

@@ -15,22 +15,27 @@ left with the thesis's ``alphad_ref`` forced (``["alphad_ref_forced"]``),
 and Appendix E's stride count for starts within Table E.2's rounding
 (``data["E"]["e2"]["strides_perturbed"]``).
 
-Parallelism: most studies are one continuation line, so the studies
-themselves are the unit of work: they run in spawned worker processes (one
-study per process, serial inside), largest first, while this process
-computes the single-gait figures. With ``scheduler`` every study runs on
-that Dask cluster instead.
+Parallelism: one scheduler (:mod:`tslip.sweeps._schedule`) runs every unit
+of work on one worker pool, largest first: each line's gait solve and each
+chunk of its points' analyses (:class:`tslip.sweeps.run.StudyJob`), each
+single-gait figure, each piece of Table 6.1 (:data:`TABLE61_PIECES`) and of
+Appendix E (each Floquet analysis and each perturbed start,
+:func:`tslip.sweeps.appendix_e.pieces`). Results are assembled here as they
+arrive. The worker count follows the work left
+(:func:`tslip.sweeps._schedule.choose_workers`): a rerun with everything
+cached starts no worker. With ``scheduler`` the same tasks run on that Dask
+cluster.
 """
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import dataclasses
+import functools
 import itertools
-import os
 import pickle
 import time
 from collections.abc import Callable
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
 
@@ -44,13 +49,14 @@ from ..gait.robustness import robustness
 from ..model.parameters import preset
 from ..simulation.options import IntegratorOptions
 from . import catalogue
-from ._pool import process_pool
+from ._lock import folder_lock
+from ._schedule import Task, choose_workers, run_tasks
 from .claims import ClaimResult, evaluate
-from .run import StudyResult, run_study
-from .spec import StudySpec
+from .run import StudyJob
 
-__all__ = ["alphad_ref_forced", "appendix_e_cached", "pitch_rate_variants", "run_all",
-           "run_catalogue", "single_figures", "table61"]
+__all__ = ["PITCH_RATE_VARIANTS", "TABLE61_PIECES", "alphad_ref_forced", "appendix_e_cached",
+           "pitch_rate_variant", "pitch_rate_variants", "run_all", "run_catalogue",
+           "single_figures", "table61"]
 
 #: Table 6.1's printed values that do not reproduce (Section 6.1, docs/conventions.md).
 THESIS_ALPHAD_REF = 2.42
@@ -72,65 +78,20 @@ APPENDIX_E_SETTINGS: dict[str, dict[str, Any]] = {
 Progress = Callable[[str, str, float], None]
 
 
-def _run_one(spec: StudySpec, out: str) -> StudyResult:
-    return run_study(spec, out, workers=1)
+#: Table 6.1's pitch-rate limit variants (:func:`pitch_rate_variants`): label ->
+#: keyword arguments of :func:`tslip.gait.robustness.robustness`.
+PITCH_RATE_VARIANTS: dict[str, dict[str, Any]] = {
+    **{f"{placement}, {mark}": {"sign": sign, "placement": placement}
+       for placement in ("touchdown", "touchdown_hip", "liftoff", "apex")
+       for sign, mark in ((-1, "-"), (1, "+"))},
+    "touchdown, -, 50 strides": {"n_steps": 50},
+    "touchdown, -, tol 1e-12": {"options": IntegratorOptions.tight()},
+}
 
 
-def run_catalogue(out_dir: str | Path, *, quick: bool | str = False, workers: int | None = None,
-                  scheduler: str | None = None, progress: Progress | None = None,
-                  names: list[str] | None = None,
-                  side_job: Callable[[], Any] | None = None) -> tuple[dict[str, StudyResult], Any]:
-    """Run (or load from cache) the catalogue's studies; optionally a side job meanwhile.
-
-    ``quick`` is True/False or a :data:`tslip.sweeps.catalogue.RESOLUTIONS`
-    name. Returns the results by study name and the side job's return value.
-    """
-    specs = catalogue.studies(quick)
-    if names is not None:
-        specs = {n: specs[n] for n in names}
-    root = Path(out_dir) / "studies"
-    n_workers = workers if workers is not None else (os.cpu_count() or 1)
-    if n_workers < 1:
-        raise ValueError(f"workers must be >= 1, got {n_workers}")
-    results: dict[str, StudyResult] = {}
-    side = None
-
-    def done(name: str, res: StudyResult, t0: float) -> None:
-        results[name] = res
-        if progress:
-            progress("study", name, time.perf_counter() - t0)
-
-    order = sorted(specs, key=lambda n: -specs[n].n_points * (3 if "robustness" in
-                                                                   specs[n].analyses else 1))
-    if scheduler is not None or n_workers == 1:
-        if side_job is not None:
-            side = side_job()
-        for name in order:
-            t0 = time.perf_counter()
-            done(name, run_study(specs[name], root / name, workers=1, scheduler=scheduler), t0)
-        return results, side
-    _warm_up()
-    t0 = time.perf_counter()
-    with process_pool(n_workers) as pool:
-        futs = {pool.submit(_run_one, specs[n], str(root / n)): n for n in order}
-        if side_job is not None:
-            side = side_job()
-        try:
-            for fut in cf.as_completed(futs):
-                done(futs[fut], fut.result(), t0)
-        except BaseException:
-            for fut in futs:
-                fut.cancel()
-            raise
-    return results, side
-
-
-def _warm_up() -> None:
-    """Compile (or load) every kernel here once, so workers find them in numba's cache."""
-    g = find_gait(preset("table2.1"))
-    floquet(g)
-    stride_properties(g)
-    robustness_report(g, n_steps=2, check=False)
+def pitch_rate_variant(gait: Gait, label: str) -> float:
+    """One of :func:`pitch_rate_variants`, by label."""
+    return robustness(gait, "pitch_rate", check=False, **PITCH_RATE_VARIANTS[label])
 
 
 def pitch_rate_variants(gait: Gait) -> dict[str, float]:
@@ -142,17 +103,9 @@ def pitch_rate_variants(gait: Gait) -> dict[str, float]:
     the first label; the others change one choice each: where the change
     is applied (:data:`tslip.gait.robustness.PLACEMENTS`), its sign, the
     strides to survive (50) and the integrator tolerance (1e-12). Labels
-    read ``"<placement>, <sign>[, <setting>]"``.
+    read ``"<placement>, <sign>[, <setting>]"`` (:data:`PITCH_RATE_VARIANTS`).
     """
-    out: dict[str, float] = {}
-    for placement in ("touchdown", "touchdown_hip", "liftoff", "apex"):
-        for sign, mark in ((-1, "-"), (1, "+")):
-            out[f"{placement}, {mark}"] = robustness(gait, "pitch_rate", sign=sign,
-                                                     placement=placement, check=False)
-    out["touchdown, -, 50 strides"] = robustness(gait, "pitch_rate", n_steps=50, check=False)
-    out["touchdown, -, tol 1e-12"] = robustness(gait, "pitch_rate", check=False,
-                                                options=IntegratorOptions.tight())
-    return out
+    return {label: pitch_rate_variant(gait, label) for label in PITCH_RATE_VARIANTS}
 
 
 def alphad_ref_forced(gait: Gait, alphad_ref: float = THESIS_ALPHAD_REF) -> dict[str, float]:
@@ -179,14 +132,7 @@ def alphad_ref_forced(gait: Gait, alphad_ref: float = THESIS_ALPHAD_REF) -> dict
             "free": float(p.controller.alphad_ref)}
 
 
-def table61() -> dict[str, Any]:
-    """Table 6.1 gait: multipliers, robustness (Section 6.1), stride (Table 6.2).
-
-    Also the evidence for the two numbers that do not reproduce: the
-    pitch-rate limit under every variant tried (:func:`pitch_rate_variants`)
-    and the residual left with the thesis's ``alphad_ref`` (:func:`alphad_ref_forced`).
-    """
-    g = find_gait(preset("table6.1"))
+def _table61_core(g: Gait) -> dict[str, Any]:
     fl = floquet(g)
     rr = robustness_report(g, check=False)
     sp = stride_properties(g)
@@ -194,9 +140,62 @@ def table61() -> dict[str, Any]:
             "step_down": rr.step_down, "push": rr.push, "pitch_rate": rr.pitch_rate,
             "stance_time": sp.stance_time, "flight_time": sp.flight_time,
             "duty_factor": sp.duty_factor, "step_frequency": sp.step_frequency,
-            "alphad_ref": g.params.controller.alphad_ref, "alpha_r": g.params.alpha_r,
-            "pitch_rate_variants": pitch_rate_variants(g),
-            "alphad_ref_forced": alphad_ref_forced(g)}
+            "alphad_ref": g.params.controller.alphad_ref, "alpha_r": g.params.alpha_r}
+
+
+#: Table 6.1's independent pieces (:func:`table61`), each a task of ``tslip reproduce``:
+#: name -> (function of the gait, estimated seconds).
+TABLE61_PIECES: dict[str, tuple[Callable[[Gait], Any], float]] = {
+    "core": (_table61_core, 0.2),
+    **{f"pitch_rate/{label}": ((lambda g, label=label: pitch_rate_variant(g, label)), 0.02)
+       for label in PITCH_RATE_VARIANTS},
+    "alphad_ref_forced": (alphad_ref_forced, 0.15),
+}
+
+
+@functools.cache
+def _table61_gait() -> Gait:
+    return find_gait(preset("table6.1"))
+
+
+def _table61_assemble(parts: dict[str, Any]) -> dict[str, Any]:
+    return {**parts["core"],
+            "pitch_rate_variants": {label: parts[f"pitch_rate/{label}"]
+                                    for label in PITCH_RATE_VARIANTS},
+            "alphad_ref_forced": parts["alphad_ref_forced"]}
+
+
+def table61() -> dict[str, Any]:
+    """Table 6.1 gait: multipliers, robustness (Section 6.1), stride (Table 6.2).
+
+    Also the evidence for the two numbers that do not reproduce: the
+    pitch-rate limit under every variant tried (:func:`pitch_rate_variants`)
+    and the residual left with the thesis's ``alphad_ref`` (:func:`alphad_ref_forced`).
+    """
+    g = _table61_gait()
+    return _table61_assemble({k: fn(g) for k, (fn, _) in TABLE61_PIECES.items()})
+
+
+def _appendix_e_entry(out_dir: str | Path, resolution: str) -> tuple[Path, str]:
+    """Appendix E's cache file and the key its content must carry."""
+    settings = APPENDIX_E_SETTINGS[catalogue.resolution_name(resolution)]
+    key = f"{code_hash(*APPENDIX_E_MODULES)}:{sorted(settings.items())!r}"
+    return Path(out_dir) / "figures" / f"appendix_e-{resolution}.pkl", key
+
+
+def _appendix_e_load(path: Path, key: str) -> dict[str, Any] | None:
+    try:
+        cached = pickle.loads(path.read_bytes())
+        if isinstance(cached, dict) and cached.get("key") == key:
+            return cached["data"]
+    except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ImportError):
+        pass  # missing or unreadable: recompute
+    return None
+
+
+def _appendix_e_store(path: Path, key: str, data: dict[str, Any]) -> None:
+    blob = pickle.dumps({"key": key, "data": data}, protocol=pickle.HIGHEST_PROTOCOL)
+    atomic_write(path, lambda tmp: Path(tmp).write_bytes(blob))
 
 
 def appendix_e_cached(out_dir: str | Path, resolution: str = "full") -> dict[str, Any]:
@@ -209,32 +208,18 @@ def appendix_e_cached(out_dir: str | Path, resolution: str = "full") -> dict[str
     """
     from .appendix_e import fig_appendix_e
 
-    settings = APPENDIX_E_SETTINGS[catalogue.resolution_name(resolution)]
-    key = f"{code_hash(*APPENDIX_E_MODULES)}:{sorted(settings.items())!r}"
-    path = Path(out_dir) / "figures" / f"appendix_e-{resolution}.pkl"
-    try:
-        cached = pickle.loads(path.read_bytes())
-        if isinstance(cached, dict) and cached.get("key") == key:
-            return cached["data"]
-    except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ImportError):
-        pass  # missing or unreadable: recompute
-    data = fig_appendix_e(**settings)
-    blob = pickle.dumps({"key": key, "data": data}, protocol=pickle.HIGHEST_PROTOCOL)
-    atomic_write(path, lambda tmp: Path(tmp).write_bytes(blob))
+    path, key = _appendix_e_entry(out_dir, resolution)
+    data = _appendix_e_load(path, key)
+    if data is None:
+        data = fig_appendix_e(**APPENDIX_E_SETTINGS[catalogue.resolution_name(resolution)])
+        _appendix_e_store(path, key, data)
     return data
 
 
-def single_figures(quick: bool | str = False, progress: Progress | None = None,
-                   out_dir: str | Path | None = None) -> dict[str, Any]:
-    """The single-gait analyses (Figures 4.1-4.7, 6.2, C.1, E.2-E.4) and Table 6.1's numbers.
-
-    ``quick`` is True/False or a :data:`tslip.sweeps.catalogue.RESOLUTIONS`
-    name; with ``out_dir`` Appendix E's data is cached there
-    (:func:`appendix_e_cached`).
-    """
-    res = catalogue.resolution_name(quick)
+def _figure_jobs(res: str) -> dict[str, Callable[[], Any]]:
+    """The single-gait figures other than Table 6.1 and Appendix E, by key."""
     coarse = res != "full"
-    jobs: dict[str, Callable[[], Any]] = {
+    return {
         "4.1": catalogue.fig_impulse_linearisation,
         "4.2": lambda: catalogue.fig_pitch_disturbance("table2.1"),
         "4.3": lambda: catalogue.fig_pitch_disturbance("table2.1-global-pd"),
@@ -243,10 +228,28 @@ def single_figures(quick: bool | str = False, progress: Progress | None = None,
         "4.5": catalogue.fig_step_down,
         "4.7": catalogue.fig_velocity_angle,
         "C.1": catalogue.fig_friction,
-        "table6.1": table61,
-        "E": (lambda: appendix_e_cached(out_dir, res)) if out_dir is not None
-        else lambda: catalogue.fig_appendix_e(**APPENDIX_E_SETTINGS[res]),
     }
+
+
+#: Estimated seconds of each figure of :func:`_figure_jobs` (warm compile cache, one core).
+FIGURE_SECONDS = {"4.1": 0.02, "4.2": 0.04, "4.3": 0.02, "6.2": 0.02, "4.4": 1.5, "4.5": 0.02,
+                  "4.7": 0.02, "C.1": 0.03}
+
+
+def single_figures(quick: bool | str = False, progress: Progress | None = None,
+                   out_dir: str | Path | None = None) -> dict[str, Any]:
+    """The single-gait analyses (Figures 4.1-4.7, 6.2, C.1, E.2-E.4) and Table 6.1's numbers.
+
+    ``quick`` is True/False or a :data:`tslip.sweeps.catalogue.RESOLUTIONS`
+    name; with ``out_dir`` Appendix E's data is cached there
+    (:func:`appendix_e_cached`). Runs here, one after the other
+    (:func:`run_all` runs the same work as parallel tasks).
+    """
+    res = catalogue.resolution_name(quick)
+    jobs: dict[str, Callable[[], Any]] = {
+        **_figure_jobs(res), "table6.1": table61,
+        "E": (lambda: appendix_e_cached(out_dir, res)) if out_dir is not None
+        else lambda: catalogue.fig_appendix_e(**APPENDIX_E_SETTINGS[res])}
     out = {}
     for key, job in jobs.items():
         t0 = time.perf_counter()
@@ -256,9 +259,89 @@ def single_figures(quick: bool | str = False, progress: Progress | None = None,
     return out
 
 
+def _figure_task(res: str, key: str, tick: Any = None) -> Any:
+    """One single-gait figure (a task)."""
+    return _figure_jobs(res)[key]()
+
+
+def _table61_task(name: str, tick: Any = None) -> Any:
+    """One piece of Table 6.1 (a task)."""
+    return TABLE61_PIECES[name][0](_table61_gait())
+
+
+def _piece_task(fn: Callable[..., Any], args: tuple[Any, ...], tick: Any = None) -> Any:
+    """One piece of Appendix E (a task)."""
+    return fn(*args)
+
+
+class _Figures:
+    """The single-gait figures, Table 6.1 and Appendix E as scheduler tasks.
+
+    A figure made of pieces is assembled when its last piece arrives;
+    Appendix E is taken from its cache when valid and cached when computed.
+    """
+
+    def __init__(self, res: str, out: Path, progress: Progress | None,
+                 arrived: Callable[[], None]) -> None:
+        from . import appendix_e
+
+        self.res, self.progress, self.t0 = res, progress, time.perf_counter()
+        self.arrived: Callable[[], None] = lambda: None
+        self.data: dict[str, Any] = {}
+        self.tasks = [Task(("figure", k), _figure_task, (res, k), FIGURE_SECONDS[k])
+                      for k in _figure_jobs(res)]
+        self.tasks += [Task(("figure", "table6.1", k), _table61_task, (k,), sec)
+                       for k, (_, sec) in TABLE61_PIECES.items()]
+        self.t61: dict[str, Any] = {}
+        self.e_path, self.e_key = _appendix_e_entry(out, res)
+        cached = _appendix_e_load(self.e_path, self.e_key)
+        self.e_parts: dict[str, Any] = {}
+        self.e_settings = APPENDIX_E_SETTINGS[res]
+        if cached is not None:
+            self._done("E", cached)
+            self.e_pieces: dict[str, Any] = {}
+        else:
+            self.e_pieces = appendix_e.pieces(**self.e_settings)
+            self.tasks += [Task(("figure", "E", k), _piece_task, (fn, args),
+                                appendix_e.PIECE_SECONDS[k.split("/")[0]])
+                           for k, (fn, args) in self.e_pieces.items()]
+        self.arrived = arrived
+
+    @property
+    def cost(self) -> float:
+        return sum(t.cost for t in self.tasks)
+
+    def _done(self, key: str, value: Any) -> None:
+        self.data[key] = value
+        if self.progress:
+            self.progress("figure", key, time.perf_counter() - self.t0)
+        self.arrived()
+
+    def on_done(self, task: Task, result: Any) -> list[Task]:
+        from . import appendix_e
+
+        key = task.key[1]
+        if key == "table6.1":
+            self.t61[task.key[2]] = result
+            if len(self.t61) == len(TABLE61_PIECES):
+                self._done(key, _table61_assemble(self.t61))
+        elif key == "E":
+            self.e_parts[task.key[2]] = result
+            if len(self.e_parts) == len(self.e_pieces):
+                data = appendix_e.assemble(self.e_parts, **self.e_settings)
+                _appendix_e_store(self.e_path, self.e_key, data)
+                self._done(key, data)
+        else:
+            self._done(key, result)
+        return []
+
+
 def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = None,
             scheduler: str | None = None, progress: Progress | None = None,
-            resolution: str | None = None) -> tuple[dict[str, Any], list[ClaimResult], float]:
+            resolution: str | None = None,
+            timing: dict[Any, tuple[float, float, Any]] | None = None,
+            on_result: Callable[[dict[str, Any]], None] | None = None,
+            ) -> tuple[dict[str, Any], list[ClaimResult], float]:
     """Run every thesis study and figure; return the data, the claims and the seconds.
 
     The report itself is written by :func:`tslip.plotting.report.reproduce`
@@ -273,14 +356,21 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
         Coarse resolution (12 points a line, 6 x 6 grids) instead of the full
         one (50 points, 40 x 40).
     workers : int, optional
-        Worker processes (default all cores; 1 runs everything here).
+        Worker processes (1 runs everything here). Default: by the work
+        left, up to all cores, serial when start-up would dominate
+        (:func:`tslip.sweeps._schedule.choose_workers`).
     scheduler : str, optional
-        Dask scheduler address for the studies.
+        Dask scheduler address to run the tasks on.
     progress : callable, optional
         ``progress(stage, name, seconds)`` after each study and figure.
     resolution : {"tiny", "quick", "full"}, optional
         Overrides ``quick``; ``"tiny"`` (3 points a line, 3 x 3 grids, a
         short Appendix E) tests the pipeline, its numbers are not meant to be read.
+    timing : dict, optional
+        Filled with each task's CPU and wall seconds (see :func:`run_catalogue`).
+    on_result : callable, optional
+        ``on_result(data)`` here after each study and figure, with the data so
+        far (e.g. to plot while the rest is computed).
 
     Returns
     -------
@@ -294,8 +384,64 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
     res = catalogue.resolution_name(quick if resolution is None else resolution)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    results, figures = run_catalogue(out, quick=res, workers=workers, scheduler=scheduler,
-                                     progress=progress,
-                                     side_job=lambda: single_figures(res, progress, out))
-    data: dict[str, Any] = {**results, **figures, "quick": res != "full", "resolution": res}
+    results = run_catalogue(out, res, workers=workers, scheduler=scheduler, progress=progress,
+                            timing=timing, on_result=on_result)
+    order = [*catalogue.STUDIES, *_figure_jobs(res), "table6.1", "E"]
+    data: dict[str, Any] = {**{k: results[k] for k in order},
+                            "quick": res != "full", "resolution": res}
     return data, evaluate(data), time.perf_counter() - t0
+
+
+def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
+                  workers: int | None = None, scheduler: str | None = None,
+                  progress: Progress | None = None,
+                  timing: dict[Any, tuple[float, float, Any]] | None = None,
+                  on_result: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
+    """Every study and single-gait figure as tasks of one scheduler; results by key.
+
+    Each study folder is locked (:func:`tslip.sweeps._lock.folder_lock`)
+    for the run. ``timing`` receives each task's CPU and wall seconds and
+    the task that made it ready (:func:`tslip.sweeps._schedule.run_tasks`);
+    ``on_result(data so far)`` is called after each study and figure.
+    """
+    res = catalogue.resolution_name(resolution)
+    out = Path(out_dir)
+    specs = catalogue.studies(res)
+    results: dict[str, Any] = {}
+    with ExitStack() as locks:
+        jobs: dict[str, StudyJob] = {}
+        for name, spec in specs.items():
+            folder = out / "studies" / name
+            locks.enter_context(folder_lock(folder))
+            jobs[name] = StudyJob(spec, folder, writes=scheduler is None)
+
+        def arrived() -> None:
+            if on_result is not None:
+                on_result({**results, **figures.data})
+
+        figures = _Figures(res, out, progress, arrived)
+        cost = sum(j.cost for j in jobs.values()) + figures.cost
+        n = 1 if scheduler is not None else choose_workers(cost, workers)
+        t0 = time.perf_counter()
+
+        def study_done(name: str) -> None:
+            results[name] = jobs.pop(name).result(n, scheduler)
+            if progress:
+                progress("study", name, time.perf_counter() - t0)
+            arrived()
+
+        def on_done(task: Task, result: Any) -> list[Task]:
+            owner = task.key[0]
+            if owner == "figure":
+                return figures.on_done(task, result)
+            new = jobs[owner].on_done(task, result)
+            if jobs[owner].finished:
+                study_done(owner)
+            return new
+
+        for name in [n for n, j in jobs.items() if j.finished]:
+            study_done(name)
+        arrived()  # what was cached
+        tasks = [t for j in jobs.values() for t in j.start()] + figures.tasks
+        run_tasks(tasks, on_done, n, timing=timing, scheduler=scheduler)
+    return {**results, **figures.data}

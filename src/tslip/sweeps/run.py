@@ -1,11 +1,15 @@
 """Run a study: continuation lines in parallel, every point cached as it finishes.
 
-Work is split into continuation lines (:meth:`StudySpec.lines`), solved
-point by point by :func:`tslip.sweeps.point.solve_line`. Lines run in worker
-processes (all cores by default; see :mod:`tslip.sweeps._pool`), or on a
-Dask cluster given its address. Each point is written to ``cache/`` the
-moment it is final, atomically, by the process that computed it, and the
-progress callback advances with it. The cache key is a hash of the study's
+Work is split into continuation lines (:meth:`StudySpec.lines`): each line's
+gaits are found by :func:`tslip.sweeps.point.solve_gaits` (a 2-D study's
+next line starts from them), and its points are analysed in chunks
+(:func:`tslip.sweeps.point.analyse_point`); :class:`StudyJob` makes these
+tasks and :mod:`tslip.sweeps._schedule` runs them, largest first, in worker
+processes (:mod:`tslip.sweeps._pool`; as many as the work pays for, up to
+all cores, unless ``workers`` is given), or on a Dask cluster given its
+address. Each point is written to ``cache/`` the moment it is final,
+atomically, by the process that computed it, and the progress callback
+advances with it. The cache key is a hash of the study's
 base parameters, the point's axis values, the analyses and the code that
 computes them (:func:`tslip.sweeps.point.code_version`), so
 
@@ -19,19 +23,16 @@ One run at a time per output folder (``.lock``, :mod:`tslip.sweeps._lock`).
 Ctrl-C stops the workers and raises :class:`StudyInterrupted` ("N of M
 points saved"). A point without a periodic gait is a record with
 ``converged = False`` and ``stability = "none"``, not an error. On a Dask
-cluster the points of a line are cached when the line is done.
+cluster the points are cached here as their tasks return.
 """
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import hashlib
 import json
 import os
-import queue as queue_mod
 import time
 from collections.abc import Callable
-from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -44,11 +45,12 @@ from .._io import atomic_write, git_hash, write_json, write_table
 from ..gait.continuation import get_param
 from . import _pool
 from ._lock import folder_lock
-from .point import code_version, seeds_from_records, solve_line
+from ._schedule import Task, choose_workers, run_tasks
+from .point import Pending, Solved, analyse_point, code_version, seeds_from_records, solve_gaits
 from .spec import StudySpec
 
-__all__ = ["StudyInterrupted", "StudyResult", "run_study", "point_key", "saved_points",
-           "study_keys"]
+__all__ = ["StudyInterrupted", "StudyJob", "StudyResult", "run_study", "point_key",
+           "saved_points", "study_keys"]
 
 Progress = Callable[[int, int], None]
 
@@ -127,11 +129,11 @@ def _save(cache: Path, key: str, rec: dict[str, Any]) -> None:
     atomic_write(cache / f"{key}.json", lambda tmp: Path(tmp).write_text(text))
 
 
-def _line_task(spec: StudySpec, assignment: dict[str, float], values: list[float],
-               keys: list[str], cached: dict[float, dict[str, Any]],
-               seeds: dict[float, dict[str, float]] | None, cache: str | None,
-               tick: Callable[[int], None] | None = None) -> list[dict[str, Any]]:
-    """Solve one line, caching each point as it is final (runs in workers)."""
+def _solve_task(spec: StudySpec, assignment: dict[str, float], values: list[float],
+                keys: list[str], cached: dict[float, dict[str, Any]],
+                seeds: dict[float, dict[str, float]] | None, cache: str | None,
+                tick: Callable[[int], None] | None = None) -> Solved:
+    """Find one line's gaits; its points without a gait are cached as final (in workers)."""
     tick = tick or _pool.notify
 
     def emit(i: int, rec: dict[str, Any]) -> None:
@@ -139,7 +141,21 @@ def _line_task(spec: StudySpec, assignment: dict[str, float], values: list[float
             _save(Path(cache), keys[i], rec)
         tick(1)
 
-    return solve_line(spec, assignment, values, seeds=seeds, cached=cached, emit=emit)
+    return solve_gaits(spec, assignment, values, seeds=seeds, cached=cached, emit=emit)
+
+
+def _analyse_task(spec: StudySpec, items: list[Pending], keys: list[str], cache: str | None,
+                  tick: Callable[[int], None] | None = None) -> list[dict[str, Any]]:
+    """Analyse solved points, caching each record as it is final (in workers)."""
+    tick = tick or _pool.notify
+    out = []
+    for item, key in zip(items, keys):
+        rec = analyse_point(spec, item)
+        if cache is not None:
+            _save(Path(cache), key, rec)
+        tick(1)
+        out.append(rec)
+    return out
 
 
 @dataclass(frozen=True)
@@ -179,7 +195,8 @@ def run_study(
         (and ``results.csv`` with ``csv=True``), ``run.json`` and ``.lock``.
         Without it nothing is cached or written.
     workers : int, optional
-        Worker processes (default: all cores; 1 runs in this process).
+        Worker processes (1 runs in this process). Default: by the work
+        left, up to all cores (:func:`tslip.sweeps._schedule.choose_workers`).
     scheduler : str, optional
         Address of a Dask distributed scheduler (``tslip[dask]``); the same
         lines then run on that cluster.
@@ -199,110 +216,205 @@ def run_study(
     tslip.sweeps._lock.FolderLocked
         If another live run holds ``out_dir`` (a ValueError).
     """
-    n_workers = workers if workers is not None else (os.cpu_count() or 1)
-    if n_workers < 1:
-        raise ValueError(f"workers must be >= 1, got {n_workers}")
+    if workers is not None and workers < 1:
+        raise ValueError(f"workers must be >= 1, got {workers}")
     try:
         if out_dir is None:
-            return _run(spec, None, n_workers, scheduler, progress, csv)
+            return _run(spec, None, workers, scheduler, progress, csv)
         with folder_lock(out_dir, wait=wait):
-            return _run(spec, Path(out_dir), n_workers, scheduler, progress, csv)
+            return _run(spec, Path(out_dir), workers, scheduler, progress, csv)
     except KeyboardInterrupt:  # the workers are stopped by now
         saved = saved_points(spec, out_dir) if out_dir is not None else 0
         raise StudyInterrupted(saved, spec.n_points) from None
 
 
-def _run(spec: StudySpec, out: Path | None, n_workers: int, scheduler: str | None,
+def _run(spec: StudySpec, out: Path | None, n_workers: int | None, scheduler: str | None,
          progress: Progress | None, csv: bool) -> StudyResult:
-    t_start = time.perf_counter()
-    cache = out / "cache" if out is not None else None
-    plan = study_keys(spec)
-    n_total = spec.n_points
-    names = _cached_names(cache)
-    records: list[list[dict[str, Any] | None]] = []
-    n_cached = 0
-    for _, _, keys in plan:
-        line: list[dict[str, Any] | None] = []
-        for k in keys:
-            rec = None
-            if f"{k}.json" in names:
-                try:
-                    rec = json.loads((cache / f"{k}.json").read_text())  # type: ignore[operator]
-                except ValueError:  # unreadable: compute it again
-                    rec = None
-            line.append(rec)
-            n_cached += rec is not None
-            if progress and n_cached % 5000 == 1:
-                progress(n_cached, n_total)
-        records.append(line)
-    done = n_cached
-    if progress:
-        progress(done, n_total)
+    job = StudyJob(spec, out, progress, writes=scheduler is None)
+    workers = 1 if scheduler is not None else choose_workers(job.cost, n_workers)
+    run_tasks(job.start(), job.on_done, workers, tick=job.tick, scheduler=scheduler)
+    return job.result(workers, scheduler, csv)
 
-    def tick(n: int) -> None:
-        nonlocal done
-        done += n
+
+#: Estimated seconds per point (warm compile cache, one core): its gait
+#: solve, and each analysis. They order the tasks (largest first) and size
+#: the analysis chunks and the worker count; they need not be exact.
+COST_SECONDS: dict[str, float] = {"solve": 0.12, "floquet": 0.005, "stride": 0.001,
+                                  "robustness": 0.025}
+#: Aimed-at seconds of one task of analyses: points are analysed in chunks
+#: about this long (one point at least).
+CHUNK_SECONDS = 0.4
+
+
+class StudyJob:
+    """A study as scheduler tasks (:mod:`tslip.sweeps._schedule`).
+
+    Each line is a solve task (:func:`tslip.sweeps.point.solve_gaits`); when
+    it is done its successors in the 2-D continuation are ready (seeded with
+    its gaits) and its solved points are analysed in chunks of about
+    :data:`CHUNK_SECONDS`, each point cached the moment it is final by the
+    process that computed it (``writes``; else here, as it arrives). Cached
+    points are replayed, not recomputed. :meth:`result` assembles and writes
+    the study's table.
+    """
+
+    def __init__(self, spec: StudySpec, out: Path | None, progress: Progress | None = None,
+                 writes: bool = True) -> None:
+        self.t_start = time.perf_counter()
+        self.spec, self.out, self.writes = spec, out, writes
+        self.cache = out / "cache" if out is not None else None
+        self.plan = study_keys(spec)
+        self.progress = progress
+        self.n_total = spec.n_points
+        names = _cached_names(self.cache)
+        self.records: list[list[dict[str, Any] | None]] = []
+        n_cached = 0
+        for _, _, keys in self.plan:
+            line: list[dict[str, Any] | None] = []
+            for k in keys:
+                rec = None
+                if f"{k}.json" in names:
+                    try:
+                        rec = json.loads((self.cache / f"{k}.json").read_text())  # type: ignore[operator]
+                    except ValueError:  # unreadable: compute it again
+                        rec = None
+                line.append(rec)
+                n_cached += rec is not None
+                if progress and n_cached % 5000 == 1:
+                    progress(n_cached, self.n_total)
+            self.records.append(line)
+        self.n_cached = self.done = n_cached
         if progress:
-            progress(min(done, n_total), n_total)
+            progress(n_cached, self.n_total)
+        self.pred, self.succ = _chains(spec)
+        self.inner = spec.axes[-1].param
+        self.seeds: list[dict[float, dict[str, float]] | None] = [None] * len(self.plan)
+        self.per_point = sum(COST_SECONDS[a] for a in set(spec.analyses))
+        self.depth = [0] * len(self.plan)
+        for i in sorted(range(len(self.plan)), key=self._chain_index, reverse=True):
+            self.depth[i] = 1 + max((self.depth[j] for j in self.succ[i]), default=0)
 
-    # 2-D studies: lines form two chains outward from the line nearest the base
-    # value; each line is seeded with its predecessor's solutions.
-    pred, succ = _chains(spec)
-    inner = spec.axes[-1].param
+    def _chain_index(self, i: int) -> int:
+        """Distance of line ``i`` from its chain's root."""
+        n = 0
+        while self.pred[i] is not None:
+            i, n = self.pred[i], n + 1  # type: ignore[assignment]
+        return n
 
-    def task(i: int, ex: _Serial) -> tuple:
-        assignment, values, keys = plan[i]
-        cached = {v: r for v, r in zip(values, records[i]) if r is not None}
-        seeds = None if pred[i] is None else seeds_from_records(records[pred[i]], inner)
-        return (_line_task, spec, assignment, values, keys, cached, seeds,
-                str(cache) if cache is not None and ex.writes else None)
+    @property
+    def missing(self) -> int:
+        """Points not cached yet."""
+        return sum(r is None for line in self.records for r in line)
 
-    ready = [i for i in range(len(plan)) if pred[i] is None]
-    with _executor(scheduler, n_workers, len(plan), tick) as ex:
-        running: dict[Any, int] = {}
-        while ready or running:
-            while ready:
-                i = ready.pop(0)
-                if any(r is None for r in records[i]):
-                    running[ex.submit(*task(i, ex))] = i
-                else:
-                    ready.extend(succ[i])  # fully cached: its successors may start
-            if running:
-                for fut in ex.wait_first(list(running)):
-                    i = running.pop(fut)
-                    recs = fut.result()
-                    if not ex.writes:
-                        _keep(cache, plan[i][2], records[i], recs, tick)
-                    records[i] = recs
-                    ready.extend(succ[i])
-            ex.poll()
-    if progress:
-        progress(n_total, n_total)
-    by_point = {tuple(r[a.param] for a in spec.axes): r for line in records for r in line}
-    frame = pd.DataFrame([by_point[pt] for pt in _points(spec)])  # type: ignore[index]
-    frame = frame.drop(columns=[c for c in frame.columns if c.startswith("_")])
-    meta = {
-        "tslip_version": __version__, "code": code_version(spec.analyses), "git": git_hash(),
-        "study": spec.to_dict(), "points": n_total, "computed": n_total - n_cached,
-        "cached": n_cached, "seconds": time.perf_counter() - t_start, "workers": n_workers,
-        "scheduler": scheduler, "tol": float(spec.meta.get("tol", 1e-10)),
-    }
-    if out is not None:
-        write_table(frame, out / "results.parquet")
-        if csv:
-            write_table(frame, out / "results.csv")
-        write_json(out / "run.json", meta)
-    return StudyResult(spec, frame, meta)
+    @property
+    def cost(self) -> float:
+        """Estimated seconds of the work left."""
+        return self.missing * (COST_SECONDS["solve"] + self.per_point)
 
+    def tick(self, n: int) -> None:
+        """``n`` more points are final."""
+        self.done += n
+        if self.progress:
+            self.progress(min(self.done, self.n_total), self.n_total)
 
-def _keep(cache: Path | None, keys: list[str], old: list[dict[str, Any] | None],
-          new: list[dict[str, Any]], tick: Callable[[int], None]) -> None:
-    """Cache the new points of a line that ran where the cache is not (Dask)."""
-    fresh = [(k, r) for k, o, r in zip(keys, old, new) if o is None]
-    if cache is not None:
-        for k, r in fresh:
-            _save(cache, k, r)
-    tick(len(fresh))
+    @property
+    def finished(self) -> bool:
+        return self.missing == 0
+
+    def start(self) -> list[Task]:
+        """The tasks ready at the start: the roots of the continuation chains."""
+        return self._ready([i for i in range(len(self.plan)) if self.pred[i] is None])
+
+    def _ready(self, lines: list[int]) -> list[Task]:
+        out: list[Task] = []
+        while lines:
+            i = lines.pop(0)
+            if any(r is None for r in self.records[i]):
+                out.append(self._solve(i))
+            else:  # fully cached: its successors may start
+                self.seeds[i] = seeds_from_records(self.records[i], self.inner)
+                lines.extend(self.succ[i])
+        return out
+
+    def _cache_arg(self) -> str | None:
+        return str(self.cache) if self.cache is not None and self.writes else None
+
+    def _solve(self, i: int) -> Task:
+        assignment, values, keys = self.plan[i]
+        cached = {v: r for v, r in zip(values, self.records[i]) if r is not None}
+        p = self.pred[i]
+        seeds = None if p is None else self.seeds[p]
+        n_new = len(values) - len(cached)
+        cost = n_new * COST_SECONDS["solve"]
+        chunk = min(n_new * self.per_point, max(CHUNK_SECONDS, self.per_point))
+        return Task((self.spec.name, "solve", i), _solve_task,
+                    (self.spec, assignment, values, keys, cached, seeds, self._cache_arg()),
+                    cost, priority=cost * self.depth[i] + chunk)
+
+    def on_done(self, task: Task, result: Any) -> list[Task]:
+        """A task of this study is done: keep its records; the tasks it made ready."""
+        i = task.key[1 + 1]
+        line = self.records[i]
+        if task.key[1] == "solve":
+            fresh = [(k, r) for k, o, r in zip(self.plan[i][2], line, result.records)
+                     if o is None and r is not None]
+            self._keep(fresh)
+            for j, r in enumerate(result.records):
+                if r is not None:
+                    line[j] = r
+            self.seeds[i] = result.seeds
+            return self._chunks(i, result.pending) + self._ready(list(self.succ[i]))
+        items = task.args[1]
+        keys = self.plan[i][2]
+        self._keep([(keys[it.index], r) for it, r in zip(items, result)])
+        for it, r in zip(items, result):
+            line[it.index] = r
+        return []
+
+    def _keep(self, fresh: list[tuple[str, dict[str, Any]]]) -> None:
+        """Records computed where the cache is not (Dask): cache them here."""
+        if self.writes:
+            return
+        if self.cache is not None:
+            for k, r in fresh:
+                _save(self.cache, k, r)
+        self.tick(len(fresh))
+
+    def _chunks(self, i: int, pending: list[Pending]) -> list[Task]:
+        size = max(1, int(CHUNK_SECONDS // max(self.per_point, 1e-9)))
+        keys = self.plan[i][2]
+        out = []
+        for c in range(0, len(pending), size):
+            items = pending[c:c + size]
+            cost = len(items) * self.per_point
+            out.append(Task((self.spec.name, "analyse", i, c), _analyse_task,
+                            (self.spec, items, [keys[it.index] for it in items],
+                             self._cache_arg()), cost))
+        return out
+
+    def result(self, workers: int, scheduler: str | None = None,
+               csv: bool = False) -> StudyResult:
+        """The study's table (written to its folder, with ``run.json``)."""
+        spec, out = self.spec, self.out
+        if self.progress:
+            self.progress(self.n_total, self.n_total)
+        by_point = {tuple(r[a.param] for a in spec.axes): r for line in self.records
+                    for r in line}  # type: ignore[union-attr]
+        frame = pd.DataFrame([by_point[pt] for pt in _points(spec)])
+        frame = frame.drop(columns=[c for c in frame.columns if c.startswith("_")])
+        meta = {
+            "tslip_version": __version__, "code": code_version(spec.analyses), "git": git_hash(),
+            "study": spec.to_dict(), "points": self.n_total,
+            "computed": self.n_total - self.n_cached, "cached": self.n_cached,
+            "seconds": time.perf_counter() - self.t_start, "workers": workers,
+            "scheduler": scheduler, "tol": float(spec.meta.get("tol", 1e-10)),
+        }
+        if out is not None:
+            write_table(frame, out / "results.parquet")
+            if csv:
+                write_table(frame, out / "results.csv")
+            write_json(out / "run.json", meta)
+        return StudyResult(spec, frame, meta)
 
 
 def _points(spec: StudySpec) -> list[tuple[float, ...]]:
@@ -325,103 +437,3 @@ def _chains(spec: StudySpec) -> tuple[list[int | None], list[list[int]]]:
         if p is not None:
             succ[p].append(i)
     return pred, succ
-
-
-class _Serial:
-    """Runs each line when submitted, in this process."""
-
-    writes = True  #: the tasks write the cache themselves
-
-    def __init__(self, tick: Callable[[int], None]) -> None:
-        self.tick = tick
-
-    def __enter__(self) -> _Serial:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        return None
-
-    def submit(self, fn: Callable, *args: Any) -> cf.Future:
-        fut: cf.Future = cf.Future()
-        fut.set_result(fn(*args, self.tick))
-        return fut
-
-    def wait_first(self, futs: list) -> list:
-        return futs
-
-    def poll(self) -> None:
-        return None
-
-
-class _Pool(_Serial):
-    """Worker processes (:func:`tslip.sweeps._pool.process_pool`); progress by queue."""
-
-    def __init__(self, n: int, tick: Callable[[int], None]) -> None:
-        super().__init__(tick)
-        self.n = n
-        self.stack = ExitStack()
-
-    def __enter__(self) -> _Pool:
-        self.queue = _pool.progress_queue()
-        self.pool = self.stack.enter_context(_pool.process_pool(self.n, self.queue))
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        self.stack.__exit__(*exc)
-        self.queue.close()
-
-    def submit(self, fn: Callable, *args: Any) -> cf.Future:
-        return self.pool.submit(fn, *args)
-
-    def wait_first(self, futs: list) -> list:
-        return list(cf.wait(futs, timeout=0.2, return_when=cf.FIRST_COMPLETED).done)
-
-    def poll(self) -> None:
-        n = 0
-        try:
-            while True:
-                n += self.queue.get_nowait()
-        except (queue_mod.Empty, OSError, ValueError):
-            pass
-        if n:
-            self.tick(n)
-
-
-class _Dask(_Serial):
-    writes = False  # the cluster may not see the cache: this process writes it
-
-    def __init__(self, address: str, tick: Callable[[int], None]) -> None:
-        super().__init__(tick)
-        try:
-            from dask.distributed import Client
-        except ImportError:
-            raise ValueError("--scheduler needs Dask: pip install 'tslip[dask]'") from None
-        self.client = Client(address)
-        self.futures: list = []
-
-    def __enter__(self) -> _Dask:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        if exc[0] is not None:
-            self.client.cancel(self.futures)
-        self.client.close()
-
-    def submit(self, fn: Callable, *args: Any) -> Any:
-        fut = self.client.submit(fn, *args, pure=False)
-        self.futures.append(fut)
-        return fut
-
-    def wait_first(self, futs: list) -> list:
-        from dask.distributed import wait
-
-        return list(wait(futs, return_when="FIRST_COMPLETED").done)
-
-
-def _executor(scheduler: str | None, workers: int, n_lines: int,
-              tick: Callable[[int], None]) -> _Serial:
-    if scheduler is not None:
-        return _Dask(scheduler, tick)
-    if workers == 1 or n_lines <= 1:
-        return _Serial(tick)
-    return _Pool(min(workers, n_lines), tick)
