@@ -4,6 +4,7 @@ a parallel reproduction equals a serial one bit for bit; an interrupted one resu
 import dataclasses
 import math
 import os
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -111,7 +112,7 @@ def _same(a, b, path="data") -> None:
         assert list(a) == list(b), path
         for k in a:
             _same(a[k], b[k], f"{path}[{k!r}]")
-    elif isinstance(a, list | tuple):
+    elif isinstance(a, Sequence) and not isinstance(a, str):  # lists, Trajectory.steps
         assert len(a) == len(b), path
         for i, (x, y) in enumerate(zip(a, b)):
             _same(x, y, f"{path}[{i}]")

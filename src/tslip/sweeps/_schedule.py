@@ -60,7 +60,7 @@ class Task:
     longest chain starts first.
     """
 
-    key: Hashable
+    key: tuple[Any, ...]
     fn: Callable[..., Any]
     args: tuple[Any, ...] = ()
     cost: float = 1.0

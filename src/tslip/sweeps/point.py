@@ -53,6 +53,7 @@ from ..gait.fixed_point import Gait, GaitProblem, find_gait
 from ..gait.robustness import KINDS, robustness_report
 from ..gait.stability import floquet
 from ..gait.stride import stride_properties
+from ..model.parameters import Params
 from .spec import StudySpec
 
 __all__ = ["CODE", "MAX_FAILURES", "Pending", "Solved", "analyse_point", "code_version",
@@ -216,8 +217,7 @@ class _Line:
         self.failed = [(math.nan, "no periodic gait found along this line")] * n
         for i in np.unique(np.linspace(0, n - 1, min(n_probe, n)).round()):
             p = self.point_params(int(i))
-            self.attempt(int(i), lambda p=p: (find_gait(p, tol=self.tol), message),
-                         keep_failure=False)
+            self.attempt(int(i), functools.partial(self._probe, p, message), keep_failure=False)
         self.grow(message)
 
     def continue_from(self, seeds: dict[float, dict[str, float]]) -> None:
@@ -278,11 +278,15 @@ class _Line:
         return Solved(list(self.records), [self.pending[i] for i in sorted(self.pending)],
                       seeds_from_records(heads, self.inner))
 
+    def _probe(self, p: Params, message: str) -> tuple[Gait, str]:
+        return find_gait(p, tol=self.tol), message
+
     def head(self, i: int) -> dict[str, Any] | None:
         """The record of point ``i`` as far as seeding goes (its unknowns)."""
         if i in self.pending:
             item = self.pending[i]
-            return {**item.point, "converged": True, **_unknowns(item.gait)}
+            known = _unknowns(item.gait) if item.gait is not None else {}
+            return {**item.point, "converged": True, **known}
         return self.records[i]
 
 
@@ -432,7 +436,8 @@ def solve_line(spec: StudySpec, assignment: dict[str, float], values: Sequence[f
     solved = solve_gaits(spec, assignment, values, seeds=seeds, cached=cached, emit=emit)
     records = list(solved.records)
     for item in solved.pending:
-        records[item.index] = analyse_point(spec, item)
+        rec = analyse_point(spec, item)
+        records[item.index] = rec
         if emit is not None:
-            emit(item.index, records[item.index])
+            emit(item.index, rec)
     return records  # type: ignore[return-value]

@@ -32,6 +32,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import itertools
+import math
 import pickle
 import time
 from collections.abc import Callable
@@ -46,6 +47,7 @@ from .._io import atomic_write
 from ..gait import find_gait, floquet, robustness_report, stride_properties
 from ..gait.fixed_point import Gait, GaitProblem, newton_solve
 from ..gait.robustness import robustness
+from ..model.controllers import LocalVelocity
 from ..model.parameters import preset
 from ..simulation.options import IntegratorOptions
 from . import catalogue
@@ -120,6 +122,9 @@ def alphad_ref_forced(gait: Gait, alphad_ref: float = THESIS_ALPHAD_REF) -> dict
     is our solved ``alphad_ref``.
     """
     p = gait.params
+    if not isinstance(p.controller, LocalVelocity):
+        raise ValueError("alphad_ref_forced needs a gait with LocalVelocity control (Table 6.1)")
+    free = p.controller.alphad_ref
     forced = dataclasses.replace(p, controller=dataclasses.replace(p.controller,
                                                                    alphad_ref=alphad_ref))
     names = ("delta", "phi", "phid", "alpha_r")
@@ -129,7 +134,11 @@ def alphad_ref_forced(gait: Gait, alphad_ref: float = THESIS_ALPHAD_REF) -> dict
                              max_starts=5)
     c1 = float(np.sum(prob.residual(z) ** 2)) if z is not None else float("inf")
     return {"alphad_ref": float(alphad_ref), "residual": float(err), "c1": c1,
-            "free": float(p.controller.alphad_ref)}
+            "free": float(free)}
+
+
+def _pitch_rate_piece(label: str, g: Gait) -> float:
+    return pitch_rate_variant(g, label)
 
 
 def _table61_core(g: Gait) -> dict[str, Any]:
@@ -140,14 +149,15 @@ def _table61_core(g: Gait) -> dict[str, Any]:
             "step_down": rr.step_down, "push": rr.push, "pitch_rate": rr.pitch_rate,
             "stance_time": sp.stance_time, "flight_time": sp.flight_time,
             "duty_factor": sp.duty_factor, "step_frequency": sp.step_frequency,
-            "alphad_ref": g.params.controller.alphad_ref, "alpha_r": g.params.alpha_r}
+            "alphad_ref": getattr(g.params.controller, "alphad_ref", math.nan),
+            "alpha_r": g.params.alpha_r}
 
 
 #: Table 6.1's independent pieces (:func:`table61`), each a task of ``tslip reproduce``:
 #: name -> (function of the gait, estimated seconds).
 TABLE61_PIECES: dict[str, tuple[Callable[[Gait], Any], float]] = {
     "core": (_table61_core, 0.2),
-    **{f"pitch_rate/{label}": ((lambda g, label=label: pitch_rate_variant(g, label)), 0.02)
+    **{f"pitch_rate/{label}": (functools.partial(_pitch_rate_piece, label), 0.02)
        for label in PITCH_RATE_VARIANTS},
     "alphad_ref_forced": (alphad_ref_forced, 0.15),
 }

@@ -399,7 +399,7 @@ class StudyJob:
         if self.progress:
             self.progress(self.n_total, self.n_total)
         by_point = {tuple(r[a.param] for a in spec.axes): r for line in self.records
-                    for r in line}  # type: ignore[union-attr]
+                    for r in line if r is not None}
         frame = pd.DataFrame([by_point[pt] for pt in _points(spec)])
         frame = frame.drop(columns=[c for c in frame.columns if c.startswith("_")])
         meta = {
