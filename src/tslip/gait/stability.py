@@ -36,7 +36,8 @@ from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status
 from .fixed_point import TIGHT, Gait
 
-__all__ = ["Floquet", "floquet", "map_jacobian", "conserved_gradients", "pitch_decoupled"]
+__all__ = ["Floquet", "floquet", "map_jacobian", "conserved_gradients", "pitch_decoupled",
+           "nontrivial_jacobian"]
 
 Stability = Literal["asymptotic", "neutral", "unstable"]
 TrivialKind = Literal["", "energy", "pitch"]
@@ -124,6 +125,23 @@ def pitch_decoupled(params: Params) -> bool:
     if params.r != 0.0 or a1 != 0.0 or a3 != 0.0:
         return False
     return (a0 == 0.0 and a2 == 0.0) or params.leg_reset == "global"
+
+
+def nontrivial_jacobian(params: Params, q: np.ndarray, A: np.ndarray) -> np.ndarray:
+    """The stride map's Jacobian ``A`` at ``q`` with its structural multipliers removed.
+
+    Without the decoupled pitch (:func:`pitch_decoupled`), then restricted to
+    the kernel of the conserved energy's gradient, which is invariant at a
+    fixed point and nearly so near one (the eq. 2.21 cost of the gait search).
+    """
+    grads = conserved_gradients(params, q)
+    if pitch_decoupled(params):
+        A = A[np.ix_(_NO_PITCH, _NO_PITCH)]
+        grads = [gr[_NO_PITCH] for gr in grads[:1]]  # the energy; the pitch rate went above
+    if grads:
+        Q = np.linalg.svd(np.array(grads))[2][len(grads):].T  # orthonormal basis of ker
+        A = Q.T @ A @ Q
+    return A
 
 
 def map_jacobian(
