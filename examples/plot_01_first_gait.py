@@ -16,8 +16,9 @@ gait = tslip.find_gait(params)         # solves delta, phi, phid and alpha_r (Se
 print(f"stance {gait.stance_time:.4f}, flight {gait.flight_time:.4f}, "
       f"residual {gait.residual:.1e}")
 
-# A conservative runner keeps its energy: one multiplier is exactly 1 (the energy's),
-# so at best it is neutrally stable; the others lie inside the unit circle.
+# A conservative runner keeps its energy: one multiplier is exactly 1 (the energy's, set
+# aside as trivial); the others lie inside the unit circle, so the gait is asymptotically
+# stable on its energy level (docs/conventions.md).
 fl = tslip.floquet(gait)               # exact multipliers (variational equations)
 print(f"largest non-trivial |lambda| = {fl.max_nontrivial:.3f}: {fl.stability}")
 

@@ -32,7 +32,7 @@ def test_gait_json_report_has_thesis_numbers():
 def test_gait_text_report_and_plots(tmp_path):
     res = invoke("gait", "--preset", "table2.1", "--no-robustness", "--plot", tmp_path)
     assert res.exit_code == 0, res.output
-    assert "neutral" in res.stdout and "trivial (conserved quantity)" in res.stdout
+    assert "asymptotic" in res.stdout and "trivial (conserved energy)" in res.stdout
     for name in ("pitch_impulse.png", "impulse_linearisation.png", "friction.png"):
         data = (tmp_path / name).read_bytes()
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 5000
@@ -53,7 +53,7 @@ def test_continue_saves_branch_with_stability(tmp_path):
     df = pd.read_csv(out)
     assert len(df) == 13 and df["converged"].all()
     stab = dict(zip(df["value"].round(3), df["stability"]))
-    assert stab[-0.2] == "unstable" and stab[0.5] == "neutral" and stab[1.0] == "unstable"
+    assert stab[-0.2] == "unstable" and stab[0.5] == "asymptotic" and stab[1.0] == "unstable"
     assert (tmp_path / "b.png").stat().st_size > 5000
 
 

@@ -33,7 +33,8 @@ def test_minimum_running_speed_then_stable_above_it(v0_branch):
     """Figure 4.8: a minimum running velocity; stable above a threshold.
 
     Measured: the branch folds between v0 = 2.0 and 2.5 (about 2.33), is unstable
-    up to 3.99 and neutral (one energy multiplier at 1) above it, to v0 = 10.
+    up to 3.99 and asymptotic on the energy level (the energy multiplier at 1 is
+    trivial) above it, to v0 = 10.
     """
     b = v0_branch
     v = b.values
@@ -48,7 +49,8 @@ def test_minimum_running_speed_then_stable_above_it(v0_branch):
     (v_s,) = stability_boundaries(b)
     assert 3.5 < v_s < 4.0
     assert np.all(b.stable[v > v_s]) and not np.any(b.stable[v < v_s])
-    assert set(np.array(b.stability)[v > v_s]) == {"neutral"}
+    assert set(np.array(b.stability)[v > v_s]) == {"asymptotic"}
+    assert np.all(b.trivial[b.converged].sum(axis=1) == 1)  # the energy multiplier
     assert np.all(b.max_nontrivial[v < v_s][b.converged[v < v_s]] > 1.0 + 1e-6)
     # the linear estimate brackets the refined one to the grid spacing
     assert stability_boundaries(b, refine=False)[0] == pytest.approx(v_s, abs=0.05)
@@ -89,8 +91,10 @@ def test_constant_torque_grows_with_leg_damping():
     tau = b.to_dataframe()["tau_c"].to_numpy()
     assert tau[0] == 0.0  # no damping: the torque vanishes (eq. 2.15 text)
     assert np.all(np.diff(tau) > 0.0)
-    # leg damping makes the gait asymptotically stable (Figure 4.12)
-    assert b.stability[0] == "neutral" and set(b.stability[1:]) == {"asymptotic"}
+    # leg damping makes the gait asymptotically stable (Figure 4.12): without it the
+    # energy multiplier is 1 (trivial; stable on the energy level), with it inside
+    assert set(b.stability) == {"asymptotic"}
+    assert b.trivial[0].sum() == 1 and not b.trivial[1:].any()
 
 
 def test_secant_and_constant_predictors_agree():
@@ -139,7 +143,7 @@ def test_to_dataframe_is_tidy(v0_branch):
     row = ok[ok["value"] == 5.0].iloc[0]
     ref = floquet(find_gait(PASSIVE))
     assert row["max_nontrivial"] == pytest.approx(ref.max_nontrivial, abs=1e-10)
-    assert row["stability"] == "neutral"
+    assert row["stability"] == "asymptotic"
 
 
 def test_cold_solves_agree_with_the_branch_across_the_mass_offset_range(r_branch):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import tslip
-from tslip.gait.stability import conserved_gradients, floquet, map_jacobian
+from tslip.gait.stability import conserved_gradients, floquet, map_jacobian, pitch_decoupled
 
 CASES = {
     "table2.1": tslip.preset("table2.1"),
@@ -47,10 +47,12 @@ def test_table_6_1_largest_multiplier(gaits):
     assert f.stability == "asymptotic" and not f.trivial.any()
 
 
-def test_table_2_1_passive_is_neutral_with_one_energy_multiplier(gaits):
+def test_table_2_1_passive_is_stable_on_its_energy_level_with_one_energy_multiplier(gaits):
+    """Conservative: the energy multiplier 1 is trivial, the label comes from the others."""
     g = gaits["table2.1"]
     f = floquet(g)
-    assert f.stability == "neutral" and f.trivial.sum() == 1
+    assert f.stability == "asymptotic" and f.trivial.sum() == 1
+    assert f.trivial_kinds[int(np.argmax(f.trivial))] == "energy"
     lam = f.multipliers[f.trivial][0]
     assert abs(lam - 1.0) < 1e-6
     assert np.all(np.abs(f.multipliers[~f.trivial]) < 1.0)
@@ -71,11 +73,35 @@ def test_mass_above_hip_or_too_low_is_unstable(r):
     assert f.stability == "unstable" and f.max_nontrivial > 1.0 + 1e-6
 
 
-def test_r_zero_has_two_structural_multipliers():
+def test_r_zero_sets_the_decoupled_pitch_and_the_energy_aside():
+    """r = 0, passive, local reset: the pitch block [[1, T], [0, 1]] and the energy."""
     g = tslip.find_gait(dataclasses.replace(tslip.preset("table2.1"), r=0.0))
     f = floquet(g)
-    assert f.trivial.sum() == 2
-    assert np.all(np.abs(f.multipliers[f.trivial] - 1.0) < 1e-4)
+    assert sorted(f.trivial_kinds) == ["", "", "energy", "pitch", "pitch"]
+    assert np.all(np.abs(f.multipliers[f.trivial] - 1.0) < 1e-6)
+    # the pitch rows of the Jacobian are those of a free rotation over the stride time
+    T = g.stance_time + g.flight_time
+    np.testing.assert_allclose(f.jacobian[[1, 4]], [[0, 1, 0, 0, T], [0, 0, 0, 0, 1]],
+                               atol=1e-9)
+    # the others are the eigenvalues of the Jacobian on (beta, xd, yd)
+    red = np.linalg.eigvals(f.jacobian[np.ix_([0, 2, 3], [0, 2, 3])])
+    rest = f.multipliers[[k != "pitch" for k in f.trivial_kinds]]
+    np.testing.assert_allclose(np.sort(np.abs(red)), np.sort(np.abs(rest)), atol=1e-12)
+
+
+@pytest.mark.parametrize("controller, reset, decoupled", [
+    (tslip.Passive(), "local", True),
+    (tslip.ConstantTorque(tau_c=0.1, c_h=0.0), "global", True),
+    (tslip.ConstantTorque(tau_c=0.1, c_h=0.0), "local", False),  # beta_TD depends on phi
+    (tslip.ConstantTorque(tau_c=0.0, c_h=0.5), "global", False),  # torque on phid
+    (tslip.GlobalPD(), "global", False),
+    (tslip.LocalVelocity(), "global", False),
+])
+def test_which_controllers_decouple_the_pitch(controller, reset, decoupled):
+    p = dataclasses.replace(tslip.preset("table2.1"), r=0.0, controller=controller,
+                            leg_reset=reset)
+    assert pitch_decoupled(p) is decoupled
+    assert not pitch_decoupled(dataclasses.replace(p, r=1e-9))
 
 
 def test_local_velocity_equals_constant_torque_with_hip_damping(gaits):

@@ -123,3 +123,37 @@ def test_hip_reaching_ground_in_flight_is_a_fall_not_a_timeout():
     tr = tslip.simulate(g.params, s, 25, terrain=tslip.Terrain.step(xf, -0.13))
     assert tr.status == Status.FALL_NO_TOUCHDOWN
     assert tr.steps[-1].flight_time < 10.0
+
+
+def test_touchdown_with_the_leg_lengthening_is_a_failed_touchdown():
+    """A spring leg cannot pull: ld > 0 at touch-down ends the contact at once.
+
+    Human-scale SLIP (80 kg, 20 kN/m) landing while the body rises along the leg:
+    the mass moves away from the foot along the leg, so the spring would stretch
+    past l0 and pull (before the rule: F_y down to about -890 N in a 0.34 s stance).
+    """
+    p = tslip.preset("slip-human")
+    s = tslip.TouchdownState(beta=p.beta0, phi=0.0, xd=1.0, yd=0.6, phid=0.0, x=0.0, h=0.0)
+    # the CoM velocity along the leg, away from the foot (r = 0: the CoM is the hip)
+    ld = -s.xd * math.cos(s.beta) + s.yd * math.sin(s.beta)
+    assert ld > 0.1
+    r = tslip.step(p, s)
+    assert r.fell and r.status == Status.FALL_LENGTHENING and "lengthening" in r.reason
+    assert r.stance_time == 0.0 and r.state is None
+    assert r.liftoff.ld == pytest.approx(ld, rel=1e-12) and r.liftoff.l == p.l0
+    # a leg touching down while shortening, however slowly, starts an ordinary stance
+    s_in = dataclasses.replace(s, yd=(s.xd * math.cos(s.beta) - 1e-3) / math.sin(s.beta))
+    assert tslip.step(p, s_in).stance_time > 0.0
+
+
+def test_negative_fy_from_the_hip_torque_with_the_leg_shortening_keeps_the_stance():
+    """Thesis case (Table 6.1 model, eq. 2.6): F_y < 0 at touch-down from the hip torque
+    alone, the spring compressing (ld < 0): the stance goes on until F_y crosses zero
+    from above (docs/conventions.md, "Events")."""
+    g = tslip.find_gait(tslip.preset("table6.1"))
+    s = dataclasses.replace(g.state, phid=g.state.phid + 3.0)  # hip torque -Kd alphad
+    r = tslip.step(g.params, s)
+    assert r.fy_negative_at_touchdown and r.grf[0, 2] < 0.0
+    assert r.stance[0, 4] < 0.0  # ld at touch-down: the spring compresses
+    assert r.ok and r.stance_time > 0.3
+    assert r.grf[:, 2].max() > 1.0 and r.grf[-1, 2] == pytest.approx(0.0, abs=1e-6)

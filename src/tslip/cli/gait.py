@@ -43,6 +43,10 @@ commands = typer.Typer()
 _POINT_BYTES = 2000.0
 
 
+#: Why a multiplier is trivial (tslip.gait.stability.Floquet.trivial_kinds).
+_TRIVIAL = {"energy": "trivial (conserved energy)", "pitch": "trivial (decoupled pitch, r = 0)"}
+
+
 def _fmt(x: Any, digits: int = 4) -> str:
     if x is None or (isinstance(x, float) and not math.isfinite(x)):
         return "-"
@@ -79,7 +83,7 @@ def _print_report(rep: dict[str, Any]) -> None:
         for m in fl["multipliers"]:
             z = complex(m["re"], m["im"])
             t.add_row(f"{z.real:+.5f}{z.imag:+.5f}j", f"{m['abs']:.5f}",
-                      "trivial (conserved quantity)" if m["trivial"] else "")
+                      _TRIVIAL.get(m.get("trivial_kind", ""), "") if m["trivial"] else "")
         console.print(t)
     s = rep["stride"]
     t = _table("stride", "quantity", "model", "theory", "source")

@@ -28,7 +28,7 @@ from .impulse import (
 )
 from .report import analyse
 from .robustness import RobustnessLimit, RobustnessResult, robustness, robustness_report
-from .stability import Floquet, floquet, map_jacobian
+from .stability import Floquet, floquet, map_jacobian, pitch_decoupled
 from .stride import (
     FrictionCheck,
     StrideProperties,
@@ -48,7 +48,7 @@ __all__ = [
     "Impulse", "ImpulseLinearisation", "PitchResponse", "impulse_linearisation",
     "pitch_disturbance_response", "stance_impulse", "analyse",
     "RobustnessLimit", "RobustnessResult", "robustness", "robustness_report",
-    "Floquet", "floquet", "map_jacobian",
+    "Floquet", "floquet", "map_jacobian", "pitch_decoupled",
     "FrictionCheck", "StrideProperties", "bounce_time", "fast_running_index", "friction_ratio",
     "predicted_flight_time", "predicted_stance_time", "stride_properties",
 ]

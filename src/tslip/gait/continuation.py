@@ -328,7 +328,7 @@ def continue_gait(
     >>> import tslip
     >>> b = continue_gait(tslip.preset("table2.1"), "v0", [4.0, 5.0, 6.0])
     >>> b.converged.tolist(), b.stability
-    ([True, True, True], ('neutral', 'neutral', 'neutral'))
+    ([True, True, True], ('asymptotic', 'asymptotic', 'asymptotic'))
     """
     params = gait_or_params.params if isinstance(gait_or_params, Gait) else gait_or_params
     base_value = get_param(params, param)

@@ -421,13 +421,11 @@ class GaitProblem:
            jacobian: Literal["fd", "exact"] = "fd") -> float:
         """Eq. 2.21: largest squared non-trivial multiplier magnitude at ``z``.
 
-        The structural multipliers of conserved quantities (energy; pitch rate
-        at ``r = 0``) are removed by restricting the stride map's Jacobian to
-        the kernel of the conserved gradients, which is invariant at a fixed
-        point and nearly so at the near-fixed points of eq. 2.22. NaN when a
-        perturbed stride falls.
+        The structural multipliers (the energy's; the decoupled pitch's at
+        ``r = 0``) are removed by :func:`~tslip.gait.stability.nontrivial_jacobian`.
+        NaN when a perturbed stride falls.
         """
-        from .stability import conserved_gradients, map_jacobian
+        from .stability import map_jacobian, nontrivial_jacobian
 
         p, s = self.decode(z)
         q = s.section()
@@ -437,12 +435,7 @@ class GaitProblem:
             return math.nan
         if not np.all(np.isfinite(A)):
             return math.nan
-        grads = conserved_gradients(p, q)
-        if grads:
-            G = np.array(grads)
-            Q = np.linalg.svd(G)[2][len(grads):].T  # orthonormal basis of ker(G)
-            A = Q.T @ A @ Q
-        lam = np.linalg.eigvals(A)
+        lam = np.linalg.eigvals(nontrivial_jacobian(p, q, A))
         return float(np.max(np.abs(lam)) ** 2) if lam.size else 0.0
 
     def cost(self, z: Sequence[float] | np.ndarray, *, eps: float = C1_THRESHOLD,

@@ -81,7 +81,8 @@ def analyse(
         fl = floquet(gait, options=options)
         out["floquet"] = {
             "multipliers": [{"re": float(z.real), "im": float(z.imag), "abs": float(abs(z)),
-                             "trivial": bool(t)} for z, t in zip(fl.multipliers, fl.trivial)],
+                             "trivial": bool(t), "trivial_kind": kind}
+                            for z, t, kind in zip(fl.multipliers, fl.trivial, fl.trivial_kinds)],
             "max_nontrivial": fl.max_nontrivial,
             "stability": fl.stability,
         }

@@ -12,8 +12,13 @@ point (eqs B.1-B.4). Two ways to get ``A``:
 A conservative model (passive without damping) keeps its energy, so ``A`` has
 the multiplier 1 with the energy gradient as left eigenvector: a structural
 ("trivial") multiplier, excluded from the largest multiplier as in eq. 2.21.
-With ``r = 0`` and no hip torque the pitch rate is conserved too, giving a
-second one (docs/conventions.md).
+
+With ``r = 0`` and a hip torque that does not depend on the pitch, the pitch
+decouples (:func:`pitch_decoupled`): ``phi`` and ``phid`` pass through a
+stride as ``(phi + phid T, phid)``, a Jordan block with two multipliers exactly
+1. The stability is then evaluated on the section that excludes the decoupled
+pitch, ``(beta, xd, yd)``, and the two pitch multipliers are reported as
+trivial (docs/conventions.md, "Poincare section and periodic gaits").
 """
 
 from __future__ import annotations
@@ -31,9 +36,13 @@ from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status
 from .fixed_point import TIGHT, Gait
 
-__all__ = ["Floquet", "floquet", "map_jacobian", "conserved_gradients"]
+__all__ = ["Floquet", "floquet", "map_jacobian", "conserved_gradients", "pitch_decoupled",
+           "nontrivial_jacobian"]
 
 Stability = Literal["asymptotic", "neutral", "unstable"]
+TrivialKind = Literal["", "energy", "pitch"]
+#: Indices of the section without the pitch: (beta, xd, yd) of (beta, phi, xd, yd, phid).
+_NO_PITCH = [0, 2, 3]
 
 
 @dataclass(frozen=True)
@@ -45,12 +54,19 @@ class Floquet:
     multipliers : ndarray of complex, shape (5,)
         Eigenvalues of the stride map's Jacobian, largest magnitude first.
     trivial : ndarray of bool, shape (5,)
-        Structural multipliers at 1 from conserved quantities.
+        Structural multipliers at 1: the conserved energy, and the decoupled
+        pitch (:func:`pitch_decoupled`).
     max_nontrivial : float
         Largest magnitude among the others.
     stability : {"asymptotic", "neutral", "unstable"}
+        From the non-trivial multipliers only: a conservative gait labelled
+        "asymptotic" is asymptotically stable on its energy level (a change
+        of energy moves it to the neighbouring gait of its family).
     jacobian : ndarray, shape (5, 5)
     method : str
+    trivial_kinds : tuple of str, length 5
+        Why each multiplier is trivial: ``"energy"``, ``"pitch"`` (two, with
+        the stability evaluated on the section without the pitch), or ``""``.
     """
 
     multipliers: np.ndarray
@@ -59,6 +75,7 @@ class Floquet:
     stability: Stability
     jacobian: np.ndarray = field(repr=False)
     method: str = "exact"
+    trivial_kinds: tuple[TrivialKind, ...] = ()
 
     @property
     def magnitudes(self) -> np.ndarray:
@@ -88,6 +105,43 @@ def conserved_gradients(params: Params, q: np.ndarray) -> list[np.ndarray]:
     if p.r == 0.0:
         grads.append(np.array([0.0, 0.0, 0.0, 0.0, 1.0]))
     return grads
+
+
+def pitch_decoupled(params: Params) -> bool:
+    """Whether the pitch decouples from the stride map's other section variables.
+
+    True when ``r = 0`` (the CoM at the hip: gravity exerts no pitch moment)
+    and the hip torque ``a0 + a1 phi + a2 betad + a3 phid`` does not depend on
+    the pitch (``a1 = a3 = 0``), and in addition either exerts no torque at
+    all or the leg resets in the inertial frame (``leg_reset="global"``, so
+    the touch-down angle does not depend on ``phi``). Then the Jacobian on
+    ``(beta, phi, xd, yd, phid)`` is block triangular with the pitch block
+    ``[[1, T], [0, 1]]`` (``T`` the stride time; ``phid = 0`` at a fixed
+    point). Controllers: :class:`~tslip.model.controllers.Passive` always;
+    ``ConstantTorque`` with ``c_h = 0`` under the global reset; ``GlobalPD``
+    and ``LocalVelocity`` only with zero gains.
+    """
+    a0, a1, a2, a3 = params.controller.torque_coefficients()
+    if params.r != 0.0 or a1 != 0.0 or a3 != 0.0:
+        return False
+    return (a0 == 0.0 and a2 == 0.0) or params.leg_reset == "global"
+
+
+def nontrivial_jacobian(params: Params, q: np.ndarray, A: np.ndarray) -> np.ndarray:
+    """The stride map's Jacobian ``A`` at ``q`` with its structural multipliers removed.
+
+    Without the decoupled pitch (:func:`pitch_decoupled`), then restricted to
+    the kernel of the conserved energy's gradient, which is invariant at a
+    fixed point and nearly so near one (the eq. 2.21 cost of the gait search).
+    """
+    grads = conserved_gradients(params, q)
+    if pitch_decoupled(params):
+        A = A[np.ix_(_NO_PITCH, _NO_PITCH)]
+        grads = [gr[_NO_PITCH] for gr in grads[:1]]  # the energy; the pitch rate went above
+    if grads:
+        Q = np.linalg.svd(np.array(grads))[2][len(grads):].T  # orthonormal basis of ker
+        A = Q.T @ A @ Q
+    return A
 
 
 def map_jacobian(
@@ -158,24 +212,32 @@ def floquet(
     """
     q = gait.state.section()
     A = map_jacobian(gait.params, q, method=method, step=step, options=options)
-    lam, W = np.linalg.eig(A.T)  # left eigenvectors of A are the columns of W
+    n_energy = len(conserved_gradients(gait.params, q)) > 0  # 0 or 1 energy multiplier
+    if pitch_decoupled(gait.params):
+        # the section without the decoupled pitch; its Jordan block [[1, T], [0, 1]]
+        lam = np.concatenate([np.linalg.eigvals(A[np.ix_(_NO_PITCH, _NO_PITCH)]), [1.0, 1.0]])
+        kinds: list[TrivialKind] = ["", "", "", "pitch", "pitch"]
+    else:
+        lam = np.linalg.eigvals(A)
+        kinds = [""] * 5
+    # the energy multiplier: the one closest to 1 (the tolerance is loose: a
+    # double root at 1 splits by sqrt(eps))
+    cand = [i for i in np.argsort(np.abs(lam - 1.0)) if kinds[i] == ""]
+    for i in cand[:n_energy]:
+        if abs(lam[i] - 1.0) < 1e-4:
+            kinds[i] = "energy"
     order = np.argsort(-np.abs(lam), kind="stable")
-    lam, W = lam[order], W[:, order]
-    trivial = np.zeros(5, dtype=bool)
-    grads = conserved_gradients(gait.params, q)
-    # one structural multiplier per conserved quantity: those closest to 1
-    # (the trivial tolerance is loose: a double root at 1 splits by sqrt(eps))
-    for _ in grads:
-        cand = [i for i in np.argsort(np.abs(lam - 1.0)) if not trivial[i]]
-        if cand and abs(lam[cand[0]] - 1.0) < 1e-4:
-            trivial[cand[0]] = True
+    lam = lam[order].astype(complex)
+    kinds = [kinds[i] for i in order]
+    trivial = np.array([k != "" for k in kinds])
     others = np.abs(lam[~trivial])
     max_nt = float(others.max()) if others.size else 0.0
     if max_nt > 1.0 + unit_tol:
         stability: Stability = "unstable"
-    elif trivial.any() or max_nt >= 1.0 - unit_tol:
+    elif max_nt >= 1.0 - unit_tol:
         stability = "neutral"
     else:
         stability = "asymptotic"
     return Floquet(multipliers=lam, trivial=trivial, max_nontrivial=max_nt,
-                   stability=stability, jacobian=A, method=method)
+                   stability=stability, jacobian=A, method=method,
+                   trivial_kinds=tuple(kinds))

@@ -73,6 +73,7 @@ ST_FALL_BACKWARD = 1  # xdot_m < 0 (eq. 2.10)
 ST_FALL_HIP_GROUND = 2  # hip at or below the ground in stance (eq. 2.11)
 ST_FALL_NO_TOUCHDOWN = 3  # hip reaches the ground in flight before the foot
 ST_FALL_TRIP = 4  # foot enters a higher terrain segment below its top (step riser)
+ST_FALL_LENGTHENING = 5  # touch-down with the leg lengthening (ld > 0): it cannot push
 ST_ERR_STEP_UNDERFLOW = 10
 ST_ERR_MAX_STEPS = 11
 ST_ERR_STANCE_TIMEOUT = 12

@@ -287,6 +287,28 @@ def _table21(**kw: Any) -> Params:
     return Params(**kw)
 
 
+#: Seyfarth, Geyer, Guenther & Blickhan (2002), "A movement criterion for running",
+#: J. Biomech. 35: the human-running SLIP used across the literature, in SI.
+SLIP_HUMAN_SI = {"m": 80.0, "l0": 1.0, "g": 9.81, "k": 20000.0, "v0": 5.0,
+                 "beta0": math.radians(68.0)}
+
+
+def _slip(**kw: Any) -> Params:
+    """The SLIP limit (Section 7.6): no trunk offset, no hip torque, no damping, global
+    leg reset to the touch-down angle and no retraction (``J`` plays no part)."""
+    kw.setdefault("alpha_r", kw["beta0"])
+    return Params(r=0.0, c_l=0.0, omega_r=0.0, leg_reset="global", controller=Passive(), **kw)
+
+
+def _slip_human() -> Params:
+    from .units import Scaling  # units imports this module
+
+    s = Scaling(M=SLIP_HUMAN_SI["m"], g=SLIP_HUMAN_SI["g"], L=SLIP_HUMAN_SI["l0"])
+    return _slip(k=s.to_dimensionless(SLIP_HUMAN_SI["k"], _TABLE["k"].dims),
+                 v0=s.to_dimensionless(SLIP_HUMAN_SI["v0"], _TABLE["v0"].dims),
+                 beta0=SLIP_HUMAN_SI["beta0"])
+
+
 _PRESETS: dict[str, tuple[str, Any]] = {
     "table2.1": ("Table 2.1 passive model", lambda: _table21()),
     "table2.1-global-pd": (
@@ -308,6 +330,17 @@ _PRESETS: dict[str, tuple[str, Any]] = {
             alpha_r=0.93, controller=LocalVelocity(Kd=0.40, alphad_ref=2.42),
         ),
     ),
+    "slip": (
+        "SLIP limit (r 0, passive, c_l 0, global reset, no retraction): k 25 (Table 2.1), "
+        "v0 1.6, beta0 1.19 (68 deg; Seyfarth et al. 2002 human running, rounded)",
+        lambda: _slip(k=25.0, v0=1.6, beta0=1.19),
+    ),
+    "slip-human": (
+        "SLIP of Seyfarth et al. 2002: 80 kg, l0 1 m, k 20 kN/m, 5 m/s touch-down speed, "
+        "68 deg; in Table 3.1 units (M 80 kg, g 9.81 m/s^2, L 1 m): k 25.48, v0 1.596, "
+        "beta0 1.187 rad",
+        _slip_human,
+    ),
 }
 
 
@@ -323,7 +356,7 @@ def preset_description(name: str) -> str:
 
 
 def preset(name: str) -> Params:
-    """Named parameter set from the thesis tables.
+    """Named parameter set: the thesis tables, and the SLIP limit (``slip``, ``slip-human``).
 
     Raises
     ------

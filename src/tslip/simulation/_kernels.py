@@ -68,6 +68,7 @@ from ..model._pack import (
     ST_ERR_STEP_UNDERFLOW,
     ST_FALL_BACKWARD,
     ST_FALL_HIP_GROUND,
+    ST_FALL_LENGTHENING,
     ST_FALL_NO_TOUCHDOWN,
     ST_FALL_TRIP,
     ST_OK,
@@ -261,6 +262,10 @@ def _event_root(P, method, R, ev, g_lo, g_hi, ytmp, gv, st):
 def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
     """Integrate the stance from ``y0`` until lift-off or a fall.
 
+    A stance that starts with the hip at the ground, ``xdot_m < 0`` or the leg
+    lengthening (``ld > 0``: a spring leg cannot pull) ends at once with that
+    fall (docs/conventions.md, "Events").
+
     ``rec`` (rows x NREC) receives ``t, y, F_x, F_y, tau``: at each accepted
     step if ``rec_dt <= 0``, else on a uniform grid of spacing ``rec_dt``
     from the dense output. ``stats`` receives
@@ -297,8 +302,10 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
         _record(P, rec, nrec, t, y)
         nrec += 1
     t_next_rec = rec_dt
-    # fallen already at touch-down: hip at the ground, or moving backward
-    if gv_old[1] <= 0.0 or gv_old[2] < 0.0:
+    # fallen already at touch-down: hip at the ground, moving backward, or the leg
+    # lengthening (ld > 0: the spring would stretch past l0 and pull on the ground,
+    # docs/conventions.md "Events")
+    if gv_old[1] <= 0.0 or gv_old[2] < 0.0 or y[3] > 0.0:
         for i in range(NSTATE):
             yout[i] = y[i]
         stats[0] = 0.0
@@ -306,7 +313,9 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
         stats[2] = 0.0
         stats[3] = nrec
         stats[4] = 0.0
-        return ST_FALL_HIP_GROUND if gv_old[1] <= 0.0 else ST_FALL_BACKWARD
+        if gv_old[1] <= 0.0:
+            return ST_FALL_HIP_GROUND
+        return ST_FALL_BACKWARD if gv_old[2] < 0.0 else ST_FALL_LENGTHENING
     h = O[O_H0]
     if h <= 0.0:
         h = initial_step(P, method, y, K[0], rtol, atol, ytmp, K[1])

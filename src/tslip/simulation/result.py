@@ -39,6 +39,7 @@ class Status(enum.IntEnum):
     FALL_HIP_GROUND = pk.ST_FALL_HIP_GROUND
     FALL_NO_TOUCHDOWN = pk.ST_FALL_NO_TOUCHDOWN
     FALL_TRIP = pk.ST_FALL_TRIP
+    FALL_LENGTHENING = pk.ST_FALL_LENGTHENING
     STEP_UNDERFLOW = pk.ST_ERR_STEP_UNDERFLOW
     MAX_STEPS = pk.ST_ERR_MAX_STEPS
     STANCE_TIMEOUT = pk.ST_ERR_STANCE_TIMEOUT
@@ -67,6 +68,8 @@ _REASONS = {
     Status.FALL_HIP_GROUND: "fall: the hip reached the ground in stance (eq. 2.11)",
     Status.FALL_NO_TOUCHDOWN: "fall: the hip reached the ground in flight before the foot",
     Status.FALL_TRIP: "fall: the foot hit a step riser (terrain)",
+    Status.FALL_LENGTHENING: ("fall: the leg touched down while lengthening (ld > 0), so the "
+                              "spring would pull on the ground; it cannot push"),
     Status.STEP_UNDERFLOW: "error: step size fell below IntegratorOptions.h_min",
     Status.MAX_STEPS: "error: more than IntegratorOptions.max_steps steps in one stance",
     Status.STANCE_TIMEOUT: "error: stance longer than IntegratorOptions.t_max_stance",
