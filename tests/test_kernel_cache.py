@@ -37,3 +37,15 @@ def test_hash_covers_every_kernel_source():
 
 def test_an_unusable_cache_is_left_alone():
     kc.check(object(), "x.py")  # no _cache attribute: ignored, no exception
+
+
+def test_a_kernel_compiled_without_cache_is_left_alone(tmp_path):
+    """A dispatcher without ``cache=True`` has a cache object with no path: ignored."""
+    from numba import njit
+
+    @njit
+    def f(x):
+        return x + 1
+
+    kc.check(f, str(tmp_path / "x.py"))
+    assert not list(tmp_path.iterdir())

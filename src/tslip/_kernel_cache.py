@@ -67,5 +67,5 @@ def check(dispatcher: object, module_file: str) -> None:
         tmp = marker.with_name(f"{marker.name}.{os.getpid()}.tmp")
         tmp.write_text(digest)
         os.replace(tmp, marker)
-    except (OSError, AttributeError):
+    except (OSError, AttributeError, TypeError):  # TypeError: a kernel without cache=True
         return
