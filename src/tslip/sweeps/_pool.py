@@ -23,6 +23,7 @@ terminates the workers instead of waiting for them.
 
 from __future__ import annotations
 
+import ast
 import concurrent.futures as cf
 import ctypes
 import multiprocessing as mp
@@ -33,9 +34,11 @@ import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
-__all__ = ["WATCH_SECONDS", "notify", "process_pool", "progress_queue", "stop_workers"]
+__all__ = ["WATCH_SECONDS", "check_main_guard", "notify", "process_pool", "progress_queue",
+           "stop_workers"]
 
 #: How often a worker checks that its parent is alive [s].
 WATCH_SECONDS = 0.5
@@ -116,13 +119,51 @@ class _Executor(cf.ProcessPoolExecutor):
             return super().submit(fn, *args, **kwargs)
 
 
+def _is_main_test(node: ast.expr) -> bool:
+    """``__name__ == "__main__"`` (either way round)."""
+    if not (isinstance(node, ast.Compare) and len(node.ops) == 1
+            and isinstance(node.ops[0], ast.Eq)):
+        return False
+    sides = [node.left, node.comparators[0]]
+    return (any(isinstance(x, ast.Name) and x.id == "__name__" for x in sides)
+            and any(isinstance(x, ast.Constant) and x.value == "__main__" for x in sides))
+
+
+def check_main_guard() -> None:
+    """Refuse, in one line, to start workers that would re-run an unguarded script.
+
+    Workers are spawned, and a spawned process imports the main script again
+    (Python's ``multiprocessing``): a script that runs a study at its top
+    level, with no ``if __name__ == "__main__":`` block, would start the study
+    again in every worker, which Python stops with a ``BrokenProcessPool``
+    deep in a traceback. Interactive sessions, ``python -c`` and
+    ``python -m package`` (a ``__main__`` module is not re-imported) pass.
+    """
+    main = sys.modules.get("__main__")
+    spec_name = getattr(getattr(main, "__spec__", None), "name", None)
+    path = getattr(main, "__file__", None)
+    if not path or (spec_name or "").endswith("__main__"):
+        return
+    try:
+        tree = ast.parse(Path(path).read_text(encoding="utf-8"))
+    except (OSError, SyntaxError, ValueError):
+        return  # not a readable Python source: leave it to multiprocessing
+    if not any(isinstance(n, ast.If) and _is_main_test(n.test) for n in tree.body):
+        raise RuntimeError(
+            f"worker processes import the script {path!r} again, and it has no "
+            "`if __name__ == \"__main__\":` block: put the code that runs the study "
+            "under one, or pass workers=1")
+
+
 @contextmanager
 def process_pool(workers: int, queue: Any = None) -> Iterator[cf.ProcessPoolExecutor]:
     """A spawn-context process pool of ``workers`` watched, SIGINT-deaf workers.
 
     ``queue`` (from :func:`progress_queue`) receives the workers' :func:`notify`
-    calls.
+    calls. Raises ``RuntimeError`` up front for a script without a main guard
+    (:func:`check_main_guard`).
     """
+    check_main_guard()
     ctx = mp.get_context("spawn")  # numba threads and fork do not mix
     pool = _Executor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
                      initargs=(os.getpid(), queue))
