@@ -23,14 +23,10 @@ Three measurements, each printed as ratios measured in the same run:
 from __future__ import annotations
 
 import argparse
-import json
-import os
-import subprocess
-import sys
 import time
 
 import numpy as np
-from _baseline import BASELINE_REV, run_at, source_at
+from _baseline import BASELINE_REV, best_of, run_at
 
 from tslip.biped import BipedOptions, BipedParams, BipedState, simulate, stride
 from tslip.biped import _kernels as kn
@@ -94,40 +90,6 @@ def scipy_stride(p: BipedParams, y0: np.ndarray, method: str, tol: float) -> dic
             cs[pk.CS_ON_R + k] = 0.0
 
 
-def _best(fn, repeat: int, clock=time.perf_counter) -> float:
-    fn()
-    best = np.inf
-    for _ in range(repeat):
-        t0 = clock()
-        fn()
-        best = min(best, clock() - t0)
-    return best
-
-
-_CPU_RUNNER = r"""
-import json, sys, time
-setup, stmt, repeat = json.loads(sys.argv[1])
-ns = {}
-exec(setup, ns)
-exec(stmt, ns)
-best = float("inf")
-for _ in range(repeat):
-    t0 = time.process_time()
-    exec(stmt, ns)
-    best = min(best, time.process_time() - t0)
-print(json.dumps(best))
-"""
-
-
-def cpu_at(rev: str, setup: str, stmt: str, repeat: int) -> float:
-    """Like ``_baseline.run_at`` but best CPU time of the process (steadier when the
-    machine is shared: time slices lost to other processes do not count)."""
-    env = dict(os.environ, PYTHONPATH=str(source_at(rev)))
-    out = subprocess.run([sys.executable, "-c", _CPU_RUNNER, json.dumps([setup, stmt, repeat])],
-                         capture_output=True, text=True, env=env, check=True)
-    return float(out.stdout.strip().splitlines()[-1])
-
-
 _SETUP = ("import numpy as np\n"
           "from tslip.biped import BipedOptions, BipedParams, BipedState, simulate, stride\n"
           "p = BipedParams(); y0 = BipedState.thesis().to_array()\n")
@@ -164,8 +126,8 @@ def main() -> None:
     for m in ("dopri5", "dop853"):
         opts = BipedOptions(rtol=a.tol, atol=a.tol, method=m)
         r = stride(p, y0, 0.0, options=opts)
-        new[m] = _best(lambda opts=opts: stride(p, y0, 0.0, options=opts), a.repeat)
-        new_cpu[m] = _best(lambda opts=opts: stride(p, y0, 0.0, options=opts), a.repeat,
+        new[m] = best_of(lambda opts=opts: stride(p, y0, 0.0, options=opts), a.repeat)
+        new_cpu[m] = best_of(lambda opts=opts: stride(p, y0, 0.0, options=opts), a.repeat,
                            time.process_time)
         print(f"   {m:7s}: {1e3 * new[m]:7.2f} ms/stride wall, {1e3 * new_cpu[m]:7.2f} ms CPU, "
               f"{r.accepted} steps, |t - t_ref| {abs(r.t - ref.t):.1e}, |y - y_ref| "
@@ -173,7 +135,7 @@ def main() -> None:
     if not a.no_baseline:
         stmt = f"stride(p, y0, 0.0, options=BipedOptions(rtol={a.tol!r}, atol={a.tol!r}))"
         old = run_at(BASELINE_REV, _SETUP, stmt, repeat=a.repeat)
-        old_cpu = cpu_at(BASELINE_REV, _SETUP, stmt, a.repeat)
+        old_cpu = run_at(BASELINE_REV, _SETUP, stmt, repeat=a.repeat, clock="process_time")
         print(f"   {BASELINE_REV} (dopri5): {1e3 * old:7.2f} ms/stride wall, {1e3 * old_cpu:7.2f} "
               f"ms CPU")
         for m in new:
@@ -188,7 +150,7 @@ def main() -> None:
           f"{min(a.repeat, 3)})")
     yf = table_e2_perturbations(0)[0]
     tr = simulate(p, yf, 20)
-    t_new = _best(lambda: simulate(p, yf, 20), min(a.repeat, 3))
+    t_new = best_of(lambda: simulate(p, yf, 20), min(a.repeat, 3))
     print(f"   now: {t_new:6.3f} s, {tr.status.name} at t = {tr.stats['t_end']:.3f}, "
           f"{tr.count_strides()} strides, {tr.stats['accepted']} steps "
           f"{tr.stats['rejected']} rejected")

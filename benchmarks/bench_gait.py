@@ -54,21 +54,11 @@ from tslip.simulation import _kernels as kn
 from tslip.simulation import _packed
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _baseline import BASELINE_REV, run_at  # noqa: E402
+from _baseline import BASELINE_REV, best_of, run_at  # noqa: E402
 from bench_step import scipy_stride  # noqa: E402
 
 TIGHT = 1e-12  # find_gait / floquet default tolerance
 THESIS = 1e-8  # robustness runs (thesis tolerance)
-
-
-def best(fn, repeat: int) -> float:
-    """Best wall time [s] of ``repeat`` calls of ``fn``."""
-    t_best = math.inf
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        t_best = min(t_best, time.perf_counter() - t)
-    return t_best
 
 
 # ---------------------------------------------------------------------------
@@ -251,7 +241,7 @@ def today_ratios(repeat: int, rounds: int = 3) -> None:
         exec(code, ns)  # warm
         t_new = t_old = math.inf
         for _ in range(rounds):  # interleaved: a busy spell slows both sides alike
-            t_new = min(t_new, best(lambda code=code: exec(code, ns), repeat))
+            t_new = min(t_new, best_of(lambda code=code: exec(code, ns), repeat))
             t_old = min(t_old, run_at(BASELINE_REV, TODAY_SETUP, stmt_old or stmt,
                                       repeat=repeat, threads=1))
         tgt = ("met" if t_old / t_new >= 4.0 else "MISSED") if target else ""
@@ -288,30 +278,30 @@ def main() -> None:
     numba.set_num_threads(1)
 
     # gait search
-    t_gait = best(lambda: tslip.find_gait(params), args.repeat)
+    t_gait = best_of(lambda: tslip.find_gait(params), args.repeat)
     prob = GaitProblem.from_params(params)
     _, err, n_starts = newton_solve(prob.residual, prob.guesses())
     starts = list(itertools.islice(prob.guesses(), n_starts))
     z_sp, err_sp = scipy_gait(prob, starts, 1e-10)
-    t_gait_sp = best(lambda: scipy_gait(prob, starts, 1e-10), 3)
+    t_gait_sp = best_of(lambda: scipy_gait(prob, starts, 1e-10), 3)
     z_pk = prob.encode(gait)
 
     # multipliers
-    t_fd = best(lambda: floquet(gait, method="fd"), args.repeat)
+    t_fd = best_of(lambda: floquet(gait, method="fd"), args.repeat)
     def cold_exact():  # without the Jacobian find_gait kept for this gait
         _packed._JACOBIANS.clear()
         floquet(gait, method="exact")
 
-    t_ex = best(cold_exact, args.repeat)
+    t_ex = best_of(cold_exact, args.repeat)
     q = gait.state.section()
     lam_sp = scipy_multipliers(gait.params, q)
-    t_fd_sp = best(lambda: scipy_multipliers(gait.params, q), 3)
+    t_fd_sp = best_of(lambda: scipy_multipliers(gait.params, q), 3)
     lam_pk = floquet(gait, method="fd").multipliers
 
     # robustness triple
     report = robustness_report(gait)
-    t_rob = best(lambda: robustness_report(gait), max(1, args.repeat // 2))
-    t_rob_nocheck = best(lambda: robustness_report(gait, check=False), max(1, args.repeat // 2))
+    t_rob = best_of(lambda: robustness_report(gait), max(1, args.repeat // 2))
+    t_rob_nocheck = best_of(lambda: robustness_report(gait, check=False), max(1, args.repeat // 2))
     n_full, _ = package_strides(gait, 1e-4)
     n_coarse_pk, lim_coarse_pk = package_strides(gait, args.scipy_search_tol)
     count = [0]

@@ -24,6 +24,7 @@ import time
 
 import numba
 import numpy as np
+from _baseline import best_of
 
 import tslip
 from tslip.gait.stability import map_jacobian
@@ -59,16 +60,6 @@ def rhs_per_stride(tols: list[float], n: int) -> dict[str, float]:
     return json.loads(out.strip().splitlines()[-1])
 
 
-def best_time(fn, repeat: int = 5) -> float:
-    """Best CPU time of this process (steadier than wall time on a shared machine)."""
-    best = np.inf
-    for _ in range(repeat):
-        t = time.process_time()
-        fn()
-        best = min(best, time.process_time() - t)
-    return best
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--tols", type=float, nargs="+", default=[1e-8, 1e-12])
@@ -90,11 +81,15 @@ def main() -> None:
             tslip.run_batch(p, states[:1], 1, options=o)  # compile / load
             map_jacobian(p, q, options=o)
             n = args.rows * args.steps
-            batch = n / best_time(lambda o=o: tslip.run_batch(p, states, args.steps, options=o))
-            smap = NMAP / best_time(
-                lambda o=o: [tslip.step_map(p, q, options=o) for _ in range(NMAP)])
-            jac = NJAC / best_time(lambda o=o: [map_jacobian(p, q, options=o) for _ in range(NJAC)])
-            gs = best_time(lambda o=o: tslip.find_gait(tslip.preset("table6.1"), options=o))
+            cpu = time.process_time  # steadier than wall time on a shared machine
+            batch = n / best_of(lambda o=o: tslip.run_batch(p, states, args.steps, options=o),
+                                clock=cpu)
+            smap = NMAP / best_of(
+                lambda o=o: [tslip.step_map(p, q, options=o) for _ in range(NMAP)], clock=cpu)
+            jac = NJAC / best_of(lambda o=o: [map_jacobian(p, q, options=o) for _ in range(NJAC)],
+                                 clock=cpu)
+            gs = best_of(lambda o=o: tslip.find_gait(tslip.preset("table6.1"), options=o),
+                         clock=cpu)
             r = tslip.step(p, s, options=o)
             rows[(tol, m)] = (counts[f"{m} {tol:g}"], r.n_integrator_steps, batch, smap, jac, gs,
                               r.state.section())

@@ -19,9 +19,8 @@ are timed too.
 from __future__ import annotations
 
 import argparse
-import time
 
-from _baseline import BASELINE_REV, run_at
+from _baseline import BASELINE_REV, best_of, run_at
 
 SETUP = """
 import numpy as np, tslip
@@ -49,13 +48,7 @@ def best_here(setup: str, stmt: str, repeat: int) -> tuple[float, dict]:
     ns: dict = {}
     exec(setup, ns)
     code = compile(stmt, "<stmt>", "exec")
-    exec(code, ns)
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        exec(code, ns)
-        best = min(best, time.perf_counter() - t0)
-    return best, ns
+    return best_of(lambda: exec(code, ns), repeat), ns
 
 
 def main() -> None:
