@@ -404,6 +404,9 @@ class BatchStep(NamedTuple):
     status: np.ndarray  # int codes of :class:`Status`
     raw: np.ndarray  # (n, NOUT) kernel output
 
+    def __repr__(self) -> str:
+        return f"BatchStep({len(self.status)} rows; {_status_counts(self.status)})"
+
 
 class BatchRun(NamedTuple):
     """Result of :func:`run_batch` (row-aligned arrays)."""
@@ -412,6 +415,16 @@ class BatchRun(NamedTuple):
     status: np.ndarray  # final status code per row
     t_fall: np.ndarray  # time of the fall, NaN if none
     touchdowns: np.ndarray  # (n, n_steps + 1, 7) touch-down states
+
+    def __repr__(self) -> str:
+        return (f"BatchRun({len(self.status)} rows, {self.touchdowns.shape[1] - 1} strides "
+                f"asked; {_status_counts(self.status)})")
+
+
+def _status_counts(codes: np.ndarray) -> str:
+    """``"OK 998, FALL_NO_TOUCHDOWN 2"``: how many rows ended in each status."""
+    values, counts = np.unique(np.asarray(codes, dtype=int), return_counts=True)
+    return ", ".join(f"{Status(int(v)).name} {int(c)}" for v, c in zip(values, counts))
 
 
 def _batch_inputs(

@@ -138,6 +138,12 @@ class StepResult:
     start: TouchdownState
     params: Params
 
+    def __repr__(self) -> str:
+        """One line: status, phase durations and integrator steps (not the records)."""
+        return (f"StepResult({self.status.name}, stance_time={self.stance_time:.6g}, "
+                f"flight_time={self.flight_time:.6g}, "
+                f"n_integrator_steps={self.n_integrator_steps})")
+
     @classmethod
     def from_kernel(cls, params: Params, start: TouchdownState, status: int, out: np.ndarray,
                     rec: np.ndarray) -> StepResult:
@@ -351,6 +357,13 @@ class Trajectory:
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.data[:, TRAJECTORY_COLUMNS.index(name)]
+
+    def __repr__(self) -> str:
+        """One line: strides, samples, time span and status (not the data)."""
+        t = self.data[:, 0]
+        span = f"t {t[0]:.6g} to {t[-1]:.6g}" if len(t) else "no samples"
+        return (f"Trajectory({len(self.steps)} strides, {len(t)} samples, {span}, "
+                f"status {self.status.name})")
 
     @property
     def time(self) -> np.ndarray:
