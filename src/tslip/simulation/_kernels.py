@@ -170,13 +170,19 @@ def grf(P, y):
 
 
 @njit(**_JIT)
+def _com_velocity(r, l, sb, cb, sp, cp, ld, bd, phd):
+    """CoM velocity (eq. A.5) from the leg and pitch with their sines and cosines."""
+    xd = -ld * cb + l * sb * bd + r * cp * phd
+    yd = ld * sb + l * cb * bd + r * sp * phd
+    return xd, yd
+
+
+@njit(**_JIT)
 def com_velocity(P, y):
     """CoM velocity from the stance state (eq. A.5)."""
-    l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
-    r = P[P_R]
-    xd = -ld * math.cos(b) + l * math.sin(b) * bd + r * math.cos(ph) * phd
-    yd = ld * math.sin(b) + l * math.cos(b) * bd + r * math.sin(ph) * phd
-    return xd, yd
+    l, b, ph = y[0], y[1], y[2]
+    return _com_velocity(P[P_R], l, math.sin(b), math.cos(b), math.sin(ph), math.cos(ph),
+                         y[3], y[4], y[5])
 
 
 @njit(**_JIT)
@@ -797,8 +803,7 @@ def _stance_row(P, t0, i, xf, h, r, row):
     sp = math.sin(ph)
     cp = math.cos(ph)
     y = h + l * sb - rp * cp
-    xd = -ld * cb + l * sb * bd + rp * cp * phd
-    yd = ld * sb + l * cb * bd + rp * sp * phd
+    xd, yd = _com_velocity(rp, l, sb, cb, sp, cp, ld, bd, phd)
     row[TR_T] = t0 + r[0]
     row[TR_STEP] = i
     row[TR_STANCE] = 1.0
