@@ -19,9 +19,12 @@ from tslip.sweeps._lock import FolderLocked, folder_lock
 
 # a 2-D study of 5 lines of 13 points: the line at the base value v0 = 5 first, then
 # two continuation chains (v0 = 4.5; v0 = 5.5, 6, 6.5) in two workers, one soon idle
+# Robustness over 200 strides makes each point about 0.15 s: the study must still be
+# running when the tests below signal it (with Floquet alone, 65 points now take 0.2 s).
 _TOML = """name = "grid"
 preset = "table2.1-local-velocity"
-analyses = ["floquet"]
+analyses = ["floquet", "robustness"]
+n_steps = 200
 [[axis]]
 param = "v0"
 values = [4.5, 5.0, 5.5, 6.0, 6.5]
