@@ -36,6 +36,9 @@ def same(a: Any, b: Any, where: str = "obj") -> None:
         return
     if type(a).__name__ == "DataFrame":
         assert list(a.columns) == list(b.columns), where
+        assert [str(t) for t in a.dtypes] == [str(t) for t in b.dtypes], (where, a.dtypes,
+                                                                          b.dtypes)
+        assert a.index.equals(b.index), f"{where}: index differs"
         for c in a.columns:
             same(a[c].to_numpy(), b[c].to_numpy(), f"{where}[{c!r}]")
         return

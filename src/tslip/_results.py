@@ -58,7 +58,7 @@ from ._io import atomic_write, git_hash, write_table
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["Result", "load", "with_units", "run_record", "encode", "decode", "FORMAT"]
+__all__ = ["Result", "load", "with_units", "frame", "run_record", "encode", "decode", "FORMAT"]
 
 #: Name and version of the file format, stored in every file.
 FORMAT_NAME, FORMAT_VERSION = "tslip-result", 1
@@ -109,7 +109,7 @@ class Result:
         """One line: the class name and :meth:`_repr_fields`."""
         parts = [f"{k}={_short(v)}" for k, v in self._repr_fields().items()]
         text = f"{type(self).__name__}({', '.join(parts)})"
-        return text if len(text) <= 200 else text[:196] + " ...)"
+        return text if len(text) <= 200 else text[:195] + " ...)"
 
     # -- table ---------------------------------------------------------------
     def to_dataframe(self) -> pd.DataFrame:
@@ -126,6 +126,14 @@ class Result:
     def _from_fields(cls: type[R], fields: dict[str, Any]) -> R:
         """Build the object back from :meth:`_fields`."""
         return cls(**fields)
+
+    def _summary(self) -> dict[str, Any]:
+        """Readable facts put at the top level of the saved record (default: none).
+
+        Not read back: :meth:`_fields` is the state. The record's own keys
+        (``format``, ``run``, ``table``, ``result``) take precedence.
+        """
+        return {}
 
     def _table_fields(self) -> tuple[str, ...]:
         """Fields of :meth:`_fields` that the table holds (left out of a table's record)."""
@@ -147,7 +155,8 @@ class Result:
         if suffix not in SUFFIXES:
             raise ValueError(f"path must end in one of {', '.join(SUFFIXES)}, got {str(path)!r}")
         fields = self._fields()
-        record: dict[str, Any] = {"format": FORMAT, "run": run_record(self)}
+        record: dict[str, Any] = {**encode(self._summary(), "summary"), "format": FORMAT,
+                                  "run": run_record(self)}
         if suffix == ".json":
             record["result"] = encode(self)
             _write_text(path, record)
@@ -207,6 +216,14 @@ def with_units(df: pd.DataFrame, units: Mapping[str, str]) -> pd.DataFrame:
         raise ValueError(f"no unit for the column(s) {', '.join(map(str, missing))}")
     df.attrs["units"] = {str(c): units[c] for c in df.columns}
     return df
+
+
+def frame(data: Mapping[str, Any] | list[dict[str, Any]], units: Mapping[str, str]
+          ) -> pd.DataFrame:
+    """A DataFrame of ``data`` (columns, or a list of rows) with :func:`with_units`."""
+    import pandas as pd
+
+    return with_units(pd.DataFrame(data), units)
 
 
 def run_record(obj: object) -> dict[str, Any]:
@@ -286,8 +303,10 @@ def encode(obj: Any, where: str = "result") -> Any:
         return {"__path__": str(obj)}
     if type(obj).__name__ == "DataFrame" and type(obj).__module__.startswith("pandas"):
         return {"__frame__": {"columns": [encode(c, where) for c in obj.columns],
-                              "data": [_encode_array(obj[c].to_numpy(), where)
-                                       for c in obj.columns],
+                              "dtypes": [str(t) for t in obj.dtypes],
+                              "data": [_encode_array(obj.iloc[:, k].to_numpy(), where)
+                                       for k in range(obj.shape[1])],
+                              "index": _encode_array(obj.index.to_numpy(), where),
                               "attrs": encode(dict(obj.attrs), where)}}
     raise TypeError(f"cannot save {where}: a {type(obj).__name__} is not a number, text, "
                     f"array, container, tslip dataclass or enum")
@@ -407,8 +426,17 @@ def decode(data: Any) -> Any:
 
         fr = data["__frame__"]
         cols = [decode(c) for c in _list(fr["columns"])]
-        df = pd.DataFrame({c: _decode_array(a) for c, a in zip(cols, _list(fr["data"]))},
-                          columns=cols)
+        arrays = [_decode_array(a) for a in _list(fr["data"])]
+        dtypes: list[Any] = [str(t) for t in _list(fr["dtypes"])]
+        if not len(cols) == len(arrays) == len(dtypes):
+            raise ValueError("a table's columns, data and dtypes differ in length")
+        df = pd.DataFrame(dict(enumerate(arrays)), index=_decode_array(fr["index"]))
+        for k, t in enumerate(dtypes):
+            if str(df[k].dtype) != t:
+                df[k] = df[k].astype(t)
+        df.columns = pd.Index(cols)
+        if isinstance(df.index, pd.Index) and df.index.equals(pd.RangeIndex(len(df))):
+            df.index = pd.RangeIndex(len(df))
         df.attrs = decode(fr.get("attrs", {}))
         return df
     return {k: decode(v) for k, v in data.items()}
@@ -495,6 +523,13 @@ def load(path: str | Path) -> Any:
         raise ValueError(f"cannot load {str(path)!r}: {exc.strerror or exc}") from None
 
 
+def _numeric(dtype: Any) -> bool:
+    try:
+        return np.dtype(str(dtype)).kind in "biufc"
+    except TypeError:  # a pandas extension type, such as "str"
+        return False
+
+
 def _load_table(rec_path: Path, record: dict, table: Any, suffix: str | None) -> Any:
     import pandas as pd
 
@@ -508,8 +543,14 @@ def _load_table(rec_path: Path, record: dict, table: Any, suffix: str | None) ->
     if tab_path.suffix.lower() == ".parquet":
         df = pd.read_parquet(tab_path)
     elif tab_path.suffix.lower() == ".csv":
-        df = pd.read_csv(tab_path)  # pandas >= 3: exact by default
         dtypes = table.get("dtypes", {})
+        if not isinstance(dtypes, dict):
+            raise ValueError("bad table dtypes")
+        # an empty cell is a missing number, but an empty text in a text column
+        text = {c for c, t in dtypes.items() if not _numeric(t)}
+        df = pd.read_csv(tab_path, keep_default_na=False,  # pandas >= 3: exact floats
+                         na_values={c: [""] for c in dtypes if c not in text},
+                         dtype={c: str for c in text})
         for c in df.columns:  # text has no types: an empty or all-integer column
             if c in dtypes and str(df[c].dtype) != dtypes[c]:
                 df[c] = df[c].astype(dtypes[c])

@@ -15,16 +15,20 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
 from scipy.optimize import least_squares
 
+from .._results import Result, with_units
 from ..model.parameters import Params, preset
 from .signals import SIGNALS, StepAverage, correlation, vaf
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
     from ..gait.fixed_point import Gait
 
 __all__ = ["FitResult", "fit_model", "model_curves", "fit_scores", "stride_table",
@@ -36,8 +40,13 @@ _BOUNDS = {"v0": (0.5, 4.0), "k": (2.0, 40.0), "beta0": (0.5, 1.45), "c_l": (0.0
            "Kd": (0.0, 3.0), "omega_r": (0.0, 5.0)}
 
 
-@dataclass(frozen=True)
-class FitResult:
+#: Units of the score table (Table 6.3): correlations are pure numbers, VAF is in %.
+SCORE_UNITS = {"signal": "-", "unit": "-", "corr_stance": "-", "vaf_stance": "%",
+               "corr_full": "-", "vaf_full": "%"}
+
+
+@dataclass(frozen=True, repr=False)
+class FitResult(Result):
     """A fitted TSLIP model and its scores.
 
     Attributes
@@ -74,6 +83,20 @@ class FitResult:
     n_evals: int
     converged: bool
     message: str
+
+    def _repr_fields(self) -> dict[str, Any]:
+        return {**self.values, "cost": self.cost, "n_evals": self.n_evals,
+                "converged": self.converged}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """Table 6.3: correlation and VAF of each signal, in stance and over the stride."""
+        return with_units(self.scores.copy(), SCORE_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """VAF of each signal in stance and over the stride (Table 6.3 as bars)."""
+        from ..plotting.experiment import plot_fit_scores
+
+        return plot_fit_scores(self, ax)
 
 
 def _set(base: Params, values: dict[str, float]) -> Params:

@@ -14,14 +14,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
 from scipy.signal import butter, savgol_filter, sosfiltfilt
 
-from ..model.units import ROBOT_SCALING, Scaling
+from .._results import Result, frame, with_units
+from ..model.units import ROBOT_SCALING, UNIT, Scaling
 from .synth import BodyGeometry
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 __all__ = [
     "SIGNALS", "ProcessOptions", "StepData", "StepAverage", "correlation", "vaf", "lowpass",
@@ -217,8 +222,8 @@ class ProcessOptions:
     belt_speed: float | None = None
 
 
-@dataclass(frozen=True)
-class StepData:
+@dataclass(frozen=True, repr=False)
+class StepData(Result):
     """Processed recording split into steps.
 
     Attributes
@@ -249,9 +254,25 @@ class StepData:
     problems: list[str] = field(default_factory=list)
     meta: dict = field(default_factory=dict)
 
+    def _repr_fields(self) -> dict[str, Any]:
+        return {"steps": len(self.steps), "samples": len(self.samples),
+                "frames": len(self.frames), "belt_speed": self.belt_speed,
+                "problems": len(self.problems)}
 
-@dataclass(frozen=True)
-class StepAverage:
+    def to_dataframe(self) -> pd.DataFrame:
+        """The long table of step samples (dimensionless, Table 3.1)."""
+        return with_units(self.samples.copy(), {"step": "-", "tau": "-", "t": UNIT["time"],
+                                                "stance": "-", **SIGNALS})
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The near foot's path relative to the CoM, every frame."""
+        from ..plotting.experiment import plot_foot_trajectory
+
+        return plot_foot_trajectory(self, ax)
+
+
+@dataclass(frozen=True, repr=False)
+class StepAverage(Result):
     """Step-averaged measurement (the data behind Figure 6.1).
 
     Attributes
@@ -271,6 +292,22 @@ class StepAverage:
     stance_time: np.ndarray
     flight_time: np.ndarray
     n_steps: int
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per ``tau``: the mean and std of every signal (``<signal>_mean``, ``_std``)."""
+        cols: dict[str, Any] = {"tau": self.tau}
+        units = {"tau": "-"}
+        for name in self.mean.columns:
+            cols[f"{name}_mean"] = self.mean[name].to_numpy()
+            cols[f"{name}_std"] = self.std[name].to_numpy()
+            units[f"{name}_mean"] = units[f"{name}_std"] = SIGNALS.get(name, "-")
+        return frame(cols, units)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """Figure 6.1's layout (3 x 3); on ``ax`` the CoM height ``y`` only."""
+        from ..plotting.experiment import plot_step_average
+
+        return plot_step_average(self, ax=ax)
 
     @property
     def duty_factor(self) -> np.ndarray:

@@ -35,6 +35,7 @@ import numpy as np
 import pandas as pd
 
 from .._checks import check_fits, check_number
+from .._results import Result, with_units
 from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..model.units import ROBOT_SCALING, Scaling
@@ -183,8 +184,30 @@ class RenderOptions:
         check_number(self.seed, "seed", lower=0, integer=True)
 
 
-@dataclass(frozen=True)
-class SyntheticRun:
+def recording_units(columns: Any) -> dict[str, str]:
+    """Units of a recording's per-frame columns, by name: ``*_px`` [px], ``*_m`` [m], ``t`` [s].
+
+    ``frame``, quality flags (``*_q``), stance flags and visible fractions
+    are ``"-"``; ``phi`` is in rad.
+    """
+    out = {}
+    for c in columns:
+        name = str(c)
+        if name.endswith("_px"):
+            out[name] = "px"
+        elif name.endswith("_m"):
+            out[name] = "m"
+        elif name in ("t", "liftoff_t"):
+            out[name] = "s"
+        elif name == "phi":
+            out[name] = "rad"
+        else:
+            out[name] = "-"
+    return out
+
+
+@dataclass(frozen=True, repr=False)
+class SyntheticRun(Result):
     """A simulated run laid out frame by frame, with its ground truth.
 
     Attributes
@@ -237,6 +260,14 @@ class SyntheticRun:
     def n_frames(self) -> int:
         """Number of frames."""
         return len(self.truth)
+
+    def _repr_fields(self) -> dict[str, Any]:
+        return {"frames": self.n_frames, "belt_speed": self.belt_speed,
+                "stance_time": self.stance_time, "flight_time": self.flight_time}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """The ground truth, one row per frame (markers in px and m, model states)."""
+        return with_units(self.truth.copy(), recording_units(self.truth.columns))
 
 
 def synthesize(params: Params, state: TouchdownState, duration: float, *,

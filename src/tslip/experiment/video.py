@@ -28,6 +28,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .._results import Result, with_units
+from .synth import recording_units
+
 # libav's own messages (e.g. "moov atom not found") would go straight to stderr beside
 # our one-line error; OpenCV reads this before it first opens a file.
 os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
@@ -143,8 +146,8 @@ class TrackerOptions:
                    foot_radius=foot_px, **kw)
 
 
-@dataclass(frozen=True)
-class TrackResult:
+@dataclass(frozen=True, repr=False)
+class TrackResult(Result):
     """Per-frame marker positions and what went wrong.
 
     Attributes
@@ -169,6 +172,14 @@ class TrackResult:
     fps: float
     problems: list[str] = field(default_factory=list)
     fatal: bool = False
+
+    def _repr_fields(self) -> dict[str, Any]:
+        return {"frames": len(self.tracks), "fps": self.fps, "problems": len(self.problems),
+                "fatal": self.fatal}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """The tracks, one row per frame (px and m; quality flags)."""
+        return with_units(self.tracks.copy(), recording_units(self.tracks.columns))
 
     @property
     def body_detection_rate(self) -> float:

@@ -32,7 +32,9 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import brentq
 
+from .._results import Result, with_units
 from ..model.parameters import PARAMETER_TABLE, Params
+from ..model.units import COLUMN_UNITS, param_unit
 from ..simulation.options import IntegratorOptions
 from .fixed_point import Gait, GaitProblem, find_gait
 from .stability import floquet
@@ -123,8 +125,8 @@ def set_param(params: Params, name: str, value: float) -> Params:
 # ---------------------------------------------------------------------------
 
 
-@dataclass(frozen=True, eq=False)
-class Branch:
+@dataclass(frozen=True, eq=False, repr=False)
+class Branch(Result):
     """A gait followed along one parameter.
 
     Attributes
@@ -185,6 +187,18 @@ class Branch:
     def __len__(self) -> int:
         return len(self.values)
 
+    def _repr_fields(self) -> dict[str, Any]:
+        lo, hi = self.exists()
+        return {"param": self.param, "points": len(self.values),
+                "converged": int(np.count_nonzero(self.converged)), "exists_from": lo,
+                "exists_to": hi, "stable": int(np.count_nonzero(self.stable))}
+
+    def plot(self, ax: Any = None) -> Any:
+        """Non-trivial multiplier magnitudes against the parameter (thesis Figure 4.8)."""
+        from ..plotting.sweeps import plot_branch
+
+        return plot_branch(self, ax)
+
     @property
     def stable(self) -> np.ndarray:
         """At least neutrally stable (the thesis's green areas)."""
@@ -227,7 +241,9 @@ class Branch:
             row["stability"] = self.stability[i]
             row["message"] = self.messages[i]
             rows.append(row)
-        return pd.DataFrame(rows)
+        units = {**COLUMN_UNITS, "param": "-", "value": param_unit(self.param) or "-",
+                 "max_nontrivial": "-", **{f"abs_lambda_{j}": "-" for j in range(1, 6)}}
+        return with_units(pd.DataFrame(rows), units)
 
 
 # ---------------------------------------------------------------------------

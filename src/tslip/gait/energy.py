@@ -19,15 +19,23 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._results import Result, frame
 from ..model.state import TouchdownState
+from ..model.units import COLUMN_UNITS
 from ..simulation.integrate import Disturbance, simulate
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status, Trajectory
 from .fixed_point import Gait
 from .impulse import Impulse, _impulse_from_run, _stance_run
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 __all__ = [
     "expected_velocity_change",
@@ -88,8 +96,8 @@ def _height(gait: Gait, s: TouchdownState) -> float:
     return gait.params.l0 * math.sin(s.beta) - gait.params.r * math.cos(s.phi)
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class HeightChangeResult:
+@dataclass(frozen=True, slots=True, eq=False, repr=False)
+class HeightChangeResult(Result):
     """Converged touch-down speed after a change in ground height.
 
     Attributes
@@ -132,6 +140,20 @@ class HeightChangeResult:
     speeds: np.ndarray
     n_average: int
     status: Status
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per touch-down: its speed ``v``, and whether it is in the averaging window."""
+        n = len(self.speeds)
+        return frame({"step": np.arange(n), "v": self.speeds,
+                      "averaged": np.arange(n) >= n - self.n_average},
+                     {**COLUMN_UNITS, "averaged": "-"})
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """Touch-down speeds, with the speed eq. 3.8 predicts."""
+        from ..plotting.results import plot_speeds
+
+        return plot_speeds(self.speeds, ax, level=self.v0 + self.dv_expected,
+                           title=f"after a height change of {self.dh:+.3g} L (dashed: eq. 3.8)")
 
 
 def velocity_after_height_change(
@@ -198,8 +220,8 @@ def velocity_after_height_change(
     )
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class StepDownResponse:
+@dataclass(frozen=True, slots=True, eq=False, repr=False)
+class StepDownResponse(Result):
     """Touch-down states stride by stride after a ground step (Figs 4.5, 4.6).
 
     Arrays have one entry per touch-down; entry 0 is the first touch-down,
@@ -242,6 +264,22 @@ class StepDownResponse:
     phi: np.ndarray
     h: np.ndarray
     trajectory: Trajectory
+
+    def _repr_fields(self) -> dict[str, Any]:
+        return {"dh": self.dh, "touchdowns": len(self.stride), "xd_last": self.xd[-1],
+                "height_last": self.height[-1], "trajectory": self.trajectory}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per touch-down (entry 0 on the old ground)."""
+        return frame({"step": self.stride, **{k: getattr(self, k) for k in (
+            "x", "y", "height", "xd", "yd", "speed", "delta", "beta", "phi", "h")}},
+            {**COLUMN_UNITS, "height": "L", "speed": COLUMN_UNITS["v"]})
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """Figures 4.5 and 4.6; on ``ax`` only the touch-down values (Figure 4.5)."""
+        from ..plotting.gait import plot_step_down_response
+
+        return plot_step_down_response(self, ax)
 
     @property
     def phase_correlation(self) -> float:
@@ -308,8 +346,8 @@ def step_down_response(
     )
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class VelocityAngleCase:
+@dataclass(frozen=True, slots=True, eq=False, repr=False)
+class VelocityAngleCase(Result):
     """One stride from the gait with the touch-down velocity angle changed.
 
     Attributes
@@ -337,6 +375,23 @@ class VelocityAngleCase:
     liftoff_delta: float
     impulse: Impulse
     trajectory: Trajectory
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row: the velocity angles, stride times and the stance's impulse."""
+        return frame([{"ddelta": self.ddelta, "delta": self.delta,
+                       "stance_time": self.stance_time, "flight_time": self.flight_time,
+                       "liftoff_delta": self.liftoff_delta, "I_x": self.impulse.I_x,
+                       "I_y": self.impulse.I_y}],
+                     {**COLUMN_UNITS, "ddelta": "rad", "liftoff_delta": "rad",
+                      "I_x": "M g^1/2 L^1/2", "I_y": "M g^1/2 L^1/2"})
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """Figure 4.7 for this case; on ``ax`` the stride's CoM path."""
+        from ..plotting.gait import plot_velocity_angle_effect
+        from ..plotting.trajectories import plot_path
+
+        return plot_velocity_angle_effect([self]) if ax is None else plot_path(self.trajectory,
+                                                                               ax)
 
 
 def velocity_angle_effect(

@@ -42,19 +42,26 @@ import time
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from scipy.optimize import least_squares
 
+from .._results import Result, frame
 from ..model import _pack as pk
 from ..model.controllers import ConstantTorque, GlobalPD, LocalVelocity
 from ..model.parameters import Params
 from ..model.state import TouchdownState
+from ..model.units import COLUMN_UNITS
 from ..simulation import _packed
 from ..simulation.integrate import step_map
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 __all__ = [
     "Gait",
@@ -125,8 +132,8 @@ class CMAReport:
         return math.sqrt(self.c2) if math.isfinite(self.c2) else math.nan
 
 
-@dataclass(frozen=True, slots=True)
-class Gait:
+@dataclass(frozen=True, slots=True, repr=False)
+class Gait(Result):
     """A periodic gait (fixed point of the touch-down map).
 
     Attributes
@@ -159,6 +166,27 @@ class Gait:
     message: str
     method: str = "newton"
     cma: CMAReport | None = None
+
+    def _repr_fields(self) -> dict[str, Any]:
+        return {"converged": self.converged, "residual": self.residual, "v": self.state.v,
+                "beta": self.state.beta, "stance_time": self.stance_time,
+                "flight_time": self.flight_time, "method": self.method}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row: the touch-down state, ``alpha_r``, stride times and the search's outcome."""
+        s = self.state
+        return frame([{"beta": s.beta, "phi": s.phi, "xd": s.xd, "yd": s.yd, "phid": s.phid,
+                       "x": s.x, "h": s.h, "v": s.v, "delta": s.delta,
+                       "alpha_r": self.params.alpha_r, "stance_time": self.stance_time,
+                       "flight_time": self.flight_time, "residual": self.residual,
+                       "converged": self.converged, "method": self.method,
+                       "message": self.message}], COLUMN_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The CoM path over two strides of the gait."""
+        from ..plotting.results import plot_gait
+
+        return plot_gait(self, ax)
 
 
 # ---------------------------------------------------------------------------

@@ -37,17 +37,24 @@ import dataclasses
 import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from scipy.integrate import simpson
 
+from .._results import Result, frame
 from ..model.parameters import Params
 from ..model.state import TouchdownState
+from ..model.units import COLUMN_UNITS, UNIT
 from ..simulation.integrate import simulate
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status, Trajectory
 from .fixed_point import Gait
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 __all__ = [
     "Impulse",
@@ -65,8 +72,20 @@ __all__ = [
 Y_P_SINGULAR_ANGLE = 1e-3
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class Impulse:
+#: Units of the impulse tables (Table 3.1).
+_IMPULSE_UNITS = {**COLUMN_UNITS, "time": UNIT["time"], "I_x": UNIT["impulse"],
+                  "I_y": UNIT["impulse"], "torque": UNIT["angular_impulse"],
+                  "direction": UNIT["angle"], "dphi": UNIT["angle"],
+                  "direction_change": UNIT["angle"], "hip_distance": "r",
+                  "x_p_follows_hip": "-", "restoring": "-", "stance_time": UNIT["time"],
+                  "dI_x": UNIT["impulse"] + " rad^-1", "dI_y": UNIT["impulse"] + " rad^-1",
+                  "dx_p": "L rad^-1", "dy_p": "L rad^-1",
+                  "dtorque": UNIT["angular_impulse"] + " rad^-1", "ddirection": "rad rad^-1",
+                  "y_p_ill_conditioned": "-"}
+
+
+@dataclass(frozen=True, slots=True, eq=False, repr=False)
+class Impulse(Result):
     """Ground reaction impulse of one stance (eqs 3.3 and 3.5).
 
     Positions are relative to the CoM [L]; time since touch-down
@@ -131,6 +150,21 @@ class Impulse:
     hip_y: np.ndarray
     state: TouchdownState | Any
     params: Params | Any
+
+    def _repr_fields(self) -> dict[str, Any]:
+        return {k: getattr(self, k) for k in ("I_x", "I_y", "x_p", "y_p", "torque",
+                                              "direction", "stance_time")}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """The stance samples: time, GRF, and foot and hip positions relative to the CoM."""
+        return frame({k: getattr(self, k) for k in ("time", "F_x", "F_y", "x", "y", "hip_x",
+                                                    "hip_y")}, _IMPULSE_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The forces of the stance at the foot, and the impulse's line of action."""
+        from ..plotting.gait import plot_pitch_impulse
+
+        return plot_pitch_impulse([self], ax)
 
     @property
     def magnitude(self) -> float:
@@ -283,8 +317,8 @@ def _pitched(state: TouchdownState, dphi: float) -> TouchdownState:
     return dataclasses.replace(state, phi=state.phi + dphi)
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class ImpulseLinearisation:
+@dataclass(frozen=True, slots=True, eq=False, repr=False)
+class ImpulseLinearisation(Result):
     """Derivatives of the impulse with respect to the pitch ``phi`` (eq. 3.4).
 
     Central differences ``(f(phi* + dphi) - f(phi* - dphi)) / (2 dphi)`` at
@@ -322,6 +356,18 @@ class ImpulseLinearisation:
     nominal: Impulse
     plus: Impulse
     minus: Impulse
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row: the six derivatives, the conditioning flag and the step ``dphi``."""
+        return frame([{k: getattr(self, k) for k in (
+            "dI_x", "dI_y", "dx_p", "dy_p", "dtorque", "ddirection", "y_p_ill_conditioned",
+            "dphi")}], _IMPULSE_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The gradients of Figure 4.1 as bars."""
+        from ..plotting.gait import plot_impulse_linearisation
+
+        return plot_impulse_linearisation(self, ax)
 
     def as_dict(self) -> dict[str, float]:
         """Return the four gradients of Figure 4.1 plus torque and direction."""
@@ -377,8 +423,8 @@ def impulse_linearisation(
     )
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class PitchResponse:
+@dataclass(frozen=True, slots=True, eq=False, repr=False)
+class PitchResponse(Result):
     """Impulses after pitch disturbances, with a metacentric summary.
 
     Behaves as the sequence of :class:`Impulse` (one per ``dphis`` entry).
@@ -415,6 +461,25 @@ class PitchResponse:
     direction_change: tuple[float, ...]
     x_p_follows_hip: tuple[float, ...]
     restoring: tuple[bool | None, ...]
+
+    def _repr_fields(self) -> dict[str, Any]:
+        return {"dphis": self.dphis, "restoring": self.restoring}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per disturbance: its impulse and the metacentric summary."""
+        rows = [{"dphi": d, "I_x": imp.I_x, "I_y": imp.I_y, "x_p": imp.x_p, "y_p": imp.y_p,
+                 "torque": imp.torque, "direction": imp.direction, "hip_distance": hd,
+                 "direction_change": dc, "x_p_follows_hip": xf, "restoring": r}
+                for d, imp, hd, dc, xf, r in zip(self.dphis, self.impulses, self.hip_distance,
+                                                 self.direction_change, self.x_p_follows_hip,
+                                                 self.restoring)]
+        return frame(rows, _IMPULSE_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """Forces and impulses of every disturbance (thesis Figure 4.2)."""
+        from ..plotting.gait import plot_pitch_impulse
+
+        return plot_pitch_impulse(self, ax)
 
     def __len__(self) -> int:
         """Return the number of disturbances."""

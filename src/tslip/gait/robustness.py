@@ -74,10 +74,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from .._results import Result, frame
 from ..model import _pack as pk
 from ..model.parameters import Params
 from ..model.state import TouchdownState
@@ -88,6 +89,11 @@ from ..simulation.integrate import BatchRun, run_batch, step
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status
 from .fixed_point import Gait
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 __all__ = [
     "KINDS",
@@ -417,8 +423,8 @@ def check_gait(gait: Gait) -> None:
 # ---------------------------------------------------------------------------
 
 
-@dataclass(frozen=True, slots=True)
-class RobustnessLimit:
+@dataclass(frozen=True, slots=True, repr=False)
+class RobustnessLimit(Result):
     """The robustness limit for one disturbance and direction.
 
     Attributes
@@ -461,14 +467,30 @@ class RobustnessLimit:
         """Why the first failing disturbance failed (one line)."""
         return self.status.reason
 
+    def _row(self) -> dict[str, Any]:
+        return {"kind": self.kind, "sign": self.sign, "limit": self.limit,
+                "first_failing": self.first_failing, "unit": self.unit,
+                "fall_stride": self.fall_stride, "status": self.status.name,
+                "n_batches": self.n_batches, "n_runs": self.n_runs, "n_errors": self.n_errors}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row; ``limit`` and ``first_failing`` are in the unit of column ``unit``."""
+        return frame([self._row()], _LIMIT_UNITS)
+
     @property
     def unit(self) -> str:
         """Unit of the disturbance."""
         return UNITS[self.kind]
 
 
-@dataclass(frozen=True, slots=True)
-class RobustnessResult:
+#: Units of a robustness table: the disturbance's own unit is in its ``unit`` column.
+_LIMIT_UNITS = {**dict.fromkeys(("kind", "sign", "unit", "fall_stride", "status", "n_batches",
+                                 "n_runs", "n_errors"), "-"),
+                "limit": "column unit", "first_failing": "column unit"}
+
+
+@dataclass(frozen=True, slots=True, repr=False)
+class RobustnessResult(Result):
     """Robustness limits of a periodic gait (thesis Section 3.1.3).
 
     Attributes
@@ -491,6 +513,23 @@ class RobustnessResult:
     n_steps: int
     tol: float
     options: IntegratorOptions
+
+    def _repr_fields(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"n_steps": self.n_steps}
+        for lim in self.limits:
+            out[lim.kind if lim.sign < 0 else f"{lim.kind}_up"] = lim.limit
+        return out
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per searched kind and sign (see :meth:`RobustnessLimit.to_dataframe`)."""
+        return frame([lim._row() for lim in self.limits] or {k: [] for k in _LIMIT_UNITS},
+                     _LIMIT_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """One bar per limit."""
+        from ..plotting.results import plot_robustness
+
+        return plot_robustness(self, ax)
 
     def get(self, kind: str, sign: int = -1) -> RobustnessLimit:
         """Return the :class:`RobustnessLimit` for ``kind`` and ``sign``."""

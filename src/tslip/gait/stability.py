@@ -25,16 +25,22 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from .._results import Result, frame
 from ..model import _pack as pk
 from ..model.parameters import Params
 from ..simulation import _packed
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status
 from .fixed_point import TIGHT, Gait
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 __all__ = ["Floquet", "floquet", "map_jacobian", "conserved_gradients", "pitch_decoupled",
            "nontrivial_jacobian"]
@@ -45,8 +51,8 @@ TrivialKind = Literal["", "energy", "pitch"]
 _NO_PITCH = [0, 2, 3]
 
 
-@dataclass(frozen=True)
-class Floquet:
+@dataclass(frozen=True, repr=False)
+class Floquet(Result):
     """Floquet multipliers of a periodic gait.
 
     Attributes
@@ -76,6 +82,25 @@ class Floquet:
     jacobian: np.ndarray = field(repr=False)
     method: str = "exact"
     trivial_kinds: tuple[TrivialKind, ...] = ()
+
+    def _repr_fields(self) -> dict[str, Any]:
+        return {"stability": self.stability, "max_nontrivial": self.max_nontrivial,
+                "method": self.method}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per multiplier, largest first: parts, magnitude, whether and why trivial."""
+        m = np.asarray(self.multipliers)
+        kinds = list(self.trivial_kinds) or [""] * len(m)
+        return frame({"k": np.arange(1, len(m) + 1), "real": m.real, "imag": m.imag,
+                      "abs": np.abs(m), "trivial": np.asarray(self.trivial, dtype=bool),
+                      "trivial_kind": kinds}, dict.fromkeys(
+                          ("k", "real", "imag", "abs", "trivial", "trivial_kind"), "-"))
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The multipliers in the complex plane with the unit circle."""
+        from ..plotting.results import plot_floquet
+
+        return plot_floquet(self, ax)
 
     @property
     def magnitudes(self) -> np.ndarray:

@@ -13,14 +13,22 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._results import Result, frame
 from ..model.parameters import Params
 from ..model.state import TouchdownState
+from ..model.units import COLUMN_UNITS, UNIT
 from ..simulation.options import IntegratorOptions
 from .fixed_point import Gait
 from .impulse import _impulse_from_run, _stance_run
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 __all__ = [
     "StrideProperties",
@@ -124,8 +132,14 @@ def fast_running_index(params: Params, v0: float | None = None) -> float:
     return bounce_time(params) / predicted_stance_time(params, v0)
 
 
-@dataclass(frozen=True, slots=True)
-class StrideProperties:
+_STRIDE_UNITS = {**COLUMN_UNITS, **dict.fromkeys(
+    ("bounce_time", "stance_time_predicted", "flight_time_predicted",
+     "flight_time_small_angle"), UNIT["time"]), "step_frequency": UNIT["frequency"],
+    "duty_factor": "-", "fast_running_index": "-", "mu": "-", "ratio": "-"}
+
+
+@dataclass(frozen=True, slots=True, repr=False)
+class StrideProperties(Result):
     """Stride timing of a periodic gait with its closed-form predictions.
 
     Times in [g^-1/2 L^1/2], frequency in [g^1/2 L^-1/2].
@@ -169,6 +183,17 @@ class StrideProperties:
         """``t_s + t_f`` [g^-1/2 L^1/2]."""
         return self.stance_time + self.flight_time
 
+    def _repr_fields(self) -> dict[str, Any]:
+        return {k: getattr(self, k) for k in ("stance_time", "flight_time", "duty_factor",
+                                              "step_frequency", "fast_running_index")}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row: the measured times and their closed-form predictions."""
+        return frame([{k: getattr(self, k) for k in (
+            "stance_time", "flight_time", "stride_time", "duty_factor", "step_frequency",
+            "bounce_time", "stance_time_predicted", "flight_time_predicted",
+            "flight_time_small_angle", "fast_running_index")}], _STRIDE_UNITS)
+
 
 def stride_properties(gait: Gait) -> StrideProperties:
     """Stride timing of a gait (Section 3.4.3, Table 6.2, Figure 4.11).
@@ -209,8 +234,8 @@ def stride_properties(gait: Gait) -> StrideProperties:
     )
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class FrictionCheck:
+@dataclass(frozen=True, slots=True, eq=False, repr=False)
+class FrictionCheck(Result):
     """Horizontal ground force against static friction over a stance (App. C).
 
     Attributes
@@ -253,6 +278,17 @@ class FrictionCheck:
     def slips(self) -> bool:
         """True if friction is exceeded anywhere in the stance."""
         return self.slip_fraction > 0.0
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """The stance samples: time, GRF and ``|F_x| / F_y``."""
+        return frame({"t": self.time, "F_x": self.F_x, "F_y": self.F_y, "ratio": self.ratio},
+                     _STRIDE_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """``|F_x|`` against ``mu F_y`` over the stance (thesis Figure C.1)."""
+        from ..plotting.gait import plot_friction
+
+        return plot_friction(self, ax)
 
 
 def _positive_measure(t: np.ndarray, g: np.ndarray) -> float:

@@ -21,6 +21,7 @@ from .parameters import PARAMETER_TABLE, Params
 
 __all__ = [
     "Scaling", "QUANTITY_DIMS", "ROBOT_SI", "ROBOT_SCALING", "to_si", "from_si", "robot_params",
+    "UNIT", "COLUMN_UNITS", "param_unit",
 ]
 
 #: (M, g, L) exponents of each quantity kind of Table 3.1.
@@ -42,6 +43,66 @@ QUANTITY_DIMS: dict[str, tuple[float, float, float]] = {
     "angular_velocity": (0, 0.5, -0.5),
     "rotational_damping": (1, 0.5, 1.5),
 }
+
+#: The unit of each quantity kind of Table 3.1, written as :data:`PARAMETER_TABLE` does;
+#: ``"-"`` for a pure number, a count, a flag or a text label.
+UNIT: dict[str, str] = {
+    "length": "L",
+    "time": "g^-1/2 L^1/2",
+    "frequency": "g^1/2 L^-1/2",
+    "speed": "g^1/2 L^1/2",
+    "acceleration": "g",
+    "mass": "M",
+    "force": "Mg",
+    "torque": "MgL",
+    "energy": "MgL",
+    "impulse": "M g^1/2 L^1/2",
+    "angular_impulse": "M g^1/2 L^3/2",
+    "angle": "rad",
+    "angular_velocity": "rad g^1/2 L^-1/2",
+    "none": "-",
+}
+
+#: Units of the columns that result tables (``to_dataframe()``) share: the
+#: trajectory's columns (``tslip.simulation.result.TRAJECTORY_COLUMNS``), the
+#: touch-down state, stride times and outcomes.
+COLUMN_UNITS: dict[str, str] = {
+    **dict.fromkeys(("t", "stance_time", "flight_time", "stride_time", "t_fall"), UNIT["time"]),
+    **dict.fromkeys(("x", "y", "l", "foot_x", "foot_y", "hip_x", "hip_y", "h", "x_p", "y_p",
+                     "foot_clearance"), UNIT["length"]),
+    **dict.fromkeys(("xd", "yd", "ld", "v"), UNIT["speed"]),
+    **dict.fromkeys(("phi", "beta", "alpha", "delta", "alpha_r"), UNIT["angle"]),
+    **dict.fromkeys(("phid", "betad", "alphad_ref"), UNIT["angular_velocity"]),
+    **dict.fromkeys(("Fx", "Fy", "F_x", "F_y"), UNIT["force"]),
+    **dict.fromkeys(("tau", "energy", "tau_c"), UNIT["torque"]),
+    **dict.fromkeys(("step", "row", "stance", "status", "converged", "message", "method",
+                     "residual", "reason", "kind", "stability"), UNIT["none"]),
+}
+
+
+def param_unit(name: str) -> str | None:
+    """The unit of a parameter or controller gain by name, None if there is none.
+
+    From :data:`PARAMETER_TABLE` and the controllers' field metadata (also as
+    a dotted ``"controller.<gain>"`` name); ``omega_r_bar`` (eq. 2.18) is a
+    ratio, ``"-"``.
+    """
+    from dataclasses import fields
+
+    from .controllers import CONTROLLERS
+
+    if name == "omega_r_bar":
+        return "-"
+    for row in PARAMETER_TABLE:
+        if row.name == name:
+            return row.unit
+    gain = name.removeprefix("controller.")
+    for cls in CONTROLLERS.values():
+        for f in fields(cls):
+            if f.name == gain and f.metadata.get("unit"):
+                return str(f.metadata["unit"])
+    return None
+
 
 #: The Planar Elliptical Runner's approximate parameters in SI (Table 5.1).
 ROBOT_SI: dict[str, float] = {"v0": 4.4, "m": 3.3, "r": 0.15, "g": 9.81, "l0": 0.5}

@@ -24,22 +24,12 @@ def param_label(name: str) -> str:
     :mod:`tslip.gait.continuation` takes them); ``omega_r_bar`` (eq. 2.18) is
     a ratio, ``[-]``. A name the package does not know is returned as is.
     """
-    from dataclasses import fields
-
-    from ..model.controllers import CONTROLLERS
-    from ..model.parameters import PARAMETER_TABLE
+    from ..model.units import param_unit
 
     if name == "omega_r_bar":
         return "omega_r_bar = omega_r l0 / v0 [-]"
-    for row in PARAMETER_TABLE:
-        if row.name == name:
-            return f"{name} [{row.unit}]"
-    gain = name.removeprefix("controller.")
-    for cls in CONTROLLERS.values():
-        for f in fields(cls):
-            if f.name == gain and f.metadata.get("unit"):
-                return f"{gain} [{f.metadata['unit']}]"
-    return name
+    unit = param_unit(name)
+    return f"{name.removeprefix('controller.')} [{unit}]" if unit is not None else name
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:

@@ -23,6 +23,7 @@ if TYPE_CHECKING:
     from ..simulation.result import StepResult, Trajectory
 
 __all__ = [
+    "plot_path",
     "plot_trajectory",
     "plot_touchdowns",
     "flight_intervals",
@@ -171,29 +172,9 @@ def plot_trajectory(
         fig = Figure(figsize=(10, 6.5), layout="constrained")
     ax_path, ax_phi, ax_l, ax_f = fig.subplots(2, 2).ravel()
     t = traj["t"]
-    x, y = traj["x"], traj["y"]
     t_flight = flight_intervals(traj, "t")
 
-    # -- CoM path --------------------------------------------------------
-    _shade_flight(ax_path, flight_intervals(traj, "x"))
-    gx, gy = ground_profile(traj, terrain, margin=0.5)
-    ax_path.fill_between(gx, gy, np.min(gy) - 0.2, color="0.75", lw=0, zorder=1)
-    ax_path.plot(gx, gy, color="k", lw=1.5, label="ground", zorder=2)
-    ax_path.plot(traj["hip_x"], traj["hip_y"], color="C1", lw=1, ls="--", label="hip")
-    ax_path.plot(x, y, color="C0", lw=1.5, label="CoM", zorder=3)
-    feet = [(e.foot_x, e.foot_y) for e in traj.events if e.kind == "touchdown"]
-    if feet:
-        fx, fy = np.array(feet).T
-        ax_path.plot(fx, fy, ls="none", marker="^", ms=6, color="C3", label="foot", zorder=4)
-    ax_path.set_xlabel(LABELS["x"])
-    ax_path.set_ylabel(LABELS["y"])
-    ax_path.set_title("centre of mass path")
-    if len(x):
-        ax_path.set_xlim(float(np.min(gx)), float(np.max(gx)))
-        y_top = float(np.max(traj["hip_y"]))
-        y_bottom = min(float(np.min(gy)), float(np.min(y)))  # a fall can end below ground
-        ax_path.set_ylim(y_bottom - 0.1, y_top + 0.15 * (y_top - y_bottom))
-    ax_path.legend(loc="center", fontsize="small", ncols=5)
+    plot_path(traj, ax_path, terrain=terrain)
 
     # -- pitch, leg length, forces ------------------------------------------
     for ax in (ax_phi, ax_l, ax_f):
@@ -224,6 +205,38 @@ def plot_trajectory(
         title += f": {traj.status.reason}"
     fig.suptitle(title)
     return fig
+
+
+def plot_path(traj: Trajectory, ax: Axes | None = None, *,
+              terrain: Terrain | None = None) -> Figure:
+    """The CoM and hip paths over the ground, with the footholds; flights shaded.
+
+    The path panel of :func:`plot_trajectory`; on ``ax`` or a new figure.
+    """
+    if ax is None:
+        fig = Figure(figsize=(8, 3), layout="constrained")
+        ax = fig.add_subplot()
+    x, y = traj["x"], traj["y"]
+    _shade_flight(ax, flight_intervals(traj, "x"))
+    gx, gy = ground_profile(traj, terrain, margin=0.5)
+    ax.fill_between(gx, gy, np.min(gy) - 0.2, color="0.75", lw=0, zorder=1)
+    ax.plot(gx, gy, color="k", lw=1.5, label="ground", zorder=2)
+    ax.plot(traj["hip_x"], traj["hip_y"], color="C1", lw=1, ls="--", label="hip")
+    ax.plot(x, y, color="C0", lw=1.5, label="CoM", zorder=3)
+    feet = [(e.foot_x, e.foot_y) for e in traj.events if e.kind == "touchdown"]
+    if feet:
+        fx, fy = np.array(feet).T
+        ax.plot(fx, fy, ls="none", marker="^", ms=6, color="C3", label="foot", zorder=4)
+    ax.set_xlabel(LABELS["x"])
+    ax.set_ylabel(LABELS["y"])
+    ax.set_title("centre of mass path")
+    if len(x):
+        ax.set_xlim(float(np.min(gx)), float(np.max(gx)))
+        y_top = float(np.max(traj["hip_y"]))
+        y_bottom = min(float(np.min(gy)), float(np.min(y)))  # a fall can end below ground
+        ax.set_ylim(y_bottom - 0.1, y_top + 0.15 * (y_top - y_bottom))
+    ax.legend(loc="center", fontsize="small", ncols=5)
+    return ax.get_figure()  # type: ignore[return-value]
 
 
 def plot_touchdowns(

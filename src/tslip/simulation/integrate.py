@@ -10,15 +10,17 @@ import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from .._checks import check_fits, check_number
+from .._results import Result, with_units
 from ..model import _pack as pk
 from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..model.terrain import Terrain
+from ..model.units import COLUMN_UNITS
 from . import _kernels as kn
 from ._threads import choose
 from .options import IntegratorOptions
@@ -31,6 +33,11 @@ from .result import (
     StepResult,
     Trajectory,
 )
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 __all__ = [
     "Disturbance",
@@ -395,7 +402,12 @@ def _com_xy(params: Params, td: TouchdownState) -> tuple[float, float]:
 # ---------------------------------------------------------------------------
 
 
-class BatchStep(NamedTuple):
+#: Columns of a touch-down state row (``TouchdownState.as_array()``).
+_TD_COLUMNS = ("beta", "phi", "xd", "yd", "phid", "x", "h")
+
+
+@dataclass(frozen=True, eq=False)
+class BatchStep(Result):
     """Result of :func:`step_batch` (row-aligned arrays)."""
 
     states: np.ndarray  # (n, 7) next touch-down states, NaN where not OK
@@ -407,8 +419,20 @@ class BatchStep(NamedTuple):
     def __repr__(self) -> str:
         return f"BatchStep({len(self.status)} rows; {_status_counts(self.status)})"
 
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per batch row: status, stride times and the next touch-down state."""
+        import pandas as pd
 
-class BatchRun(NamedTuple):
+        df = pd.DataFrame({"row": np.arange(len(self.status)),
+                           "status": [Status(int(c)).name for c in self.status],
+                           "stance_time": self.stance_time, "flight_time": self.flight_time})
+        for k, name in enumerate(_TD_COLUMNS):
+            df[name] = self.states[:, k]
+        return with_units(df, COLUMN_UNITS)
+
+
+@dataclass(frozen=True, eq=False)
+class BatchRun(Result):
     """Result of :func:`run_batch` (row-aligned arrays)."""
 
     n_done: np.ndarray  # completed strides per row
@@ -419,6 +443,27 @@ class BatchRun(NamedTuple):
     def __repr__(self) -> str:
         return (f"BatchRun({len(self.status)} rows, {self.touchdowns.shape[1] - 1} strides "
                 f"asked; {_status_counts(self.status)})")
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per row and touch-down (NaN after a fall), with the row's outcome."""
+        import pandas as pd
+
+        n, m = self.touchdowns.shape[:2]
+        df = pd.DataFrame({
+            "row": np.repeat(np.arange(n), m), "step": np.tile(np.arange(m), n),
+            "n_done": np.repeat(self.n_done, m),
+            "status": np.repeat([Status(int(c)).name for c in self.status], m),
+            "t_fall": np.repeat(self.t_fall, m)})
+        flat = self.touchdowns.reshape(n * m, 7)
+        for k, name in enumerate(_TD_COLUMNS):
+            df[name] = flat[:, k]
+        return with_units(df, {**COLUMN_UNITS, "n_done": "-"})
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """Touch-down speed stride by stride, a line per row."""
+        from ..plotting.results import plot_batch_run
+
+        return plot_batch_run(self, ax)
 
 
 def _status_counts(codes: np.ndarray) -> str:

@@ -7,19 +7,21 @@ import math
 import operator
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 
-from .._io import git_hash, write_json, write_table
+from .._results import Result, with_units
 from ..model import _pack as pk
 from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..model.terrain import Terrain
+from ..model.units import COLUMN_UNITS
 
 if TYPE_CHECKING:
     import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 __all__ = [
     "Status", "LiftoffState", "StepResult", "StepList", "Trajectory", "Event", "EventList",
@@ -99,7 +101,7 @@ class LiftoffState:
 
 
 @dataclass(frozen=True, slots=True)
-class StepResult:
+class StepResult(Result):
     """One stride: touch-down, stance, lift-off, flight, next touch-down.
 
     Attributes
@@ -143,6 +145,22 @@ class StepResult:
         return (f"StepResult({self.status.name}, stance_time={self.stance_time:.6g}, "
                 f"flight_time={self.flight_time:.6g}, "
                 f"n_integrator_steps={self.n_integrator_steps})")
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """The stance samples: ``t`` since touch-down, leg and pitch states, GRF, hip torque."""
+        import pandas as pd
+
+        cols = ["t", "l", "beta", "phi", "ld", "betad", "phid"]
+        df = pd.DataFrame(self.stance, columns=cols)
+        for k, name in enumerate(("Fx", "Fy", "tau"), 1):
+            df[name] = self.grf[:, k]
+        return with_units(df, COLUMN_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The ground reaction force and hip torque over the stance."""
+        from ..plotting.results import plot_step
+
+        return plot_step(self, ax)
 
     @classmethod
     def from_kernel(cls, params: Params, start: TouchdownState, status: int, out: np.ndarray,
@@ -335,7 +353,7 @@ class EventList(Sequence[Event]):
 
 
 @dataclass(frozen=True)
-class Trajectory:
+class Trajectory(Result):
     """A multi-stride run, sampled in time.
 
     ``data`` has the columns of :data:`TRAJECTORY_COLUMNS`: time, step index,
@@ -384,13 +402,62 @@ class Trajectory:
         return out
 
     def to_dataframe(self) -> pd.DataFrame:
-        """Time series as a tidy ``pandas.DataFrame``."""
+        """Time series as a tidy ``pandas.DataFrame``, one row per sample (units in attrs)."""
         import pandas as pd
 
         df = pd.DataFrame(self.data, columns=list(TRAJECTORY_COLUMNS))
         df["step"] = df["step"].astype(int)
         df["stance"] = df["stance"].astype(bool)
-        return df
+        return with_units(df, COLUMN_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """Four panels (:func:`~tslip.plotting.plot_trajectory`), or the CoM path on ``ax``."""
+        from ..plotting.trajectories import plot_path, plot_trajectory
+
+        return plot_trajectory(self) if ax is None else plot_path(self, ax)
+
+    # -- what save stores: the samples (the table) and the kernel's stride records
+    def _fields(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"data": self.data, "status": self.status, "params": self.params,
+                               "terrain": self.terrain, "meta": self.meta}
+        st, ev = self.steps, self.events
+        if isinstance(st, StepList) and isinstance(ev, EventList) and ev._steps is st:
+            out["strides"] = {"starts": st._starts, "outs": st._outs, "info": st._info,
+                              "tloc": st._tloc, "last": ev._last}
+        else:
+            out["steps"], out["events"] = tuple(st), tuple(ev)
+        return out
+
+    @classmethod
+    def _from_fields(cls, fields: dict[str, Any]) -> Trajectory:
+        fields = dict(fields)
+        rec = fields.pop("strides", None)
+        if rec is not None:
+            steps = StepList(fields["params"], rec["starts"], rec["outs"], rec["info"],
+                             fields["data"], rec["tloc"])
+            fields["steps"], fields["events"] = steps, EventList(steps, rec["last"])
+        return cls(**fields)
+
+    def _table_fields(self) -> tuple[str, ...]:
+        return ("data",)
+
+    @classmethod
+    def _from_table(cls, df: pd.DataFrame, fields: dict[str, Any]) -> dict[str, Any]:
+        data = df[list(TRAJECTORY_COLUMNS)].to_numpy(dtype=np.float64)
+        return {**fields, "data": np.ascontiguousarray(data)}
+
+    def _summary(self) -> dict[str, Any]:
+        from .. import __version__
+
+        return {
+            "tslip_version": __version__,
+            "params": self.params.to_dict(),
+            "status": self.status.name,
+            "reason": self.status.reason,
+            "n_steps": len(self.steps),
+            "terrain": {"breakpoints": self.terrain.breakpoints, "heights": self.terrain.heights},
+            **self.meta,
+        }
 
     def steps_dataframe(self) -> pd.DataFrame:
         """One row per stride: touch-down state, times, outcome."""
@@ -408,27 +475,8 @@ class Trajectory:
                     "status": s.status.name,
                 }
             )
-        return pd.DataFrame(rows)
+        return with_units(pd.DataFrame(rows, columns=_STEP_COLUMNS), COLUMN_UNITS)
 
-    def save(self, path: str | Path) -> Path:
-        """Write the time series to ``.csv`` or ``.parquet`` (atomically).
 
-        A ``<name>.json`` beside it records parameters, status and version.
-        """
-        from .. import __version__
-
-        write_table(self.to_dataframe(), path)
-        path = Path(path)
-        meta = {
-            "tslip_version": __version__,
-            "params": self.params.to_dict(),
-            "status": self.status.name,
-            "reason": self.status.reason,
-            "n_steps": len(self.steps),
-            "terrain": {"breakpoints": self.terrain.breakpoints, "heights": self.terrain.heights},
-            "git": git_hash(),
-            **self.meta,
-        }
-        write_json(path.with_suffix(".json"), meta)
-        return path
-
+_STEP_COLUMNS = ["step", "beta", "phi", "xd", "yd", "phid", "v", "delta", "x", "h",
+                 "stance_time", "flight_time", "foot_x", "foot_clearance", "status"]

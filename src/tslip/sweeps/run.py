@@ -35,22 +35,29 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
 
 from .. import __version__
 from .._io import atomic_write, git_hash, write_json, write_table
+from .._results import Result, with_units
 from ..gait.continuation import get_param
+from ..gait.robustness import UNITS as ROBUSTNESS_UNITS
+from ..model.units import COLUMN_UNITS, UNIT, param_unit
 from . import _pool
 from ._lock import folder_lock
 from ._schedule import Task, choose_workers, run_tasks
 from .point import Pending, Solved, analyse_point, code_version, seeds_from_records, solve_gaits
 from .spec import StudySpec
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
 __all__ = ["StudyInterrupted", "StudyJob", "StudyResult", "run_study", "point_key",
-           "saved_points", "study_keys"]
+           "saved_points", "study_keys", "STUDY_UNITS"]
 
 Progress = Callable[[int, int], None]
 
@@ -158,13 +165,54 @@ def _analyse_task(spec: StudySpec, items: list[Pending], keys: list[str], cache:
     return out
 
 
-@dataclass(frozen=True)
-class StudyResult:
+#: Units of a study's result columns (:func:`tslip.sweeps.point.analyse_point`), besides
+#: its axes' parameters. ``seconds`` is wall time.
+STUDY_UNITS: dict[str, str] = {
+    **COLUMN_UNITS,
+    **dict.fromkeys(("n_trivial", "max_nontrivial", "min_nontrivial", "duty_factor",
+                     "fast_running_index", *(f"abs_lambda_{j}" for j in range(1, 6)),
+                     *(f"{kind}_status" for kind in ROBUSTNESS_UNITS)), "-"),
+    **dict.fromkeys(("stance_time_predicted", "flight_time_predicted", "bounce_time"),
+                    UNIT["time"]),
+    "step_frequency": UNIT["frequency"],
+    **ROBUSTNESS_UNITS,
+    "seconds": "s",
+}
+
+
+@dataclass(frozen=True, repr=False)
+class StudyResult(Result):
     """A study's tidy results: one row per point, axes first."""
 
     spec: StudySpec
     frame: pd.DataFrame
     meta: dict[str, Any] = field(default_factory=dict)
+
+    def _repr_fields(self) -> dict[str, Any]:
+        f = self.frame
+        conv = int(f["converged"].sum()) if "converged" in f else None
+        return {"name": self.spec.name, "points": len(f),
+                "axes": tuple(a.param for a in self.spec.axes), "converged": conv}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """The table: one row per point, axes first (units of the axes and the results)."""
+        units = {**STUDY_UNITS, **{a.param: param_unit(a.param) or "-" for a in self.spec.axes}}
+        return with_units(self.frame.copy(), units)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """Non-trivial multiplier magnitudes against the last axis; stable domain shaded."""
+        from ..plotting.studies import plot_study_multipliers
+
+        return plot_study_multipliers(self, ax)
+
+    def _table_fields(self) -> tuple[str, ...]:
+        return ("frame",)
+
+    @classmethod
+    def _from_table(cls, df: pd.DataFrame, fields: dict[str, Any]) -> dict[str, Any]:
+        df = df.copy()
+        df.attrs = {}
+        return {**fields, "frame": df}
 
     def column(self, name: str) -> np.ndarray:
         """One result column as an array."""
