@@ -39,6 +39,7 @@ def same(a: Any, b: Any, where: str = "obj") -> None:
         assert [str(t) for t in a.dtypes] == [str(t) for t in b.dtypes], (where, a.dtypes,
                                                                           b.dtypes)
         assert a.index.equals(b.index), f"{where}: index differs"
+        same(dict(a.attrs), dict(b.attrs), f"{where}.attrs")
         for c in a.columns:
             same(a[c].to_numpy(), b[c].to_numpy(), f"{where}[{c!r}]")
         return
