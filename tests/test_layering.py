@@ -16,8 +16,8 @@ ALLOWED = {
     "biped": {"model", "simulation", "gait"},
     "plotting": {"model", "simulation", "gait", "sweeps", "experiment", "biped"},
 }
-TOP = {"_io", "_results", "_checks", "_kernel_cache", "_codehash", "__init__", "__main__",
-       "_typing", "__version__"}
+TOP = {"_io", "_results", "_checks", "_kernel_cache", "_codehash", "_renamed", "protocols",
+       "__init__", "__main__", "_typing", "__version__"}
 
 
 def _imports(path: Path, plot_methods: bool = True) -> set[str]:
