@@ -7,15 +7,13 @@ is given, and a one-line repr.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 
 import numpy as np
 import pytest
-from matplotlib.figure import Figure
 
 import tslip
-from _same import same
+from _result_checks import check_frozen, check_plot, check_repr, check_round_trip, check_units
 from tslip import gait as tg
 from tslip._results import Result
 
@@ -56,6 +54,7 @@ def _objects(gait) -> dict[str, object]:
                                                               n_average=5),
         "StepDownResponse": tg.step_down_response(gait, -0.05, n_steps=4),
         "VelocityAngleCase": tg.velocity_angle_effect(gait, (0.02,))[0],
+        "GaitReport": tg.analyse(gait.params, gait=gait, n_steps=5),
     }
 
 
@@ -64,7 +63,7 @@ def _study_and_experiment(gait) -> dict[str, object]:
     import pandas as pd
 
     from tslip.experiment.fit import FitResult, fit_scores, model_curves, stride_table
-    from tslip.experiment.render import render_frames
+    from tslip.experiment.render import camera_frames
     from tslip.experiment.signals import ProcessOptions, average_steps, process_tracks
     from tslip.experiment.synth import Camera, synthesize
     from tslip.experiment.video import Calibration, TrackerOptions, track_frames
@@ -89,7 +88,7 @@ def _study_and_experiment(gait) -> dict[str, object]:
                     times=stride_table(avg, ts, tf), cost=0.5, n_evals=1, converged=True,
                     message="built in the test")
     cal = Calibration(cam.px_per_m, cam.ground_px, cam.hip_px)
-    track = track_frames(render_frames(run, stop=6), cal, TrackerOptions.for_scale(
+    track = track_frames(camera_frames(run, stop=6), cal, TrackerOptions.for_scale(
         cal.px_per_m), fps=cam.fps)
     return {"StudyResult": study, "SyntheticRun": run, "StepData": data, "StepAverage": avg,
             "FitResult": fit, "TrackResult": track}
@@ -107,68 +106,35 @@ NAMES = ["Trajectory", "Trajectory, a fall", "StepResult", "BatchStep", "BatchRu
          "Floquet", "RobustnessResult", "RobustnessLimit", "Impulse", "ImpulseLinearisation",
          "PitchResponse", "Branch", "StrideProperties", "FrictionCheck", "HeightChangeResult",
          "StepDownResponse", "VelocityAngleCase", "StudyResult", "SyntheticRun", "StepData",
-         "StepAverage", "FitResult", "TrackResult"]
+         "StepAverage", "FitResult", "TrackResult", "GaitReport"]
 #: Classes without a figure of their own.
 NO_PLOT = {"BatchStep", "RobustnessLimit", "StrideProperties", "SyntheticRun", "TrackResult"}
 
 
 @pytest.mark.parametrize("name", NAMES)
 def test_is_a_frozen_result_dataclass(objects, name):
-    obj = objects[name]
-    assert isinstance(obj, Result) and dataclasses.is_dataclass(obj)
-    f = dataclasses.fields(obj)[0].name
-    with pytest.raises(dataclasses.FrozenInstanceError):
-        setattr(obj, f, None)
+    check_frozen(objects[name])
 
 
 @pytest.mark.parametrize("suffix", [".json", ".parquet", ".csv"])
 @pytest.mark.parametrize("name", NAMES)
 def test_round_trip_is_bit_for_bit(objects, name, suffix, tmp_path):
-    obj = objects[name]
-    path = obj.save(tmp_path / f"r{suffix}")
-    back = tslip.load(path)
-    same(obj, back)
-    same(obj, type(obj).load(path))
-    rec = json.loads(path.with_suffix(".json").read_text())
-    run = rec["run"]
-    assert run["tslip_version"] == tslip.__version__ and len(run["code_hash"]) == 24
-    assert run["class"] == f"{type(obj).__module__}:{type(obj).__qualname__}"
-    if hasattr(obj, "params"):
-        assert run["params"] == obj.params.to_dict()
-    if suffix != ".json":  # the table beside the record is to_dataframe()
-        import pandas as pd
-
-        df = pd.read_parquet(path) if suffix == ".parquet" else pd.read_csv(path)
-        want = obj.to_dataframe()
-        assert list(df.columns) == list(want.columns) and len(df) == len(want)
-        assert rec["table"]["units"] == want.attrs["units"]
+    check_round_trip(objects[name], tmp_path / f"r{suffix}")
 
 
 @pytest.mark.parametrize("name", NAMES)
 def test_table_has_a_unit_for_every_column(objects, name):
-    df = objects[name].to_dataframe()
-    units = df.attrs["units"]
-    assert list(units) == [str(c) for c in df.columns]
-    assert all(isinstance(u, str) and u for u in units.values())
-    assert len(df.columns) > 0 and df.columns.is_unique
+    check_units(objects[name])
 
 
 @pytest.mark.parametrize("name", NAMES)
 def test_repr_is_one_short_line(objects, name):
-    text = repr(objects[name])
-    assert "\n" not in text and len(text) <= 200
-    assert text.startswith(type(objects[name]).__name__ + "(")
+    check_repr(objects[name])
 
 
 @pytest.mark.parametrize("name", sorted(set(NAMES) - NO_PLOT))
 def test_plot_draws_on_the_given_axes(objects, name):
-    fig = Figure()
-    ax = fig.add_subplot()
-    assert objects[name].plot(ax=ax) is fig
-    assert ax.lines or ax.patches or ax.collections  # something was drawn there
-    assert len(fig.axes) <= 2  # on ax (a twin axis at most), not on new axes
-    own = objects[name].plot()
-    assert isinstance(own, Figure) and own is not fig and own.axes
+    check_plot(objects[name])
 
 
 @pytest.mark.parametrize("name", sorted(NO_PLOT))
@@ -205,3 +171,28 @@ def test_loaded_trajectory_rebuilds_its_strides_and_events(objects, tmp_path):
     assert [e.kind for e in back.events] == [e.kind for e in tr.events]
     assert back.steps[2].state == tr.steps[2].state
     assert np.array_equal(back.steps[1].grf, tr.steps[1].grf)
+
+
+def test_gait_report_dict_is_the_results_numbers(objects):
+    """The JSON dict of the report holds the numbers of the result objects it keeps."""
+    rep = objects["GaitReport"]
+    d = rep.to_dict()
+    json.dumps(d, allow_nan=False)  # plain JSON
+    assert d["floquet"]["max_nontrivial"] == rep.floquet.max_nontrivial
+    assert d["robustness"]["step_down"]["limit"] == rep.robustness.step_down
+    assert d["stride"]["duty_factor"] == rep.stride.duty_factor
+    assert d["gait"]["stance_time"] == rep.gait.stance_time
+    assert d["impulse"]["nominal"]["I_y"] == rep.impulse.nominal.I_y
+    assert not rep.errors
+
+
+def test_gait_report_keeps_the_reason_of_a_refused_analysis(gait, tmp_path):
+    """Robustness refuses an unconverged gait: the report keeps why, and still saves."""
+    import dataclasses
+
+    bad = dataclasses.replace(gait, converged=False)
+    rep = tg.analyse(bad.params, gait=bad, n_steps=3)
+    assert rep.robustness is None and "converge" in rep.errors["robustness"]
+    assert rep.to_dict()["robustness"] == {"error": rep.errors["robustness"]}
+    assert rep.to_dataframe()["step_down"].isna().all()
+    check_round_trip(rep, tmp_path / "rep.json")

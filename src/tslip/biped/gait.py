@@ -13,12 +13,13 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .._renamed import accepts_n_strides, module_getattr, warn_renamed
+from .._results import Result, frame
 from ..gait.stability import Floquet as _TslipFloquet
 from ..gait.stability import TrivialKind, classify_stability
 from ..simulation.result import Status
@@ -26,7 +27,12 @@ from . import _kernels as kn
 from . import _pack as pk
 from .dynamics import controller_references, leg_phase
 from .parameters import BIPED_PARAMETER_TABLE, STATE_FIELDS, BipedParams, BipedState
-from .simulate import BipedOptions, Trajectory, simulate, step
+from .simulate import BIPED_UNITS, BipedOptions, Trajectory, simulate, step
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 __all__ = [
     "SECTION_FIELDS",
@@ -85,7 +91,7 @@ def step_map(params: BipedParams, z: NDArray[np.float64],
     return to_section(params, res.state, res.t), res.status
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Floquet(_TslipFloquet):
     """Multipliers of the linearised stride map at a section vector.
 
@@ -228,8 +234,8 @@ def tracking_errors(tr: Trajectory, leg: int = 0, t_from: float = -math.inf,
                           (float(ls.min()), float(ls.max())))
 
 
-@dataclass(frozen=True)
-class Gait:
+@dataclass(frozen=True, repr=False)
+class Gait(Result):
     """A periodic gait of the biped: the outcome of :func:`find_periodic_gait`.
 
     Never raised on non-convergence. The biped's counterpart of
@@ -259,6 +265,24 @@ class Gait:
     evaluations: int
     history: list[float] = field(default_factory=list)
     multipliers: NDArray[np.complex128] | None = field(default=None, repr=False)
+
+    def _repr_fields(self) -> dict[str, Any]:
+        return {"converged": self.converged, "residual": self.residual,
+                "evaluations": self.evaluations}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row: the section vector (:data:`SECTION_FIELDS`) and the search's outcome."""
+        row: dict[str, Any] = dict(zip(SECTION_FIELDS, np.asarray(self.z).tolist()))
+        row.update(residual=self.residual, converged=self.converged,
+                   evaluations=self.evaluations, message=self.message)
+        return frame([row], BIPED_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The right foot's path relative to the hip over one stride of the gait."""
+        from ..plotting.biped import plot_foot_path
+
+        y, t0 = from_section(self.params, self.z)
+        return plot_foot_path(simulate(self.params, y, 1, t0=t0), ax=ax)
 
 
 #: Free section entries of the thesis search (starred in Table E.2): pitch

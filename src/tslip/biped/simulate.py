@@ -24,19 +24,25 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .._checks import check_fields
 from .._renamed import accepts_n_strides, module_getattr, warn_renamed
+from .._results import Result, frame, with_units
 from ..model._pack import METHODS
 from ..simulation.result import Status
 from . import _kernels as kn
 from . import _pack as pk
 from ._legacy import SIMULATE_ALIASES
 from .parameters import STATE_FIELDS, BipedParams, BipedState
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 __all__ = [
     "BipedOptions",
@@ -58,6 +64,28 @@ RECORD_COLUMNS: tuple[str, ...] = (
     ("t",) + STATE_FIELDS + ("contact_R", "contact_L", "Fx_R", "Fz_R", "Fx_L", "Fz_L",
                               "tau_R", "tau_L", "F_tR", "F_tL", "F_sR", "F_sL")
 )
+
+
+def state_unit(name: str) -> str:
+    """Unit of a state field (eq. E.9) or its rate (``*_d``), Table 3.1."""
+    base = name.removesuffix("_d")
+    unit = "rad" if base.startswith("theta") else "L"
+    if name.endswith("_d"):
+        return "rad g^1/2 L^-1/2" if unit == "rad" else "g^1/2 L^1/2"
+    return unit
+
+
+#: Units of the biped's result tables: the recorded columns, the state and the contact state.
+BIPED_UNITS: dict[str, str] = {
+    "t": "g^-1/2 L^1/2", **{n: state_unit(n) for n in STATE_FIELDS},
+    **dict.fromkeys(("contact_R", "contact_L", "on_R", "on_L", "status", "accepted",
+                     "rho_R", "converged", "residual", "evaluations", "message"), "-"),
+    **dict.fromkeys(("Fx_R", "Fz_R", "Fx_L", "Fz_L", "F_tR", "F_tL", "F_sR", "F_sL"), "Mg"),
+    **dict.fromkeys(("tau_R", "tau_L"), "MgL"),
+    **dict.fromkeys(("x_R", "z_R", "x_L", "z_L"), "L"),
+}
+#: The contact state ``(on_R, on_L, x_R, z_R, x_L, z_L)``: flags and touch-down anchors.
+CONTACT_FIELDS = ("on_R", "on_L", "x_R", "z_R", "x_L", "z_L")
 
 
 def to_status(code: int) -> Status:
@@ -159,8 +187,8 @@ class BipedEvent:
     foot_z: float
 
 
-@dataclass(frozen=True)
-class Trajectory:
+@dataclass(frozen=True, repr=False)
+class Trajectory(Result):
     """A biped run, recorded at every accepted integrator step and event.
 
     The biped's counterpart of :class:`tslip.Trajectory` (both are
@@ -193,6 +221,26 @@ class Trajectory:
     def __getitem__(self, name: str) -> NDArray[np.float64]:
         return self.data[:, RECORD_COLUMNS.index(name)]
 
+    def _repr_fields(self) -> dict[str, Any]:
+        t = self.data[:, 0]
+        return {"n_steps": self.n_steps, "samples": len(t),
+                "t_from": t[0] if len(t) else None, "t_to": t[-1] if len(t) else None,
+                "status": self.status}
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The right foot's path relative to the hip against the reference (Figure E.3)."""
+        from ..plotting.biped import plot_foot_path
+
+        return plot_foot_path(self, ax=ax)
+
+    def _table_fields(self) -> tuple[str, ...]:
+        return ("data",)
+
+    @classmethod
+    def _from_table(cls, df: pd.DataFrame, fields: dict[str, Any]) -> dict[str, Any]:
+        data = df[list(RECORD_COLUMNS)].to_numpy(dtype=np.float64)
+        return {**fields, "data": np.ascontiguousarray(data)}
+
     @property
     def time(self) -> NDArray[np.float64]:
         """Sample times [g^-1/2 L^1/2]."""
@@ -224,11 +272,11 @@ class Trajectory:
         return count_strides(self.events, t_end=float(self.stats.get("t_end", self.time[-1])),
                              fell=self.fell, min_contact=mc)
 
-    def to_dataframe(self) -> Any:
-        """The recorded time series as a ``pandas.DataFrame``."""
+    def to_dataframe(self) -> pd.DataFrame:
+        """The recorded time series, one row per sample (units in attrs)."""
         import pandas as pd
 
-        return pd.DataFrame(self.data, columns=list(RECORD_COLUMNS))
+        return with_units(pd.DataFrame(self.data, columns=list(RECORD_COLUMNS)), BIPED_UNITS)
 
 
 def count_strides(events: list[BipedEvent], *, t_end: float, fell: bool,
@@ -356,8 +404,8 @@ def simulate(
     )
 
 
-@dataclass(frozen=True, slots=True)
-class StepResult:
+@dataclass(frozen=True, slots=True, repr=False)
+class StepResult(Result):
     """One stride of the biped (right touch-down to the next), as :func:`step` returns it.
 
     The biped's counterpart of :class:`tslip.StepResult` (both are
@@ -380,6 +428,17 @@ class StepResult:
     state: NDArray[np.float64]
     contact: NDArray[np.float64]
     accepted: int
+
+    def _repr_fields(self) -> dict[str, Any]:
+        return {"status": self.status, "t": self.t, "accepted": self.accepted}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row: the outcome, the next right touch-down's time, state and contact state."""
+        row: dict[str, Any] = {"status": self.status.name, "t": self.t,
+                               "accepted": self.accepted}
+        row.update(zip(STATE_FIELDS, np.asarray(self.state).tolist()))
+        row.update(zip(CONTACT_FIELDS, np.asarray(self.contact).tolist()))
+        return frame([row], BIPED_UNITS)
 
     @property
     def fell(self) -> bool:

@@ -158,7 +158,7 @@ def gait_cmd(
         gait = find_gait(params, method="cma" if method == "cma" else "newton", seed=seed)
         if not gait.converged:
             fail(gait.message, 1)
-        rep = analyse(params, gait=gait, robustness=not no_robustness)
+        rep = analyse(params, gait=gait, robustness=not no_robustness).to_dict()
         if as_json:
             typer.echo(json.dumps(rep, indent=2))
         else:

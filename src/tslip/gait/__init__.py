@@ -26,7 +26,7 @@ from .impulse import (
     pitch_disturbance_response,
     stance_impulse,
 )
-from .report import analyse
+from .report import GaitReport, analyse
 from .robustness import RobustnessLimit, RobustnessResult, robustness, robustness_report
 from .stability import Floquet, floquet, map_jacobian, pitch_decoupled
 from .stride import (
@@ -46,7 +46,7 @@ __all__ = [
     "step_down_response", "velocity_after_height_change", "velocity_angle_effect",
     "CMAReport", "Gait", "GaitProblem", "cma_minimize", "find_gait", "gait_residual",
     "Impulse", "ImpulseLinearisation", "PitchResponse", "impulse_linearisation",
-    "pitch_disturbance_response", "stance_impulse", "analyse",
+    "pitch_disturbance_response", "stance_impulse", "analyse", "GaitReport",
     "RobustnessLimit", "RobustnessResult", "robustness", "robustness_report",
     "Floquet", "floquet", "map_jacobian", "pitch_decoupled",
     "FrictionCheck", "StrideProperties", "bounce_time", "fast_running_index", "friction_ratio",
