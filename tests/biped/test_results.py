@@ -8,6 +8,7 @@ import pytest
 import tslip
 from _result_checks import check_frozen, check_plot, check_repr, check_round_trip, check_units
 from tslip.biped import BipedParams, BipedState, simulate, step
+from tslip.biped.design import DesignSearch
 from tslip.biped.gait import find_periodic_gait, floquet, to_section
 from tslip.biped.metacentre import metacentric_test
 from tslip.biped.stored import load_gait
@@ -27,10 +28,15 @@ def objects():
         "Floquet": floquet(p, z),
         "PitchResponse": metacentric_test(p, BipedState.from_array(y), t0,
                                           pitches=(0.0, 0.1)),
+        "DesignSearch": DesignSearch(
+            best={"score": 0.81, "residual": 3e-9, "params": p.to_dict(), "z": z.tolist(),
+                  "largest": 0.81, "message": "ok", "design": {"Kp_h": 1.25}},
+            evaluations=17, history=(0.93, 0.88, 0.81), seconds=12.5, interrupted=True),
     }
 
 
-NAMES = ["Trajectory", "Trajectory, short", "StepResult", "Gait", "Floquet", "PitchResponse"]
+NAMES = ["Trajectory", "Trajectory, short", "StepResult", "Gait", "Floquet", "PitchResponse",
+         "DesignSearch"]
 NO_PLOT = {"StepResult"}
 
 
@@ -86,3 +92,13 @@ def test_loaded_trajectory_works_like_the_original(objects, tmp_path):
     back = tslip.load(tr.save(tmp_path / "b.parquet"))
     assert back.n_steps == tr.n_steps and back.count_strides() == tr.count_strides()
     assert np.array_equal(back["Fz_R"], tr["Fz_R"])
+
+
+def test_design_search_reads_as_the_dict_it_replaced(objects):
+    r = objects["DesignSearch"]
+    assert r["best"]["score"] == 0.81 and r["history"] == (0.93, 0.88, 0.81)
+    assert r["interrupted"] is True and r["evaluations"] == 17
+    with pytest.raises(KeyError):
+        r["nope"]
+    df = r.to_dataframe()
+    assert list(df["best_score"]) == [0.93, 0.88, 0.81] and list(df["generation"]) == [0, 1, 2]

@@ -27,16 +27,24 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from typing import Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .._checks import check_number
+from .._results import Result, frame
 from .gait import refine_periodic_gait, section_multipliers
 from .parameters import BipedParams
 
-__all__ = ["DESIGN_BOUNDS", "SEARCH_SETTINGS", "apply_design", "check_search_settings",
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["DESIGN_BOUNDS", "SEARCH_SETTINGS", "DesignSearch", "apply_design",
+           "check_search_settings",
            "design_objective", "stable_gait_search"]
 
 #: Design variable -> (lower, upper); see the module docstring.
@@ -134,13 +142,63 @@ def check_search_settings(names: dict[str, str] | None = None, **values: Any) ->
         check_number(value, (names or {}).get(key, key), **SEARCH_SETTINGS[key])
 
 
+@dataclass(frozen=True, repr=False)
+class DesignSearch(Result):
+    """What :func:`stable_gait_search` found.
+
+    Attributes
+    ----------
+    best : dict
+        The best :func:`design_objective` result (``score``, ``residual``,
+        ``params``, ``z``, ``largest``, ``message``) plus its ``design``.
+    evaluations : int
+        Designs scored.
+    history : tuple of float
+        Best score after the start and after each generation.
+    seconds : float
+        Wall time [s].
+    interrupted : bool
+        Ended by Ctrl-C (the best so far is kept).
+    """
+
+    best: dict[str, Any]
+    evaluations: int
+    history: tuple[float, ...]
+    seconds: float
+    interrupted: bool
+
+    def __getitem__(self, key: str) -> Any:
+        """The field ``key``, as from the dict this result replaced."""
+        if key not in ("best", "evaluations", "history", "seconds", "interrupted"):
+            raise KeyError(key)
+        return getattr(self, key)
+
+    def _repr_fields(self) -> dict[str, Any]:
+        return {"score": self.best.get("score"), "evaluations": self.evaluations,
+                "generations": len(self.history) - 1, "seconds": self.seconds,
+                "interrupted": self.interrupted}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per generation (0: the start): the best score so far."""
+        return frame({"generation": range(len(self.history)), "best_score": self.history},
+                     {"generation": "-", "best_score": "-"})
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The best score (largest multiplier magnitude, or a penalty) per generation."""
+        from ..plotting.results import plot_series
+
+        return plot_series(self.history, ax, xlabel="generation [-]",
+                           ylabel="best score (max |lambda|) [-]",
+                           title=f"design search: {self.evaluations} designs")
+
+
 def stable_gait_search(base: BipedParams, z0: NDArray[np.float64], *,
                        names: tuple[str, ...] = tuple(DESIGN_BOUNDS),
                        budget_s: float = 600.0, max_evals: int = 400, popsize: int = 8,
                        sigma0: float = 0.08, seed: int = 3, processes: int = 1,
                        log: Callable[[str], None] | None = None,
                        on_improve: Callable[[dict[str, Any]], None] | None = None,
-                       ) -> dict[str, Any]:
+                       ) -> DesignSearch:
     """CMA-ES over the design variables ``names`` for the smallest ``max |lambda|``.
 
     ``base`` and ``z0`` are a converged gait (the warm start). Stops after
@@ -152,7 +210,7 @@ def stable_gait_search(base: BipedParams, z0: NDArray[np.float64], *,
 
     Returns
     -------
-    dict
+    DesignSearch
         ``best`` (the best :func:`design_objective` result plus ``design``),
         ``evaluations``, ``history`` (best score per generation), ``seconds``,
         ``interrupted``.
@@ -217,5 +275,5 @@ def stable_gait_search(base: BipedParams, z0: NDArray[np.float64], *,
         if pool is not None:
             pool.terminate() if interrupted else pool.close()
             pool.join()
-    return {"best": best, "evaluations": n_ev, "history": history,
-            "seconds": time.perf_counter() - t_start, "interrupted": interrupted}
+    return DesignSearch(best=best, evaluations=n_ev, history=tuple(history),
+                        seconds=time.perf_counter() - t_start, interrupted=interrupted)

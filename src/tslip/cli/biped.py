@@ -319,11 +319,11 @@ def optimise_cmd(
         r = stable_gait_search(p, z0, budget_s=budget, max_evals=max_evals, popsize=popsize,
                                sigma0=sigma0, seed=seed, processes=processes, log=c.print,
                                on_improve=checkpoint)
-        b = r["best"]
+        b = r.best
         data: dict[str, Any] = {"design": b.get("design"), "bounds": DESIGN_BOUNDS,
-                                "evaluations": r["evaluations"], "seconds": r["seconds"],
-                                "history": r["history"], "residual": b["residual"],
-                                "converged": b["score"] < 10.0, "interrupted": r["interrupted"]}
+                                "evaluations": r.evaluations, "seconds": r.seconds,
+                                "history": list(r.history), "residual": b["residual"],
+                                "converged": b["score"] < 10.0, "interrupted": r.interrupted}
         if "z" in b:
             bp = BipedParams.from_dict(b["params"])
             data.update(params=b["params"], z=b["z"])
@@ -332,7 +332,7 @@ def optimise_cmd(
             data.update(extra)
             for line in lines:
                 c.print(line)
-        c.print(f"best score {b['score']:.4f} after {r['evaluations']} designs "
-                f"({r['seconds']:.0f} s)")
+        c.print(f"best score {b['score']:.4f} after {r.evaluations} designs "
+                f"({r.seconds:.0f} s)")
         write_json(out, data)
         c.print(f"wrote {out}")

@@ -150,9 +150,9 @@ class HeightChangeResult(Result):
 
     def plot(self, ax: Axes | None = None) -> Figure:
         """Touch-down speeds, with the speed eq. 3.8 predicts."""
-        from ..plotting.results import plot_speeds
+        from ..plotting.results import plot_series
 
-        return plot_speeds(self.speeds, ax, level=self.v0 + self.dv_expected,
+        return plot_series(self.speeds, ax, level=self.v0 + self.dv_expected,
                            title=f"after a height change of {self.dh:+.3g} L (dashed: eq. 3.8)")
 
 

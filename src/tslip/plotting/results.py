@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from ..simulation.result import StepResult
 
 __all__ = ["plot_step", "plot_floquet", "plot_robustness", "plot_gait", "plot_batch_run",
-           "plot_speeds"]
+           "plot_series"]
 
 
 def _axes(ax: Axes | None, size: tuple[float, float] = (6.0, 3.6)) -> tuple[Figure, Axes]:
@@ -109,14 +109,15 @@ def plot_batch_run(run: BatchRun, ax: Axes | None = None) -> Figure:
     return fig
 
 
-def plot_speeds(speeds: Any, ax: Axes | None = None, *, level: float | None = None,
+def plot_series(values: Any, ax: Axes | None = None, *, level: float | None = None,
+                xlabel: str = "touch-down number [-]", ylabel: str = LABELS["v"],
                 title: str = "") -> Figure:
-    """Touch-down speeds stride by stride, with an optional reference ``level``."""
+    """Values one by one (touch-down speeds, a search's best score), with a ``level`` line."""
     fig, ax = _axes(ax)
-    ax.plot(np.arange(len(speeds)), speeds, marker="o", ms=3, color="C0")
+    ax.plot(np.arange(len(values)), values, marker="o", ms=3, color="C0")
     if level is not None and np.isfinite(level):
         ax.axhline(level, color="C3", ls="--", lw=1)
-    ax.set_xlabel("touch-down number [-]")
-    ax.set_ylabel(LABELS["v"])
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize="medium")
     return fig
