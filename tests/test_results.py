@@ -184,6 +184,8 @@ def _crafted(tmp_path, result) -> Path:
     "os:system", "builtins:eval", "subprocess:Popen",
     "tslip._io:os.system.__call__", "tslip._results:Result.__subclasses__",
     "tslip.model:Params ; os", "tslip", "",
+    "tslip.__main__:X",              # importing it would run the command line
+    "__main__:Box",                  # the running script's namespace
 ])
 def test_a_crafted_file_builds_nothing_else(tmp_path, name):
     marker = tmp_path / "ran"
@@ -197,6 +199,13 @@ def test_a_crafted_file_builds_nothing_else(tmp_path, name):
     with pytest.raises(ValueError):
         tslip.load(path)
     assert not marker.exists()
+
+
+def test_the_command_line_module_is_never_imported(tmp_path):
+    assert "tslip.__main__" not in sys.modules
+    with pytest.raises(ValueError, match="bad class name"):
+        tslip.load(_crafted(tmp_path, {"__type__": "tslip.__main__:main", "fields": {}}))
+    assert "tslip.__main__" not in sys.modules
 
 
 def test_a_module_outside_tslip_is_never_imported(tmp_path):

@@ -154,7 +154,6 @@ class Result:
         suffix = path.suffix.lower()
         if suffix not in SUFFIXES:
             raise ValueError(f"path must end in one of {', '.join(SUFFIXES)}, got {str(path)!r}")
-        fields = self._fields()
         record: dict[str, Any] = {**encode(self._summary(), "summary"), "format": FORMAT,
                                   "run": run_record(self)}
         if suffix == ".json":
@@ -163,7 +162,7 @@ class Result:
             return path
         df = self.to_dataframe()
         table = set(self._table_fields())
-        rest = {k: v for k, v in fields.items() if k not in table}
+        rest = {k: v for k, v in self._fields().items() if k not in table}
         record["table"] = {"file": path.name, "fields": sorted(table),
                            "units": dict(df.attrs.get("units", {})),
                            "dtypes": {str(c): str(t) for c, t in df.dtypes.items()}}
@@ -344,14 +343,15 @@ def _resolve(name: Any) -> type:
 
     Allowed: dataclasses and enums defined in ``tslip`` (whose module is
     imported here if it is not yet), and :class:`Result` subclasses of any
-    module already imported. Nothing else is looked up or called.
+    module already imported. Nothing else is looked up or called, and no
+    ``__main__`` (``python -m tslip`` runs the command line when imported).
     """
     if not isinstance(name, str) or name.count(":") != 1:
         raise ValueError(f"bad class name {name!r}")
     module, qual = name.split(":")
     mparts, qparts = module.split("."), qual.split(".")
     if not all(_IDENT.match(p) for p in mparts + qparts) or any(
-            p.startswith("__") for p in qparts):
+            p.startswith("__") for p in mparts + qparts):
         raise ValueError(f"bad class name {name!r}")
     in_tslip = mparts[0] == "tslip"
     if in_tslip:
