@@ -12,7 +12,7 @@ warn and are removed in 0.4.
 """
 
 from .._renamed import module_getattr
-from ..simulation.result import Status
+from ..simulation.result import Status as Status  # the shared enum, also here
 from ._legacy import SIMULATE_ALIASES
 from .dynamics import accelerations, energy, mass_matrix
 from .parameters import BIPED_PARAMETER_TABLE, BipedParams, BipedState
@@ -23,7 +23,6 @@ __all__ = [
     "BipedParams",
     "BipedState",
     "BipedOptions",
-    "Status",
     "StepResult",
     "Trajectory",
     "simulate",
