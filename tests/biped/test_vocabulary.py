@@ -138,3 +138,25 @@ def test_the_old_names_of_a_biped_step_and_run_still_simulate():
     new = biped.step(BipedParams(), BipedState.thesis().to_array(), 0.0)
     assert isinstance(res, StrideResult) and res.t == new.t
     np.testing.assert_array_equal(res.state, new.state)
+
+
+def test_every_name_in_the_docs_vocabulary_table_exists():
+    """docs/model.md, "Vocabulary": each dotted tslip name it cites resolves."""
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).parents[2] / "docs" / "model.md").read_text()
+    section = text[text.index("## Vocabulary"):]
+    names = set(re.findall(r"`(?:\{\w+\}`)?(tslip(?:\.\w+)+)", section))
+    assert len(names) >= 15, names
+    for name in sorted(names):
+        parts = name.split(".")
+        for cut in range(len(parts), 0, -1):  # the longest importable module prefix
+            try:
+                obj = importlib.import_module(".".join(parts[:cut]))
+                break
+            except ImportError:
+                continue
+        for attr in parts[cut:]:
+            obj = getattr(obj, attr)  # AttributeError names the missing one
+        assert obj is not None, name
