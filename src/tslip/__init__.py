@@ -60,7 +60,8 @@ _SUBPACKAGE = {
 }
 
 #: Subpackages, imported on first attribute access too (``tslip.gait.analyse``).
-_SUBPACKAGES = ("biped", "cli", "experiment", "gait", "model", "plotting", "simulation", "sweeps")
+_SUBPACKAGES = ("biped", "cli", "experiment", "gait", "model", "plotting", "protocols",
+               "simulation", "sweeps")
 
 __all__ = [
     "__version__",

@@ -43,7 +43,6 @@ __all__ = [
     "BipedEvent",
     "Trajectory",
     "StepResult",
-    "Status",
     "to_status",
     "MIN_CONTACT_FRACTION",
     "count_strides",

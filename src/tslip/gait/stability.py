@@ -37,7 +37,7 @@ from ..simulation.result import Status
 from .fixed_point import TIGHT, Gait
 
 __all__ = ["Floquet", "floquet", "map_jacobian", "conserved_gradients", "pitch_decoupled",
-           "nontrivial_jacobian", "classify_stability"]
+           "nontrivial_jacobian"]
 
 Stability = Literal["asymptotic", "neutral", "unstable"]
 TrivialKind = Literal["", "energy", "pitch"]
@@ -86,6 +86,17 @@ class Floquet:
     def stable(self) -> bool:
         """At least neutrally stable (the thesis's condition for robustness)."""
         return self.stability != "unstable"
+
+
+def classify_stability(max_nontrivial: float, unit_tol: float = 1e-6) -> Stability:
+    """The stability rule of both models' :class:`Floquet` (eq. 2.21's largest multiplier).
+
+    "unstable" above ``1 + unit_tol`` (and for NaN: a perturbed stride fell),
+    "neutral" within ``unit_tol`` of 1, "asymptotic" below.
+    """
+    if not max_nontrivial <= 1.0 + unit_tol:
+        return "unstable"
+    return "neutral" if max_nontrivial >= 1.0 - unit_tol else "asymptotic"
 
 
 def conserved_gradients(params: Params, q: np.ndarray) -> list[np.ndarray]:
@@ -232,17 +243,7 @@ def floquet(
     trivial = np.array([k != "" for k in kinds])
     others = np.abs(lam[~trivial])
     max_nt = float(others.max()) if others.size else 0.0
+    stability = classify_stability(max_nt, unit_tol)
     return Floquet(multipliers=lam, trivial=trivial, max_nontrivial=max_nt,
-                   stability=classify_stability(max_nt, unit_tol), jacobian=A, method=method,
+                   stability=stability, jacobian=A, method=method,
                    trivial_kinds=tuple(kinds))
-
-
-def classify_stability(max_nontrivial: float, unit_tol: float = 1e-6) -> Stability:
-    """The stability rule of both models' :class:`Floquet` (eq. 2.21's largest multiplier).
-
-    "unstable" above ``1 + unit_tol`` (and for NaN: a perturbed stride fell),
-    "neutral" within ``unit_tol`` of 1, "asymptotic" below.
-    """
-    if not max_nontrivial <= 1.0 + unit_tol:
-        return "unstable"
-    return "neutral" if max_nontrivial >= 1.0 - unit_tol else "asymptotic"

@@ -31,12 +31,13 @@ class IntegrationError(RuntimeError):
     """The integrator could not proceed (not a fall: a numerical failure)."""
 
 
-#: Codes of outcomes that are neither a fall nor an error (20+). The TSLIP's
-#: kernels return codes 0-19 (``model._pack.ST_*``); the biped's own codes are
-#: translated to these at one boundary (:func:`tslip.biped._pack.to_status`).
+#: Codes only the biped reaches (the TSLIP's kernels return those of
+#: ``model._pack.ST_*``); the biped kernels' own codes are translated to the
+#: shared ones at one boundary (:func:`tslip.biped.simulate.to_status`). 20 is
+#: left for the apex map's ``NO_APEX``.
 ST_FALL_PITCH = 6
 ST_FALL_LEG = 7
-ST_T_END = 20
+ST_T_END = 21
 
 
 @enum.unique  # two names on one code would silently make one an alias of the other
