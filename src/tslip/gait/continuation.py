@@ -272,7 +272,7 @@ class Branch:
 
 def _solve_point(
     base: Params, param: str, value: float, history: list[tuple[float, Gait]], tol: float,
-    options: IntegratorOptions | None, predictor: str, hold: dict[str, Any],
+    options: IntegratorOptions | None, predictor: str, hold: dict[str, Any] | None = None,
 ) -> tuple[Gait, str]:
     """One point: secant predictor, then the neighbour, then the automatic guesses.
 
@@ -280,6 +280,7 @@ def _solve_point(
     speed, not the apex speed a branch may hold); ``hold``: ``find_gait``'s
     ``fix``, ``energy``, ``section``.
     """
+    hold = hold or {}
     p = set_param(base, param, value)
     prob = GaitProblem.from_params(p, options, **hold)
     starts: list[tuple[str, np.ndarray]] = []
