@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..model.parameters import Params
+from ..model.parameters import PARAMETER_TABLE, Params
 from ..simulation.options import IntegratorOptions
 from .continuation import get_param, set_param
 from .fixed_point import Gait, find_gait
@@ -273,10 +273,8 @@ class StableRegion:
         df = pd.DataFrame({self.names[0]: a.ravel(), self.names[1]: b.ravel(),
                            "n_gaits": self.n_gaits.ravel(), "n_stable": self.n_stable.ravel(),
                            "max_nontrivial": self.max_nontrivial.ravel()})
-        from ..plotting.sweeps import param_label
-
-        df.attrs["units"] = {n: param_label(n).rpartition("[")[2].rstrip("]") or "-"
-                             for n in self.names}
+        units = {row.name: row.unit for row in PARAMETER_TABLE}
+        df.attrs["units"] = {n: units.get(n, "-") for n in self.names}
         df.attrs["units"].update({"n_gaits": "-", "n_stable": "-", "max_nontrivial": "-"})
         return df
 
