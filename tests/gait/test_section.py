@@ -165,3 +165,135 @@ def test_bad_inputs_are_one_line_errors(slip):
         apex_map(tslip.preset("table2.1"), ApexState(1.0, 5.0))
     with pytest.raises(ValueError, match="ApexState.y"):
         ApexState(math.nan, 1.0)
+
+
+# ---------------------------------------------------------------------------
+# the gait search at fixed energy and on the apex section, against the reference
+# ---------------------------------------------------------------------------
+
+
+def ref_apex_fixed_point(E, beta, k, lo, hi):
+    """Fixed point of the reference apex map in (lo, hi) and its derivative there."""
+    from scipy.optimize import brentq
+
+    def f(y):
+        return ref_apex_map(y, E, beta, k)[0] - y
+
+    y = brentq(f, lo, hi, xtol=1e-14)
+
+    def central(h):
+        return (ref_apex_map(y + h, E, beta, k)[0] - ref_apex_map(y - h, E, beta, k)[0]) / (2 * h)
+
+    return y, (4.0 * central(2e-5) - central(4e-5)) / 3.0  # Richardson
+
+
+def test_fixed_energy_gait_matches_the_reference_fixed_point(slip):
+    E = 2.2
+    g = tslip.find_gait(slip, fix="energy", energy=E)
+    assert g.converged and g.fix == "energy"
+    s = g.state
+    # the energy held, by hand (m = g = l0 = 1, r = 0): v^2/2 + sin(beta0)
+    assert 0.5 * (s.xd**2 + s.yd**2) + math.sin(s.beta) == pytest.approx(E, abs=1e-12)
+    assert g.params.v0 == pytest.approx(s.v, abs=1e-15)  # the touch-down speed found
+    assert s.phi == 0.0 and s.phid == 0.0  # the undetermined pitch held at r = 0
+    y_apex = math.sin(s.beta) + 0.5 * s.yd**2
+    assert g.apex.y == pytest.approx(y_apex, abs=1e-14)
+    y_ref, d_ref = ref_apex_fixed_point(E, slip.beta0, slip.k, y_apex - 0.01, y_apex + 0.01)
+    assert y_apex == pytest.approx(y_ref, abs=1e-9)
+    f_td = tslip.floquet(g)
+    f_ap = tslip.floquet(g, section="apex")
+    assert f_ap.multipliers.shape == (4,) and f_ap.section == "apex"
+    assert f_ap.max_nontrivial == pytest.approx(abs(d_ref), abs=1e-6)
+    assert f_td.max_nontrivial == pytest.approx(abs(d_ref), abs=1e-6)
+    assert f_ap.stability == f_td.stability == "asymptotic"
+
+
+def _nonzero_nontrivial(f):
+    lam = f.multipliers[~f.trivial]
+    return np.sort_complex(lam[np.abs(lam) > 1e-9])
+
+
+@pytest.mark.parametrize("name, fd_tol", [("slip", 1e-6), ("table2.1", 2e-6)])
+def test_apex_multipliers_equal_the_touchdown_ones(name, fd_tol):
+    """Return maps of one flow on two sections are conjugate: the same multipliers but
+    the touch-down 0 of a leg set at a fixed angle. Table 2.1 without retraction
+    (r = 0.3, local reset) goes through the kernels' touch-down search from the apex."""
+    p = dataclasses.replace(tslip.preset(name), omega_r=0.0)
+    g = tslip.find_gait(p)
+    assert g.converged
+    f_td = tslip.floquet(g)
+    f_ap = tslip.floquet(g, section="apex")
+    f_fd = tslip.floquet(g, section="apex", method="fd")  # differences of the apex map itself
+    lam_td = np.sort_complex(f_td.multipliers)
+    assert np.min(np.abs(lam_td)) < 1e-9  # the touch-down 0 (the fixed leg angle)
+    lam_td = lam_td[np.abs(lam_td) > 1e-9]
+    np.testing.assert_allclose(np.sort_complex(f_ap.multipliers), lam_td, atol=1e-9)
+    np.testing.assert_allclose(np.sort_complex(f_fd.multipliers), lam_td, atol=fd_tol)
+    np.testing.assert_allclose(_nonzero_nontrivial(f_ap), _nonzero_nontrivial(f_td), atol=1e-9)
+    assert f_ap.stability == f_td.stability
+
+
+def test_apex_section_holds_the_forward_speed(slip):
+    g = tslip.find_gait(slip, section="apex")
+    assert g.converged and g.section == "apex"
+    assert g.state.xd == pytest.approx(slip.v0, abs=1e-12)  # v0 is the apex speed here
+    assert g.held == g.state.xd
+    assert tslip.floquet(g).section == "apex"  # the gait's section by default
+
+
+def test_fixed_energy_tslip_gait():
+    """Table 2.1 (r = 0.3, the pitch free) at a fixed energy: held, and kept by the stride."""
+    p = tslip.preset("table2.1")
+    g = tslip.find_gait(p, fix="energy", energy=15.0)
+    assert g.converged
+    s = g.state
+    by_hand = (0.5 * p.m * (s.xd**2 + s.yd**2) + 0.5 * p.J * s.phid**2
+               + p.m * p.g * (p.l0 * math.sin(s.beta) - p.r * math.cos(s.phi)))
+    assert by_hand == pytest.approx(15.0, abs=1e-12)
+    nxt = tslip.step(g.params, s, options=TIGHT).state
+    assert total_energy(p, nxt) == pytest.approx(15.0, abs=1e-9)
+
+
+def test_fixed_energy_continuation_holds_energy_and_pitch():
+    """The stop-17 case: along beta0 at fixed energy the undetermined pitch drifted (to 3e23)
+    and the branch crashed; with the pitch held it runs, at constant energy."""
+    p = dataclasses.replace(tslip.preset("slip"), k=25.0)
+    b = tslip.continue_gait(p, "beta0", np.linspace(1.1, 1.4, 13), fix="energy", energy=2.2)
+    assert b.fix == "energy" and b.energy == 2.2
+    assert b.converged.sum() >= 10
+    for g in b.gaits:
+        if g is None:
+            continue
+        s = g.state
+        assert 0.5 * (s.xd**2 + s.yd**2) + math.sin(s.beta) == pytest.approx(2.2, abs=1e-10)
+        assert s.phi == 0.0 and s.phid == 0.0
+    df = b.to_dataframe()
+    np.testing.assert_allclose(df["energy"].dropna(), 2.2, atol=1e-10)
+    # the apex branch: the same gaits and the same non-trivial multipliers
+    a = tslip.continue_gait(p, "beta0", b.values[b.converged], fix="energy", energy=2.2,
+                            section="apex")
+    assert a.multipliers.shape == (b.converged.sum(), 4) and a.converged.all()
+    np.testing.assert_allclose(a.max_nontrivial, b.max_nontrivial[b.converged], rtol=1e-8)
+
+
+def test_stability_boundary_at_fixed_energy_matches_the_reference():
+    """Where the SLIP's flat gait turns unstable along beta0 at E = 2.2: re-solved at fixed
+    energy (at fixed speed the boundary would be elsewhere), against the reference."""
+    from scipy.optimize import brentq
+
+    p = tslip.preset("slip")
+    b = tslip.continue_gait(p, "beta0", np.linspace(1.17, 1.215, 4), fix="energy", energy=2.2)
+    assert b.converged.all()
+    (x,) = tslip.gait.stability_boundaries(b)
+
+    def excess(beta):
+        g = b.gaits[int(np.argmin(np.abs(b.values - beta)))]
+        y = g.apex.y
+        lo = max(math.sin(beta) + 1e-6, y - 0.02)
+        return abs(ref_apex_fixed_point(2.2, beta, p.k, lo, y + 0.02)[1]) - 1.0
+
+    i = int(np.argmax(b.max_nontrivial > 1.0))
+    x_ref = brentq(excess, b.values[i - 1], b.values[i], xtol=1e-8)
+    assert x == pytest.approx(x_ref, abs=1e-5)
+    fixed_speed = tslip.continue_gait(p, "beta0", np.linspace(1.17, 1.215, 4))
+    assert abs(tslip.gait.stability_boundaries(fixed_speed)[0] - x) > 1e-4  # 7.7e-4
