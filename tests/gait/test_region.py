@@ -115,5 +115,7 @@ def test_bad_inputs(slip):
         all_gaits(slip, energy=E, deltas=[0.1, 0.2])
     with pytest.raises(ValueError, match="energy"):
         tslip.find_gait(slip, energy=2.2)  # an energy without fix="energy"
+    with pytest.raises(ValueError, match=r"energy must be in \(0.928"):
+        all_gaits(slip, energy=0.5)  # below the touch-down potential sin(1.19)
     with pytest.raises(ValueError, match="fix must be"):
         tslip.find_gait(slip, fix="power")

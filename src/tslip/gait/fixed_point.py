@@ -327,6 +327,8 @@ def _newton_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float,
     z, err, n = newton_solve(prob.residual, itertools.chain([first], starts), tol=tol,
                              max_starts=max_starts,
                              jacobian=prob.residual_jacobian if exact else None)
+    if z is not None and not prob.exists(z):  # least squares left the energy's states
+        z = None
     if z is None:  # every start failed inside the solver
         g = _make_gait(prob, first, tol, "")
         return dataclasses.replace(

@@ -218,6 +218,12 @@ class GaitProblem:
             raise ValueError(f"section must be 'touchdown' or 'apex', got {self.section!r}")
         if self.fix == "energy" and not math.isfinite(self.energy):
             raise ValueError(f"energy [MgL] must be finite with fix='energy', got {self.energy!r}")
+        if self.fix == "energy":
+            p = self.params
+            e_min = p.m * p.g * (p.l0 * math.sin(p.beta0) - p.r)  # at rest, touching down
+            if not self.energy > e_min:
+                raise ValueError(f"energy must be in ({e_min:.6g}, inf) MgL (above the "
+                                 f"touch-down potential at beta0), got {self.energy!r}")
         object.__setattr__(self, "_idx", {n: i for i, n in enumerate(self.names)})
         # as pack_params(decode(z)[0]) but for alpha_r and the reference, which
         # _stride writes in: tau = P[P_C0] + ..., P_C0 = Kd * alphad_ref (eq. 2.14)
@@ -270,6 +276,14 @@ class GaitProblem:
         kin = (self.energy - p.m * p.g * (p.l0 * math.sin(p.beta0) - p.r * math.cos(phi))
                - 0.5 * p.J * phid * phid)
         return math.sqrt(2.0 * kin / p.m) if kin > 0.0 else math.nan
+
+    def exists(self, z: Sequence[float] | np.ndarray) -> bool:
+        """Whether a touch-down state exists at ``z`` (the energy held can reach it)."""
+        try:
+            values = self._values(z)
+        except ValueError:
+            return False
+        return math.isfinite(self.speed(values["delta"], values["phi"], values["phid"]))
 
     def _speed_gradient(self, delta: float, phi: float, phid: float, v: float
                         ) -> dict[str, float]:
