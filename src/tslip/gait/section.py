@@ -372,7 +372,7 @@ def apex_map(params: Params, apex: ApexState,
         Model; the leg angle law must make the apex a section (:func:`apex_section_ok`).
     apex : ApexState
     options : IntegratorOptions, optional
-        Stance integration (default tolerance 1e-6; gait analyses use 1e-12).
+        Stance integration (default: dopri5 at 1e-8, the thesis's; gait analyses use 1e-12).
 
     Returns
     -------
