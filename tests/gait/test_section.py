@@ -297,3 +297,20 @@ def test_stability_boundary_at_fixed_energy_matches_the_reference():
     assert x == pytest.approx(x_ref, abs=1e-5)
     fixed_speed = tslip.continue_gait(p, "beta0", np.linspace(1.17, 1.215, 4))
     assert abs(tslip.gait.stability_boundaries(fixed_speed)[0] - x) > 1e-4  # 7.7e-4
+
+
+def test_tslip_descent_with_a_turning_trunk():
+    """r = 0.3 and phid != 0: no closed form, the kernels' touch-down search from the apex.
+    The touch-down it finds satisfies eq. 2.9 on the parabola, and the closed-form way back
+    (touchdown_to_apex) returns the apex."""
+    p = dataclasses.replace(tslip.preset("table2.1"), omega_r=0.0, alpha_r=1.0)
+    a = ApexState(y=1.1, xd=4.8, phi=0.05, phid=0.4, x=0.2)
+    td = apex_to_touchdown(p, a)
+    T = -td.yd / p.g
+    phi_t = a.phi + a.phid * T
+    assert td.phi == pytest.approx(phi_t, abs=1e-14)
+    assert td.beta == pytest.approx(p.alpha_r - phi_t, abs=1e-14)  # local reset: alpha - phi
+    foot = a.y - 0.5 * p.g * T**2 + p.r * math.cos(phi_t) - p.l0 * math.sin(td.beta)
+    assert abs(foot) < 1e-12  # eq. 2.9
+    np.testing.assert_allclose(touchdown_to_apex(p, td).as_array(), a.as_array(), atol=1e-12)
+    assert total_energy(p, td) == pytest.approx(total_energy(p, a), abs=1e-12)
