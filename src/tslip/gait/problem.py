@@ -188,7 +188,7 @@ class GaitProblem:
     >>> prob = GaitProblem.from_params(tslip.preset("table2.1"))
     >>> prob.names
     ('delta', 'phi', 'phid', 'alpha_r')
-    >>> g = find_gait(prob.params)
+    >>> g = tslip.find_gait(prob.params)
     >>> bool(prob.c1(prob.encode(g)) < 1e-20)
     True
     """

@@ -225,7 +225,7 @@ def apex_to_touchdown(params: Params, apex: ApexState,
 
 def _apex_speed(params: Params, y: np.ndarray, E: float, phid: float | np.ndarray
                 ) -> np.ndarray:
-    """Forward speed at apex height ``y`` and energy ``E`` (:func:`energy` solved for xd)."""
+    """Forward speed at apex height ``y`` and energy ``E`` (:func:`total_energy` solved for xd)."""
     p = params
     kin = E - p.m * p.g * y - 0.5 * p.J * np.asarray(phid) ** 2
     if np.any(kin < 0.0) or not np.all(np.isfinite(kin)):
