@@ -28,7 +28,7 @@ import time
 import numpy as np
 from _baseline import BASELINE_REV, best_of, run_at
 
-from tslip.biped import BipedOptions, BipedParams, BipedState, simulate, stride
+from tslip.biped import BipedOptions, BipedParams, BipedState, simulate, step
 from tslip.biped import _kernels as kn
 from tslip.biped import _pack as pk
 from tslip.sweeps.appendix_e import table_e2_perturbations
@@ -90,6 +90,7 @@ def scipy_stride(p: BipedParams, y0: np.ndarray, method: str, tol: float) -> dic
             cs[pk.CS_ON_R + k] = 0.0
 
 
+# the baseline revision predates the shared names: its one stride is ``stride``
 _SETUP = ("import numpy as np\n"
           "from tslip.biped import BipedOptions, BipedParams, BipedState, simulate, stride\n"
           "p = BipedParams(); y0 = BipedState.thesis().to_array()\n")
@@ -104,7 +105,7 @@ def main() -> None:
     a = ap.parse_args()
     p = BipedParams()
     y0 = BipedState.thesis().to_array()
-    ref = stride(p, y0, 0.0, options=BipedOptions(rtol=1e-12, atol=1e-12, method="dop853"))
+    ref = step(p, y0, 0.0, options=BipedOptions(rtol=1e-12, atol=1e-12, method="dop853"))
 
     best_scipy = np.inf
     if not a.no_scipy:
@@ -125,9 +126,9 @@ def main() -> None:
     new, new_cpu = {}, {}
     for m in ("dopri5", "dop853"):
         opts = BipedOptions(rtol=a.tol, atol=a.tol, method=m)
-        r = stride(p, y0, 0.0, options=opts)
-        new[m] = best_of(lambda opts=opts: stride(p, y0, 0.0, options=opts), a.repeat)
-        new_cpu[m] = best_of(lambda opts=opts: stride(p, y0, 0.0, options=opts), a.repeat,
+        r = step(p, y0, 0.0, options=opts)
+        new[m] = best_of(lambda opts=opts: step(p, y0, 0.0, options=opts), a.repeat)
+        new_cpu[m] = best_of(lambda opts=opts: step(p, y0, 0.0, options=opts), a.repeat,
                            time.process_time)
         print(f"   {m:7s}: {1e3 * new[m]:7.2f} ms/stride wall, {1e3 * new_cpu[m]:7.2f} ms CPU, "
               f"{r.accepted} steps, |t - t_ref| {abs(r.t - ref.t):.1e}, |y - y_ref| "

@@ -29,7 +29,7 @@ def main() -> None:
 
     cv2.setNumThreads(1)
     import tslip
-    from tslip.experiment.render import render_frames, write_video
+    from tslip.experiment.render import camera_frames, write_video
     from tslip.experiment.synth import Camera, synthesize
     from tslip.experiment.video import Calibration, TrackerOptions, track_frames, track_video
 
@@ -39,7 +39,7 @@ def main() -> None:
     cal = Calibration(cam.px_per_m, cam.ground_px, cam.hip_px)
     opt = TrackerOptions.for_scale(cam.px_per_m)
     t0 = time.perf_counter()
-    frames = list(render_frames(run))
+    frames = list(camera_frames(run))
     t_render = time.perf_counter() - t0
     t_mem = math.inf
     for _ in range(args.repeat):

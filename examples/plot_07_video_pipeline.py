@@ -13,7 +13,7 @@ model's signals, average the steps, and fit the model, scored by correlation and
 
 import tslip
 from tslip.experiment import average_steps, fit_model, process_tracks
-from tslip.experiment.render import render_frames
+from tslip.experiment.render import camera_frames
 from tslip.experiment.synth import Camera, synthesize
 from tslip.experiment.video import TrackerOptions, measure_calibration, track_frames
 from tslip.plotting.experiment import plot_step_average
@@ -22,9 +22,9 @@ gait = tslip.find_gait(tslip.preset("table6.1"))
 camera = Camera(width=512, height=408, fps=500.0)
 run = synthesize(gait.params, gait.state, 1.6, camera=camera)   # 1.6 s of video
 
-first = next(render_frames(run, stop=1))
+first = next(camera_frames(run, stop=1))
 cal = measure_calibration(first, 0.18)       # scale from the two body discs, 0.18 m apart
-tracks = track_frames(render_frames(run), cal, TrackerOptions.for_scale(cal.px_per_m),
+tracks = track_frames(camera_frames(run), cal, TrackerOptions.for_scale(cal.px_per_m),
                       fps=camera.fps)
 print(f"tracked {len(tracks.tracks)} frames at {cal.px_per_m:.1f} px/m")
 

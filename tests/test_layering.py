@@ -16,7 +16,8 @@ ALLOWED = {
     "biped": {"model", "simulation", "gait"},
     "plotting": {"model", "simulation", "gait", "sweeps", "experiment", "biped"},
 }
-TOP = {"_io", "_checks", "_kernel_cache", "_codehash", "__init__", "__main__", "_typing",
+TOP = {"_io", "_checks", "_kernel_cache", "_codehash", "_renamed", "protocols", "__init__",
+       "__main__", "_typing",
        "__version__"}
 
 

@@ -14,7 +14,7 @@ from tslip.biped import BipedParams, BipedState
 from tslip.biped.gait import (
     find_periodic_gait,
     from_section,
-    stride_map,
+    step_map,
     to_section,
 )
 from tslip.biped.stored import gait_path
@@ -29,7 +29,7 @@ def test_section_round_trip_and_stride_map_phase():
     y2, t0 = from_section(p, z)
     assert t0 == pytest.approx(0.0)
     np.testing.assert_array_equal(y2[1:], y[1:])
-    z1, st = stride_map(p, z)
+    z1, st = step_map(p, z)
     assert st.name == "OK"
     assert 0.0 <= z1[-1] < 1.0
     assert z1[-1] != pytest.approx(z[-1], abs=1e-3)  # the Table E.2 stride is not T long
@@ -101,7 +101,7 @@ def test_stored_gaits_load_by_name_and_bad_sources_are_one_line(tmp_path):
         # periodic: recomputed from the state, not the residual the file records
         z = to_section(p, y, t0)
         np.testing.assert_allclose(z, data["z"], rtol=0, atol=1e-12)
-        z1, st = stride_map(p, z, REFINE_OPTIONS)
+        z1, st = step_map(p, z, REFINE_OPTIONS)
         assert st.name == "OK" and np.linalg.norm(_wrap(z1 - z)) < 1e-8, name
     with pytest.raises(ValueError, match="does not exist.*converged-e2"):
         load_gait(str(tmp_path / "nope.json"))

@@ -17,7 +17,7 @@ from tslip.biped.gait import (
     floquet,
     refine_periodic_gait,
     section_multipliers,
-    stride_map,
+    step_map,
     survives_disturbance,
     to_section,
 )
@@ -42,16 +42,16 @@ def test_stored_converged_gait_is_periodic_and_stable():
         data = json.load(fh)
     p = BipedParams.from_dict(data["params"])
     z = np.array(data["z"])
-    z1, st = stride_map(p, z, REFINE_OPTIONS)
+    z1, st = step_map(p, z, REFINE_OPTIONS)
     assert st.name == "OK"
     assert np.linalg.norm(_wrap(z1 - z)) < 1e-8
     fr = floquet(p, z)  # central differences on the section, step 1e-5
     assert fr.residual < 1e-8 and fr.multipliers.shape == (17,)
-    assert 0.5 < fr.largest < 1.0
+    assert 0.5 < fr.max_nontrivial < 1.0
     # a second step size (10x) and a forward-difference check agree to 1e-4
     for ev in (section_multipliers(p, z, fd_step=1e-4),
                section_multipliers(p, z, fd_step=1e-5, central=False)):
-        assert abs(np.abs(ev[0]) - fr.largest) < 1e-4
+        assert abs(np.abs(ev[0]) - fr.max_nontrivial) < 1e-4
         lead = ev[np.abs(ev) > np.abs(ev[0]) - 1e-3]  # the leading (complex pair) multipliers
         for m in fr.multipliers[:lead.size]:
             assert np.min(np.abs(lead - m)) < 1e-4
@@ -67,13 +67,13 @@ def test_floquet_stays_on_the_section():
     z_off[0] += 1e-3  # off the section: floquet puts it back first
     fr = floquet(p, z_off, eps=1e-4)
     assert fr.z[0] == pytest.approx(z[0], abs=1e-9)
-    assert fr.largest == pytest.approx(0.788, abs=2e-3)
+    assert fr.max_nontrivial == pytest.approx(0.788, abs=2e-3)
 
 
 def test_disturbance_kinds():
     p = BipedParams()
     z = to_section(p, BipedState.thesis().to_array(), 0.0)
-    ok, status = survives_disturbance(p, z, "push", 0.0, n_strides=1)
+    ok, status = survives_disturbance(p, z, "push", 0.0, n_steps=1)
     assert ok and status == "OK"
     with pytest.raises(ValueError, match="unknown disturbance"):
         survives_disturbance(p, z, "kick", 0.1)

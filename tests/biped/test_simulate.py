@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import tslip
-from tslip.biped import BipedOptions, BipedParams, BipedState, BipedStatus, simulate, stride
+from tslip.biped import BipedOptions, BipedParams, BipedState, Status, simulate, step
 
 
 def _tslip_limit_case():
@@ -55,15 +55,15 @@ def test_massless_single_leg_limit_matches_tslip_stance():
 
 def test_table_e2_run_records_alternating_contacts_and_right_strides():
     tr = simulate(BipedParams(), BipedState.thesis(), 2)
-    assert tr.status == BipedStatus.OK
+    assert tr.status == Status.OK
     kinds = [e.kind for e in tr.events]
     assert kinds[:4] == ["liftoff_R", "touchdown_L", "liftoff_L", "touchdown_R"]
-    assert tr.n_strides == 2
+    assert tr.n_steps == 2
     # touch-down anchors: the foot lands at the ground, the stance foot barely slides
     for e in tr.events:
         if e.kind.startswith("touchdown"):
             assert abs(e.foot_z) < 1e-9
-    one = stride(BipedParams(), BipedState.thesis().to_array(), 0.0)
+    one = step(BipedParams(), BipedState.thesis().to_array(), 0.0)
     assert one.t == pytest.approx(tr.strides[0, 0], abs=1e-9)
     np.testing.assert_allclose(one.state, tr.strides[0, 1:19], atol=1e-9)
 
@@ -89,7 +89,7 @@ def test_invalid_parameters_name_the_field(changes, field):
 
 def test_invalid_simulation_input():
     p = BipedParams()
-    with pytest.raises(ValueError, match="n_strides"):
+    with pytest.raises(ValueError, match="n_steps"):
         simulate(p, BipedState.thesis(), 0)
     with pytest.raises(ValueError, match="shape"):
         simulate(p, np.zeros(5), 1)
@@ -106,5 +106,5 @@ def test_a_gait_that_falls_reports_stride_and_reason():
     tr = simulate(p, BipedState.thesis(), 20)
     assert tr.fell
     assert tr.status.reason.startswith("fall:")
-    assert tr.n_strides < 20
+    assert tr.n_steps < 20
     assert tr.events[-1].kind == "fall"

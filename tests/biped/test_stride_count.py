@@ -71,5 +71,5 @@ def test_table_e2_run_counts_contacts_of_the_recorded_trajectory():
     durations = [(t[ends[ends > s][0]] if np.any(ends > s) else t[-1]) - t[s] for s in starts]
     assert min(durations) < 1e-2  # this run has a scuff ...
     assert run.count_strides() == sum(d >= mc for d in durations)
-    assert run.count_strides() < run.n_strides  # ... which the kernel counted as a stride
-    assert run.count_strides(0.0) == run.n_strides
+    assert run.count_strides() < run.n_steps  # ... which the kernel counted as a stride
+    assert run.count_strides(0.0) == run.n_steps

@@ -104,7 +104,7 @@ def test_run_json_records_the_preset_and_values_that_ran(tmp_path):
 def biped_run():
     from tslip.biped import BipedParams, BipedState, simulate
 
-    return simulate(BipedParams(), BipedState.thesis(), n_strides=1)
+    return simulate(BipedParams(), BipedState.thesis(), n_steps=1)
 
 
 @pytest.mark.parametrize("suffix", [".mp4", ".gif"])

@@ -16,7 +16,7 @@ from tslip.biped.dynamics import foot_position, hip_position
 from tslip.biped.gait import from_section
 from tslip.biped.stored import gait_path
 from tslip.cli.main import app
-from tslip.experiment.render import render_frames
+from tslip.experiment.render import camera_frames
 from tslip.experiment.synth import Camera, synthesize_biped
 from tslip.experiment.video import Calibration, TrackerOptions, track_frames
 from tslip.model.units import ROBOT_SCALING
@@ -161,7 +161,7 @@ def test_tracking_recovers_the_markers(run) -> None:  # noqa: ANN001
     about 1.5-2x that: 0.15 px for the discs, 0.25 px for the feet. Without
     the sub-pixel circle fit the discs are 0.38 and 0.45 px RMS off."""
     cal = Calibration(CAM.px_per_m, CAM.ground_px, CAM.hip_px)
-    res = track_frames(render_frames(run, stop=100), cal, TrackerOptions.for_scale(cal.px_per_m),
+    res = track_frames(camera_frames(run, stop=100), cal, TrackerOptions.for_scale(cal.px_per_m),
                        fps=CAM.fps)
     tr, tru = res.tracks, run.truth.iloc[:100]
     assert not res.fatal and res.body_detection_rate == 1.0

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import tslip
-from tslip.experiment.render import render_frames, write_video
+from tslip.experiment.render import camera_frames, write_video
 from tslip.experiment.synth import Camera, synthesize
 from tslip.experiment.video import (
     Calibration,
@@ -44,7 +44,7 @@ def test_tracking_to_a_tenth_of_a_pixel(run) -> None:  # noqa: ANN001
     0.43 px RMS off, so the disc check fails.
     """
     cal = Calibration(CAM.px_per_m, CAM.ground_px, CAM.hip_px)
-    res = track_frames(render_frames(run), cal, _opts(cal), fps=CAM.fps)
+    res = track_frames(camera_frames(run), cal, _opts(cal), fps=CAM.fps)
     tr, tru = res.tracks, run.truth
     assert res.body_detection_rate == 1.0
     ok = tr["body_q"] == 1
@@ -65,7 +65,7 @@ def test_tracking_to_a_tenth_of_a_pixel(run) -> None:  # noqa: ANN001
 
 
 def test_calibration_measured_from_frame(run) -> None:  # noqa: ANN001
-    frame = next(render_frames(run, stop=1))
+    frame = next(camera_frames(run, stop=1))
     cal = measure_calibration(frame, 0.18)
     assert abs(cal.px_per_m / CAM.px_per_m - 1) < 0.02
     assert abs(cal.ground_y - CAM.ground_px) < 2.0
@@ -93,7 +93,7 @@ def test_vanishing_markers_reported(run) -> None:  # noqa: ANN001
     cal = Calibration(CAM.px_per_m, CAM.ground_px, CAM.hip_px)
 
     def frames():  # noqa: ANN202
-        for k, f in enumerate(render_frames(run, stop=60)):
+        for k, f in enumerate(camera_frames(run, stop=60)):
             if 30 <= k <= 39:
                 f[:] = 200
             yield f

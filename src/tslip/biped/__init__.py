@@ -3,22 +3,36 @@
 Bodies, equations of motion (TMT, eqs E.1-E.22), ground contact (eqs
 E.23-E.24), phase-based controller (eqs E.25-E.34) and the compiled
 simulator; :mod:`.gait` holds the periodic-gait search and analyses.
+
+The biped speaks the TSLIP's vocabulary (docs/model.md, "Vocabulary"): one
+stride is :func:`step` -> :class:`StepResult`, a run is :func:`simulate` ->
+:class:`Trajectory`, and both report the shared :class:`tslip.Status`. The
+old names (``BipedStatus``, ``BipedTrajectory``, ``stride``, ``StrideResult``)
+warn and are removed in 0.4.
 """
 
+from .._renamed import module_getattr
+from ..simulation.result import Status
+from ._legacy import SIMULATE_ALIASES
 from .dynamics import accelerations, energy, mass_matrix
 from .parameters import BIPED_PARAMETER_TABLE, BipedParams, BipedState
-from .simulate import BipedOptions, BipedStatus, BipedTrajectory, simulate, stride
+from .simulate import BipedOptions, StepResult, Trajectory, simulate, step
 
 __all__ = [
     "BIPED_PARAMETER_TABLE",
     "BipedParams",
     "BipedState",
     "BipedOptions",
-    "BipedStatus",
-    "BipedTrajectory",
+    "Status",
+    "StepResult",
+    "Trajectory",
     "simulate",
-    "stride",
+    "step",
     "mass_matrix",
     "accelerations",
     "energy",
 ]
+
+
+#: Old names (deprecated, removed in 0.4).
+__getattr__ = module_getattr(__name__, SIMULATE_ALIASES)

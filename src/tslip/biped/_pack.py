@@ -45,7 +45,8 @@ NSTRIDE = 25
 S_NREC, S_NEV, S_NSTRIDE, S_NACC, S_NREJ, S_TEND, S_NFEV, S_RECFULL = range(8)
 NSTATS = 8
 
-# -- statuses ------------------------------------------------------------------------
+# -- statuses: the kernels' own codes, translated to the shared tslip.Status by name ----
+#    (STATUS_NAMES, used by tslip.biped.simulate.to_status: the one boundary) ----------
 ST_OK = 0
 ST_TEND = 1
 ST_FALL_HIP = 10
@@ -56,6 +57,21 @@ ST_FALL_NO_TD = 14
 ST_ERR_MAX_STEPS = 20
 ST_ERR_UNDERFLOW = 21
 ST_ERR_NONFINITE = 22
+
+#: Kernel code -> name of its :class:`tslip.Status` member (names, so that this
+#: layout module, which the kernels import, imports nothing of the simulation).
+STATUS_NAMES: dict[int, str] = {
+    ST_OK: "OK",
+    ST_TEND: "T_END",
+    ST_FALL_HIP: "FALL_HIP_GROUND",
+    ST_FALL_BACKWARD: "FALL_BACKWARD",
+    ST_FALL_PITCH: "FALL_PITCH",
+    ST_FALL_LEG: "FALL_LEG",
+    ST_FALL_NO_TD: "FALL_NO_TOUCHDOWN",
+    ST_ERR_MAX_STEPS: "MAX_STEPS",
+    ST_ERR_UNDERFLOW: "STEP_UNDERFLOW",
+    ST_ERR_NONFINITE: "NONFINITE",
+}
 
 
 def pack_params(p: BipedParams) -> np.ndarray:

@@ -18,23 +18,27 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._renamed import accepts_n_strides, module_getattr, warn_renamed
+from ..gait.stability import Floquet as _TslipFloquet
+from ..gait.stability import TrivialKind, classify_stability
+from ..simulation.result import Status
 from . import _kernels as kn
 from . import _pack as pk
 from .dynamics import controller_references, leg_phase
 from .parameters import BIPED_PARAMETER_TABLE, STATE_FIELDS, BipedParams, BipedState
-from .simulate import BipedOptions, BipedStatus, BipedTrajectory, simulate, stride
+from .simulate import BipedOptions, Trajectory, simulate, step
 
 __all__ = [
     "SECTION_FIELDS",
     "to_section",
     "from_section",
-    "stride_map",
-    "FloquetResult",
+    "step_map",
+    "Floquet",
     "floquet",
     "strides_until_fall",
     "TrackingErrors",
     "tracking_errors",
-    "GaitSearchResult",
+    "Gait",
     "find_periodic_gait",
     "refine_periodic_gait",
     "section_multipliers",
@@ -71,39 +75,49 @@ def from_section(params: BipedParams, z: NDArray[np.float64]) -> tuple[NDArray[n
     return y, t0
 
 
-def stride_map(params: BipedParams, z: NDArray[np.float64],
-               options: BipedOptions | None = None) -> tuple[NDArray[np.float64], BipedStatus]:
+def step_map(params: BipedParams, z: NDArray[np.float64],
+             options: BipedOptions | None = None) -> tuple[NDArray[np.float64], Status]:
     """One stride from section vector ``z``: the next section vector and status."""
     y, t0 = from_section(params, z)
-    res = stride(params, y, t0, options=options)
-    if res.status != BipedStatus.OK:
+    res = step(params, y, t0, options=options)
+    if res.status != Status.OK:
         return np.full(NZ, np.nan), res.status
     return to_section(params, res.state, res.t), res.status
 
 
 @dataclass(frozen=True)
-class FloquetResult:
+class Floquet(_TslipFloquet):
     """Multipliers of the linearised stride map at a section vector.
+
+    The TSLIP's :class:`tslip.gait.Floquet` (its fields, :attr:`stable`,
+    :attr:`magnitudes` and stability rule), at the biped's section, with:
 
     Attributes
     ----------
     multipliers : ndarray, shape (17,), complex
         Multipliers of the reduced map (section without ``z_b``, see
         :func:`section_multipliers`), sorted by decreasing magnitude. The
-        18-dimensional map only adds a zero multiplier for ``z_b``.
+        18-dimensional map only adds a zero multiplier for ``z_b``. None is
+        trivial (``trivial`` all False): nothing is conserved.
     jacobian : ndarray, shape (17, 17)
         Jacobian of the reduced map ``w -> P(z(w))[1:]``, ``w = z[1:]``.
+    max_nontrivial : float
+        Largest magnitude (NaN, and ``stability`` "unstable", if a perturbed
+        stride fell).
     residual : float
         ``|P(z) - z|`` (phase wrapped); near zero only at a periodic gait.
-    largest : float
-        Largest magnitude.
+    z : ndarray, shape (18,)
+        The section vector.
     """
 
-    multipliers: NDArray[np.complex128]
-    jacobian: NDArray[np.float64]
-    residual: float
-    largest: float
-    z: NDArray[np.float64] = field(repr=False)
+    residual: float = math.nan
+    z: NDArray[np.float64] = field(default_factory=lambda: np.full(NZ, np.nan), repr=False)
+
+    @property
+    def largest(self) -> float:
+        """Deprecated name of :attr:`max_nontrivial` (removed in tslip 0.4)."""
+        warn_renamed("Floquet.largest", "Floquet.max_nontrivial")
+        return self.max_nontrivial
 
 
 def _on_section(params: BipedParams, z: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -116,7 +130,7 @@ def _on_section(params: BipedParams, z: NDArray[np.float64]) -> NDArray[np.float
 
 def _reduced_jacobian(params: BipedParams, z: NDArray[np.float64], step: float,
                       central: bool, options: BipedOptions
-                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], BipedStatus]:
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], Status]:
     """Jacobian of ``w -> P(z(w))[1:]`` by finite differences on the section.
 
     Every perturbed start is put back on the section (right foot on the
@@ -125,17 +139,17 @@ def _reduced_jacobian(params: BipedParams, z: NDArray[np.float64], step: float,
     where a perturbed stride falls.
     """
     z = _on_section(params, z)
-    z1, st = stride_map(params, z, options)
+    z1, st = step_map(params, z, options)
     A = np.empty((NZ - 1, NZ - 1))
     for j in range(1, NZ):
         h = step * max(1.0, abs(z[j]))
         zp = z.copy()
         zp[j] += h
-        zp1, _ = stride_map(params, _on_section(params, zp), options)
+        zp1, _ = step_map(params, _on_section(params, zp), options)
         if central:
             zm = z.copy()
             zm[j] -= h
-            zm1, _ = stride_map(params, _on_section(params, zm), options)
+            zm1, _ = step_map(params, _on_section(params, zm), options)
             A[:, j - 1] = _wrap(zp1 - zm1)[1:] / (2 * h)
         else:
             A[:, j - 1] = _wrap(zp1 - z1)[1:] / h
@@ -149,8 +163,12 @@ def _sorted_eigvals(A: NDArray[np.float64]) -> NDArray[np.complex128]:
     return ev[np.argsort(-np.abs(ev))]
 
 
+_NOT_TRIVIAL: TrivialKind = ""
+_NONE_TRIVIAL = (_NOT_TRIVIAL,) * (NZ - 1)  # the biped's map conserves nothing
+
+
 def floquet(params: BipedParams, z: NDArray[np.float64], *, eps: float = 1e-5,
-            options: BipedOptions | None = None) -> FloquetResult:
+            options: BipedOptions | None = None, unit_tol: float = 1e-6) -> Floquet:
     """Floquet multipliers of the stride map on the touch-down section.
 
     Central differences of the reduced map of :func:`section_multipliers`:
@@ -161,22 +179,27 @@ def floquet(params: BipedParams, z: NDArray[np.float64], *, eps: float = 1e-5,
     ground and gives wrong multipliers.) Step ``eps * max(1, |z_j|)``;
     integrator ``options`` default to :data:`REFINE_OPTIONS` (the map's
     integration noise must be far below ``eps``). A run that falls within a
-    perturbed stride gives NaN multipliers.
+    perturbed stride gives NaN multipliers. Magnitudes within ``unit_tol`` of
+    1 count as neutral (the TSLIP's rule, :func:`tslip.gait.stability.classify_stability`).
     """
     options = options or REFINE_OPTIONS
     z = _on_section(params, np.asarray(z, dtype=np.float64))
     A, z1, st = _reduced_jacobian(params, z, eps, True, options)
     ev = _sorted_eigvals(A)
-    res = float(np.linalg.norm(_wrap(z1 - z))) if st == BipedStatus.OK else math.inf
-    return FloquetResult(ev, A, res, float(np.abs(ev[0])), z)
+    res = float(np.linalg.norm(_wrap(z1 - z))) if st == Status.OK else math.inf
+    largest = float(np.abs(ev[0]))
+    return Floquet(multipliers=ev, trivial=np.zeros(ev.size, dtype=bool),
+                   max_nontrivial=largest, stability=classify_stability(largest, unit_tol),
+                   jacobian=A, method="fd", trivial_kinds=_NONE_TRIVIAL[: ev.size], residual=res,
+                   z=z)
 
 
 def strides_until_fall(params: BipedParams, state: BipedState | NDArray[np.float64],
                        t0: float = 0.0, max_strides: int = 50,
-                       options: BipedOptions | None = None) -> tuple[int, BipedTrajectory]:
+                       options: BipedOptions | None = None) -> tuple[int, Trajectory]:
     """Completed strides before a fall (``max_strides`` if none), and the run."""
     tr = simulate(params, state, max_strides, t0=t0, options=options)
-    return tr.n_strides, tr
+    return tr.n_steps, tr
 
 
 @dataclass(frozen=True)
@@ -190,7 +213,7 @@ class TrackingErrors:
     shank_range: tuple[float, float]
 
 
-def tracking_errors(tr: BipedTrajectory, leg: int = 0, t_from: float = -math.inf,
+def tracking_errors(tr: Trajectory, leg: int = 0, t_from: float = -math.inf,
                     t_to: float = math.inf) -> TrackingErrors:
     """Thigh-length and hip-angle tracking errors of a leg (eqs E.29, E.32)."""
     m = (tr.time >= t_from) & (tr.time <= t_to)
@@ -206,8 +229,11 @@ def tracking_errors(tr: BipedTrajectory, leg: int = 0, t_from: float = -math.inf
 
 
 @dataclass(frozen=True)
-class GaitSearchResult:
-    """Outcome of :func:`find_periodic_gait` (never raised on non-convergence).
+class Gait:
+    """A periodic gait of the biped: the outcome of :func:`find_periodic_gait`.
+
+    Never raised on non-convergence. The biped's counterpart of
+    :class:`tslip.Gait` (both are :class:`tslip.protocols.GaitLike`).
 
     Attributes
     ----------
@@ -257,7 +283,7 @@ def find_periodic_gait(
     seed: int = 1,
     options: BipedOptions | None = None,
     objective: Any = None,
-) -> GaitSearchResult:
+) -> Gait:
     """Search a periodic gait: CMA-ES (``cma``) then least squares on the stride map.
 
     The residual is ``P(z) - z`` on the section (eq. E.36 plus the phase).
@@ -267,7 +293,7 @@ def find_periodic_gait(
 
     Returns
     -------
-    GaitSearchResult
+    Gait
         With ``converged=False`` and the best residual when the search stalls.
     """
     import cma
@@ -304,8 +330,8 @@ def find_periodic_gait(
             p, z = unpack(x)
         except ValueError:
             return np.full(NZ, 10.0)
-        z1, st = stride_map(p, z, options)
-        if st != BipedStatus.OK:
+        z1, st = step_map(p, z, options)
+        if st != Status.OK:
             return np.full(NZ, 10.0)
         return _wrap(z1 - z)
 
@@ -348,7 +374,7 @@ def find_periodic_gait(
     ok = best < tol
     msg = (f"periodic gait found, residual {best:.2e}" if ok else
            f"no periodic gait to tolerance {tol:g}: best residual {best:.2e}")
-    return GaitSearchResult(ok, best, z, p, msg, nev[0], history)
+    return Gait(ok, best, z, p, msg, nev[0], history)
 
 
 def _ground_height(p: BipedParams, y: NDArray[np.float64]) -> float:
@@ -376,7 +402,7 @@ def refine_periodic_gait(
     fd_step: float = 1e-6,
     options: BipedOptions | None = None,
     multipliers: bool = True,
-) -> GaitSearchResult:
+) -> Gait:
     """Drive ``|P(z) - z|`` below ``tol`` by Levenberg-Marquardt shooting.
 
     Well-posed section: every section entry except ``z_b`` is free (``z_b``
@@ -422,8 +448,8 @@ def refine_periodic_gait(
             p, z = unpack(x)
         except ValueError:
             return None
-        z1, st = stride_map(p, z, options)
-        return None if st != BipedStatus.OK else _wrap(z1 - z)
+        z1, st = step_map(p, z, options)
+        return None if st != Status.OK else _wrap(z1 - z)
 
     def jac(x: NDArray[np.float64], r: NDArray[np.float64], cols: int) -> NDArray[np.float64]:
         J = np.empty((NZ, cols))
@@ -441,7 +467,7 @@ def refine_periodic_gait(
 
     r = res(x)
     if r is None:
-        return GaitSearchResult(False, math.inf, z0, params,
+        return Gait(False, math.inf, z0, params,
                                 "no periodic gait: the start state falls within a stride",
                                 nev[0], [math.inf])
     n = float(np.linalg.norm(r))
@@ -477,7 +503,7 @@ def refine_periodic_gait(
     ok = n <= tol
     msg = (f"periodic gait found, residual {n:.2e}" if ok else
            f"no periodic gait to tolerance {tol:g}: best residual {n:.2e}")
-    return GaitSearchResult(ok, n, z, p, msg, nev[0], history, ev)
+    return Gait(ok, n, z, p, msg, nev[0], history, ev)
 
 
 def section_multipliers(params: BipedParams, z: NDArray[np.float64], *,
@@ -503,10 +529,11 @@ def section_multipliers(params: BipedParams, z: NDArray[np.float64], *,
 DISTURBANCES: tuple[str, ...] = ("step_down", "push", "pitch_rate")
 
 
+@accepts_n_strides
 def survives_disturbance(params: BipedParams, z: NDArray[np.float64], kind: str,
-                         value: float, n_strides: int = 25,
+                         value: float, n_steps: int = 25,
                          options: BipedOptions | None = None) -> tuple[bool, str]:
-    """Run ``n_strides`` from the gait ``z`` with one disturbance; (survived, status).
+    """Run ``n_steps`` from the gait ``z`` with one disturbance; (survived, status).
 
     ``step_down``: the ground is shifted by ``value`` [L] (negative: down)
     for every touch-down after the first right stance (the body is shifted by
@@ -525,8 +552,8 @@ def survives_disturbance(params: BipedParams, z: NDArray[np.float64], kind: str,
         y[14] -= value
         y[17] -= value
     if kind != "step_down":
-        tr = simulate(params, y, n_strides, t0=t0, options=options)
-        return tr.n_strides >= n_strides, tr.status.name
+        tr = simulate(params, y, n_steps, t0=t0, options=options)
+        return tr.n_steps >= n_steps, tr.status.name
     # first right stance on the original ground; cut in the middle of the first
     # interval after a lift-off in which both feet are in the air
     first = simulate(params, y, 1, t0=t0, options=options)
@@ -546,13 +573,14 @@ def survives_disturbance(params: BipedParams, z: NDArray[np.float64], kind: str,
         return False, part.status.name
     y1 = part.final_state.copy()
     y1[1] -= value
-    tr = simulate(params, y1, n_strides, t0=float(part.stats["t_end"]),
+    tr = simulate(params, y1, n_steps, t0=float(part.stats["t_end"]),
                   contact=part.final_contact, options=options)
-    return tr.n_strides >= n_strides, tr.status.name
+    return tr.n_steps >= n_steps, tr.status.name
 
 
+@accepts_n_strides
 def disturbance_limit(params: BipedParams, z: NDArray[np.float64], kind: str, *,
-                      sign: float = -1.0, n_strides: int = 25, tol: float = 1e-3,
+                      sign: float = -1.0, n_steps: int = 25, tol: float = 1e-3,
                       options: BipedOptions | None = None) -> Any:
     """Largest survivable magnitude of a disturbance (``tslip.gait.robustness.limit_search``).
 
@@ -562,7 +590,15 @@ def disturbance_limit(params: BipedParams, z: NDArray[np.float64], kind: str, *,
     from ..gait.robustness import limit_search
 
     def survives(m: NDArray[np.float64]) -> NDArray[np.bool_]:
-        return np.array([survives_disturbance(params, z, kind, sign * float(v), n_strides,
+        return np.array([survives_disturbance(params, z, kind, sign * float(v), n_steps,
                                               options)[0] for v in np.ravel(m)])
 
     return limit_search(survives, start=0.01, tol=tol, ladder=8, k=1, max_magnitude=10.0)
+
+
+#: Old names (deprecated, removed in 0.4): docs/model.md, "Vocabulary".
+__getattr__ = module_getattr(__name__, {
+    "stride_map": ("tslip.biped.gait.step_map", lambda: step_map),
+    "FloquetResult": ("tslip.biped.gait.Floquet", lambda: Floquet),
+    "GaitSearchResult": ("tslip.biped.gait.Gait", lambda: Gait),
+})

@@ -1,12 +1,13 @@
-"""Public biped simulation API: runs, the stride map, typed results.
+"""Public biped simulation API: runs, one stride, typed results.
 
 Validates inputs, calls :func:`._kernels.run`, and maps its flat arrays and
-status to a :class:`BipedTrajectory`. A stride is right-foot touch-down to
+status to a :class:`Trajectory` with a shared :class:`tslip.Status`. A stride
+(a "step" of the shared vocabulary, docs/model.md) is right-foot touch-down to
 the next right-foot touch-down (Section E.2.5).
 
 Counting strides
 ----------------
-The kernels stop after ``n_strides`` right-foot *contact events*, and the
+The kernels stop after ``n_steps`` right-foot *contact events*, and the
 ground model (eqs E.23-E.24) also registers scuffs: a swinging foot that
 brushes the ground for a fraction of a millisecond (the foot mass on the
 ground damper relaxes in ``m_f / c_z = 1e-3`` g^-1/2 L^1/2). Such a contact
@@ -21,7 +22,6 @@ between 0.001 and 0.15.
 
 from __future__ import annotations
 
-import enum
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -30,74 +30,43 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._checks import check_fields
+from .._renamed import accepts_n_strides, module_getattr, warn_renamed
 from ..model._pack import METHODS
+from ..simulation.result import Status
 from . import _kernels as kn
 from . import _pack as pk
+from ._legacy import SIMULATE_ALIASES
 from .parameters import STATE_FIELDS, BipedParams, BipedState
 
 __all__ = [
     "BipedOptions",
-    "BipedStatus",
     "BipedEvent",
-    "BipedTrajectory",
-    "StrideResult",
+    "Trajectory",
+    "StepResult",
+    "Status",
+    "to_status",
     "MIN_CONTACT_FRACTION",
     "count_strides",
     "default_min_contact",
     "simulate",
-    "stride",
+    "step",
     "RECORD_COLUMNS",
 ]
 
-#: Columns of :attr:`BipedTrajectory.data`.
+#: Columns of :attr:`Trajectory.data`.
 RECORD_COLUMNS: tuple[str, ...] = (
     ("t",) + STATE_FIELDS + ("contact_R", "contact_L", "Fx_R", "Fz_R", "Fx_L", "Fz_L",
                               "tau_R", "tau_L", "F_tR", "F_tL", "F_sR", "F_sL")
 )
 
 
-class BipedStatus(enum.IntEnum):
-    """Outcome of a biped run."""
+def to_status(code: int) -> Status:
+    """The shared :class:`tslip.Status` of a biped kernel's code (``_pack.STATUS_NAMES``).
 
-    OK = pk.ST_OK
-    T_END = pk.ST_TEND
-    FALL_HIP = pk.ST_FALL_HIP
-    FALL_BACKWARD = pk.ST_FALL_BACKWARD
-    FALL_PITCH = pk.ST_FALL_PITCH
-    FALL_LEG = pk.ST_FALL_LEG
-    FALL_NO_TOUCHDOWN = pk.ST_FALL_NO_TD
-    ERR_MAX_STEPS = pk.ST_ERR_MAX_STEPS
-    ERR_STEP_UNDERFLOW = pk.ST_ERR_UNDERFLOW
-    ERR_NONFINITE = pk.ST_ERR_NONFINITE
-
-    @property
-    def fell(self) -> bool:
-        """True for a fall (not an integrator failure)."""
-        return 10 <= int(self) < 20
-
-    @property
-    def is_error(self) -> bool:
-        """True for an integrator failure."""
-        return int(self) >= 20
-
-    @property
-    def reason(self) -> str:
-        """One-line description."""
-        return _REASONS[self]
-
-
-_REASONS = {
-    BipedStatus.OK: "completed the requested strides",
-    BipedStatus.T_END: "reached the end time",
-    BipedStatus.FALL_HIP: "fall: a hip reached the ground",
-    BipedStatus.FALL_BACKWARD: "fall: the body moved backward (xd_b < 0)",
-    BipedStatus.FALL_PITCH: "fall: body pitch beyond +-pi/2",
-    BipedStatus.FALL_LEG: "fall: a thigh or shank length reached zero",
-    BipedStatus.FALL_NO_TOUCHDOWN: "fall: no right touch-down within the stride time limit",
-    BipedStatus.ERR_MAX_STEPS: "integrator: maximum number of steps",
-    BipedStatus.ERR_STEP_UNDERFLOW: "integrator: step size underflow",
-    BipedStatus.ERR_NONFINITE: "integrator: non-finite state",
-}
+    The one place where the biped kernels' codes meet the shared enum: its
+    falls (1-9), errors (10-19) and the end time (``T_END``, 20+).
+    """
+    return Status[pk.STATUS_NAMES[int(code)]]
 
 
 def _m(description: str, lower: float, lower_open: bool = True, unit: str = "") -> dict:
@@ -191,17 +160,20 @@ class BipedEvent:
 
 
 @dataclass(frozen=True)
-class BipedTrajectory:
+class Trajectory:
     """A biped run, recorded at every accepted integrator step and event.
+
+    The biped's counterpart of :class:`tslip.Trajectory` (both are
+    :class:`tslip.protocols.RunLike`).
 
     Attributes
     ----------
     data : ndarray, shape (n, 31)
         Columns :data:`RECORD_COLUMNS`.
     events : list of BipedEvent
-    strides : ndarray, shape (n_strides, 25)
+    strides : ndarray, shape (n_steps, 25)
         Time, state (18) and contact state (6) just after each right touch-down.
-    status : BipedStatus
+    status : Status
     params : BipedParams
     final_state : ndarray, shape (18,)
     final_contact : ndarray, shape (6,)
@@ -212,7 +184,7 @@ class BipedTrajectory:
     data: NDArray[np.float64]
     events: list[BipedEvent]
     strides: NDArray[np.float64]
-    status: BipedStatus
+    status: Status
     params: BipedParams
     final_state: NDArray[np.float64]
     final_contact: NDArray[np.float64]
@@ -232,9 +204,15 @@ class BipedTrajectory:
         return self.status.fell
 
     @property
-    def n_strides(self) -> int:
+    def n_steps(self) -> int:
         """Completed strides (right touch-downs after the start)."""
         return int(self.strides.shape[0])
+
+    @property
+    def n_strides(self) -> int:
+        """Deprecated name of :attr:`n_steps` (removed in tslip 0.4)."""
+        warn_renamed("Trajectory.n_strides", "Trajectory.n_steps")
+        return self.n_steps
 
     def count_strides(self, min_contact: float | None = None) -> int:
         """Full strides, right touch-down to right touch-down, scuffs not counted.
@@ -292,25 +270,27 @@ def _check(params: Any, state: Any) -> tuple[BipedParams, NDArray[np.float64]]:
     return params, BipedState.from_array(state).to_array()
 
 
+@accepts_n_strides
 def simulate(
     params: BipedParams,
     state: BipedState | NDArray[np.float64],
-    n_strides: int,
+    n_steps: int,
     *,
     t0: float = 0.0,
     t_end: float = math.inf,
     contact: NDArray[np.float64] | None = None,
     options: BipedOptions | None = None,
-) -> BipedTrajectory:
-    """Simulate up to ``n_strides`` strides of the biped from ``state`` at ``t0``.
+) -> Trajectory:
+    """Simulate up to ``n_steps`` strides of the biped from ``state`` at ``t0``.
 
     Parameters
     ----------
     params : BipedParams
     state : BipedState or array_like, shape (18,)
         ``(q, qd)`` at time ``t0`` (eq. E.9).
-    n_strides : int
-        Number of right touch-downs to run through (>= 1).
+    n_steps : int
+        Number of right touch-downs to run through (>= 1). The old keyword
+        ``n_strides`` still works, with a ``DeprecationWarning``, until 0.4.
     t0 : float
         Start time; sets the controller phase (eq. E.25).
     t_end : float
@@ -323,7 +303,7 @@ def simulate(
 
     Returns
     -------
-    BipedTrajectory
+    Trajectory
         Ends early at a fall (status says which) or integrator failure.
 
     Raises
@@ -336,8 +316,8 @@ def simulate(
     Thesis Appendix E, eqs E.22-E.34, Section E.2.5.
     """
     params, y0 = _check(params, state)
-    if not isinstance(n_strides, (int, np.integer)) or n_strides < 1:
-        raise ValueError(f"n_strides must be an integer >= 1, got {n_strides!r}")
+    if not isinstance(n_steps, (int, np.integer)) or n_steps < 1:
+        raise ValueError(f"n_steps must be an integer >= 1, got {n_steps!r}")
     if not math.isfinite(t0):
         raise ValueError(f"t0 [g^-1/2 L^1/2] must be finite, got {t0!r}")
     if not t_end > t0:
@@ -350,23 +330,23 @@ def simulate(
     else:
         cs[:] = np.asarray(contact, dtype=np.float64)
     rec = np.empty((options.max_records, pk.NREC))
-    ev = np.empty((8 * int(n_strides) + 16, pk.NEV))
-    strides = np.empty((int(n_strides), pk.NSTRIDE))
+    ev = np.empty((8 * int(n_steps) + 16, pk.NEV))
+    strides = np.empty((int(n_steps), pk.NSTRIDE))
     yend = np.empty(18)
     csend = np.empty(pk.NCS)
     stats = np.zeros(pk.NSTATS)
-    st = kn.run(P, options.pack(t_end), float(t0), y0, cs, int(n_strides), rec, ev, strides,
+    st = kn.run(P, options.pack(t_end), float(t0), y0, cs, int(n_steps), rec, ev, strides,
                 yend, csend, stats)
     n_ev = int(stats[pk.S_NEV])
     events = [
         BipedEvent(float(e[0]), _EVENT_NAMES[int(e[1])], float(e[2]), float(e[3]))
         for e in ev[:n_ev]
     ]
-    return BipedTrajectory(
+    return Trajectory(
         data=rec[: int(stats[pk.S_NREC])].copy(),
         events=events,
-        strides=strides[: min(int(stats[pk.S_NSTRIDE]), int(n_strides))].copy(),
-        status=BipedStatus(int(st)),
+        strides=strides[: min(int(stats[pk.S_NSTRIDE]), int(n_steps))].copy(),
+        status=to_status(st),
         params=params,
         final_state=yend,
         final_contact=csend,
@@ -377,12 +357,15 @@ def simulate(
 
 
 @dataclass(frozen=True, slots=True)
-class StrideResult:
-    """One stride of the stride map (right touch-down to the next).
+class StepResult:
+    """One stride of the biped (right touch-down to the next), as :func:`step` returns it.
+
+    The biped's counterpart of :class:`tslip.StepResult` (both are
+    :class:`tslip.protocols.StepLike`).
 
     Attributes
     ----------
-    status : BipedStatus
+    status : Status
     t : float
         Time of the next right touch-down [g^-1/2 L^1/2].
     state : ndarray, shape (18,)
@@ -392,17 +375,32 @@ class StrideResult:
         Integrator steps taken.
     """
 
-    status: BipedStatus
+    status: Status
     t: float
     state: NDArray[np.float64]
     contact: NDArray[np.float64]
     accepted: int
 
+    @property
+    def fell(self) -> bool:
+        """True if the runner fell in this stride."""
+        return self.status.fell
+
+    @property
+    def ok(self) -> bool:
+        """True if the stride ended in a right touch-down."""
+        return self.status == Status.OK
+
+    @property
+    def reason(self) -> str:
+        """Why the stride ended as it did."""
+        return self.status.reason
+
 
 _NO_REC = np.empty((0, pk.NREC))
 
 
-def stride(
+def step(
     params: BipedParams,
     state: NDArray[np.float64],
     t0: float,
@@ -410,8 +408,8 @@ def stride(
     contact: NDArray[np.float64] | None = None,
     options: BipedOptions | None = None,
     _P: NDArray[np.float64] | None = None,
-) -> StrideResult:
-    """One stride from ``(t0, state)`` without recording (the stride map)."""
+) -> StepResult:
+    """One stride from ``(t0, state)`` without recording (the step map's stride)."""
     options = options or BipedOptions()
     P = pk.pack_params(params) if _P is None else _P
     y0 = np.asarray(state, dtype=np.float64)
@@ -425,10 +423,14 @@ def stride(
     yend = np.empty(18)
     csend = np.empty(pk.NCS)
     stats = np.zeros(pk.NSTATS)
-    st = BipedStatus(int(kn.run(P, options.pack(), float(t0), y0, cs, 1, _NO_REC, ev, strides,
-                                yend, csend, stats)))
-    if st != BipedStatus.OK:
-        return StrideResult(st, float(stats[pk.S_TEND]), np.full(18, np.nan), csend,
-                            int(stats[pk.S_NACC]))
-    return StrideResult(st, float(strides[0, 0]), strides[0, 1:19].copy(),
-                        strides[0, 19:25].copy(), int(stats[pk.S_NACC]))
+    st = to_status(kn.run(P, options.pack(), float(t0), y0, cs, 1, _NO_REC, ev, strides, yend,
+                          csend, stats))
+    if st != Status.OK:
+        return StepResult(st, float(stats[pk.S_TEND]), np.full(18, np.nan), csend,
+                          int(stats[pk.S_NACC]))
+    return StepResult(st, float(strides[0, 0]), strides[0, 1:19].copy(),
+                      strides[0, 19:25].copy(), int(stats[pk.S_NACC]))
+
+
+#: Old names (deprecated, removed in 0.4): docs/model.md, "Vocabulary".
+__getattr__ = module_getattr(__name__, SIMULATE_ALIASES)

@@ -107,8 +107,8 @@ def simulate_cmd(
         p, y, t0 = _start(sets, gait, from_tslip)
         tr = simulate(p, y, strides, t0=t0, options=BipedOptions(rtol=tol, atol=tol))
         c = make_console()
-        c.print(f"{tr.n_strides} strides, {tr.status.reason} (t = {tr.stats['t_end']:.3f})")
-        if tr.n_strides:
+        c.print(f"{tr.n_steps} strides, {tr.status.reason} (t = {tr.stats['t_end']:.3f})")
+        if tr.n_steps:
             for leg, name in ((0, "right"), (1, "left")):
                 te = tracking_errors(tr, leg, t0, tr.strides[0, 0])
                 c.print(f"{name} leg, stride 1: thigh RMS error {te.thigh_rms:.2e} L, "
@@ -135,9 +135,9 @@ def _gait_summary(p: BipedParams, z: np.ndarray, ev: np.ndarray | None,
         lines.append("multipliers: a perturbed stride falls (NaN)")
     y, t0 = from_section(p, z)
     tr = simulate(p, y, strides, t0=t0)
-    data["strides_until_fall"] = tr.n_strides
+    data["strides_until_fall"] = tr.n_steps
     data["fall_reason"] = tr.status.reason
-    lines.append(f"strides until fall: {tr.n_strides} of {strides} ({tr.status.reason})")
+    lines.append(f"strides until fall: {tr.n_steps} of {strides} ({tr.status.reason})")
     return data, lines
 
 
@@ -220,7 +220,7 @@ def animate_cmd(
         p, y, t0 = _start(sets, gait, from_tslip)
         tr = simulate(p, y, strides, t0=t0)
         animate_biped(tr, out, fps=fps)
-        make_console().print(f"{tr.n_strides} strides, {tr.status.reason}; wrote {out}")
+        make_console().print(f"{tr.n_steps} strides, {tr.status.reason}; wrote {out}")
 
 
 @biped_app.command("report")
@@ -247,7 +247,7 @@ def report_cmd(
         out_dir.mkdir(parents=True, exist_ok=True)
         tr = simulate(p, y, strides, t0=t0)
         c = make_console()
-        c.print(f"strides until fall: {tr.n_strides} ({tr.status.reason})")
+        c.print(f"strides until fall: {tr.n_steps} ({tr.status.reason})")
         plot_tracking(tr).savefig(out_dir / "fig_e2_tracking.png", dpi=120)
         plot_foot_path(tr).savefig(out_dir / "fig_e3_foot_path.png", dpi=120)
         meta = metacentric_test(p, BipedState.from_array(y), t0)
@@ -263,7 +263,8 @@ def report_cmd(
             f"{i},{m.real:.6g},{m.imag:.6g},{abs(m):.6g}" for i, m in enumerate(fr.multipliers)
         ]
         (out_dir / "multipliers.csv").write_text("\n".join(rows) + "\n")
-        c.print(f"largest multiplier {fr.largest:.3f} (periodicity residual {fr.residual:.2e})")
+        c.print(f"largest multiplier {fr.max_nontrivial:.3f} "
+                f"(periodicity residual {fr.residual:.2e})")
         if robustness:
             from ..biped.gait import DISTURBANCES, disturbance_limit
 

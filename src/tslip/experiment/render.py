@@ -14,9 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .._renamed import module_getattr
 from .synth import Camera, SyntheticRun, _body_corners
 
-__all__ = ["render_frames", "write_video", "check_mp4_size", "FOOT_BGR"]
+__all__ = ["camera_frames", "write_video", "check_mp4_size", "FOOT_BGR"]
 
 
 def check_mp4_size(width: int, height: int) -> None:
@@ -32,11 +33,13 @@ _BODY = (70.0, 75.0, 85.0)
 _LEG = (40.0, 40.0, 45.0)
 
 
-def render_frames(run: SyntheticRun, *, start: int = 0, stop: int | None = None
+def camera_frames(run: SyntheticRun, *, start: int = 0, stop: int | None = None
                   ) -> Iterator[np.ndarray]:
     """Yield the frames of ``run`` as BGR ``uint8`` arrays, shape (height, width, 3).
 
-    Frames are produced one at a time (memory independent of length).
+    Frames are produced one at a time (memory independent of length). Named
+    ``render_frames`` before 0.3, the name of :func:`tslip.plotting.render_frames`
+    (RGB figures of a trajectory); the old name warns until 0.4.
     """
     cam, g, opt = run.camera, run.geometry, run.options
     H, W, s = cam.height, cam.width, cam.px_per_m
@@ -186,14 +189,20 @@ def write_video(run: SyntheticRun, path: str | Path, *, quality: int = 16,
     n = run.n_frames
     if path.suffix.lower() == ".mp4":
         check_mp4_size(run.camera.width, run.camera.height)
-        frames = (f[:, :, ::-1] for f in render_frames(run))  # BGR -> RGB
+        frames = (f[:, :, ::-1] for f in camera_frames(run))  # BGR -> RGB
         return write_mp4(path, frames, run.camera.fps, crf=quality, preset="veryfast",
                          progress=progress, total=n)
     if path.suffix:
         raise ValueError(f"video output must be a .mp4 file or a directory, got {str(path)!r}")
     path.mkdir(parents=True, exist_ok=True)
-    for k, frame in enumerate(render_frames(run)):
+    for k, frame in enumerate(camera_frames(run)):
         iio.imwrite(path / f"frame_{k:06d}.png", frame[:, :, ::-1])
         if progress is not None:
             progress(k + 1, n)
     return path
+
+
+#: Old names (deprecated, removed in 0.4).
+__getattr__ = module_getattr(__name__, {
+    "render_frames": ("tslip.experiment.render.camera_frames", lambda: camera_frames),
+})

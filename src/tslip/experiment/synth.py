@@ -460,9 +460,9 @@ def _biped_motion(params: BipedParams, state: BipedState | np.ndarray, duration:
                          f"{biped_options.max_records} rows; raise BipedOptions.max_records")
     strides = traj.strides
     t_all = traj.time * T
-    if traj.n_strides < 2 or t_all[-1] < strides[0, 0] * T + duration:
+    if traj.n_steps < 2 or t_all[-1] < strides[0, 0] * T + duration:
         raise ValueError(f"the simulated biped run is too short for a {duration:g} s "
-                         f"recording: it ended after {traj.n_strides} stride(s) at t = "
+                         f"recording: it ended after {traj.n_steps} stride(s) at t = "
                          f"{traj.time[-1]:.3f} g^-1/2 L^1/2")
     speed = (strides[-1, 1] - strides[0, 1]) * L / ((strides[-1, 0] - strides[0, 0]) * T)
     q_all = traj.data[:, 1:10]

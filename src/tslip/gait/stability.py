@@ -53,7 +53,7 @@ from .section import (
 )
 
 __all__ = ["Floquet", "floquet", "map_jacobian", "apex_jacobian", "conserved_gradients",
-           "pitch_decoupled", "nontrivial_jacobian"]
+           "pitch_decoupled", "nontrivial_jacobian", "classify_stability"]
 
 Stability = Literal["asymptotic", "neutral", "unstable"]
 TrivialKind = Literal["", "energy", "pitch"]
@@ -307,12 +307,17 @@ def floquet(
     trivial = np.array([k != "" for k in kinds])
     others = np.abs(lam[~trivial])
     max_nt = float(others.max()) if others.size else 0.0
-    if max_nt > 1.0 + unit_tol:
-        stability: Stability = "unstable"
-    elif max_nt >= 1.0 - unit_tol:
-        stability = "neutral"
-    else:
-        stability = "asymptotic"
     return Floquet(multipliers=lam, trivial=trivial, max_nontrivial=max_nt,
-                   stability=stability, jacobian=A, method=method,
+                   stability=classify_stability(max_nt, unit_tol), jacobian=A, method=method,
                    trivial_kinds=tuple(kinds), section=section)
+
+
+def classify_stability(max_nontrivial: float, unit_tol: float = 1e-6) -> Stability:
+    """The stability rule of both models' :class:`Floquet` (eq. 2.21's largest multiplier).
+
+    "unstable" above ``1 + unit_tol`` (and for NaN: a perturbed stride fell),
+    "neutral" within ``unit_tol`` of 1, "asymptotic" below.
+    """
+    if not max_nontrivial <= 1.0 + unit_tol:
+        return "unstable"
+    return "neutral" if max_nontrivial >= 1.0 - unit_tol else "asymptotic"

@@ -16,20 +16,20 @@ from ..biped.dynamics import controller_references, foot_position, hip_position,
 from .gait import plot_pitch_impulse
 
 if TYPE_CHECKING:
-    from ..biped.simulate import BipedTrajectory
+    from ..biped.simulate import Trajectory
     from ..gait.impulse import PitchResponse
 
 __all__ = ["plot_tracking", "plot_foot_path", "plot_metacentric", "draw_biped", "animate_biped"]
 
 
-def _window(tr: BipedTrajectory, stride: int) -> np.ndarray:
+def _window(tr: Trajectory, stride: int) -> np.ndarray:
     t_s = np.r_[tr.time[0], tr.strides[:, 0]]
     if stride + 1 >= t_s.size:
         return np.ones(tr.time.size, dtype=bool)
     return (tr.time >= t_s[stride]) & (tr.time <= t_s[stride + 1])
 
 
-def plot_tracking(tr: BipedTrajectory, stride: int = 0, leg: int = 0) -> Figure:
+def plot_tracking(tr: Trajectory, stride: int = 0, leg: int = 0) -> Figure:
     """Reference vs actual thigh length, shank length and hip angle (Figure E.2)."""
     m = _window(tr, stride)
     t = tr.time[m]
@@ -50,7 +50,7 @@ def plot_tracking(tr: BipedTrajectory, stride: int = 0, leg: int = 0) -> Figure:
     return fig
 
 
-def plot_foot_path(tr: BipedTrajectory, leg: int = 0, ax: Any = None,
+def plot_foot_path(tr: Trajectory, leg: int = 0, ax: Any = None,
                    stride: int | None = None) -> Figure:
     """Reference and actual foot path relative to the hip (Figure E.3).
 
@@ -136,7 +136,7 @@ def draw_biped(ax: Any, params: Any, y: np.ndarray) -> None:
         ax.plot(foot[0], foot[1], "o", color=color, ms=4)
 
 
-def animate_biped(tr: BipedTrajectory, path: str | Path, fps: float = 30,
+def animate_biped(tr: Trajectory, path: str | Path, fps: float = 30,
                   speed: float = 0.5) -> Path:
     """Write a GIF or MP4 of the run with both legs drawn (right red, left blue).
 

@@ -31,10 +31,25 @@ class IntegrationError(RuntimeError):
     """The integrator could not proceed (not a fall: a numerical failure)."""
 
 
+#: Codes of outcomes that are neither a fall nor an error (20+). The TSLIP's
+#: kernels return codes 0-19 (``model._pack.ST_*``); the biped's own codes are
+#: translated to these at one boundary (:func:`tslip.biped._pack.to_status`).
+ST_FALL_PITCH = 6
+ST_FALL_LEG = 7
+ST_T_END = 20
+
+
+@enum.unique  # two names on one code would silently make one an alias of the other
 class Status(enum.IntEnum):
-    """Outcome of a stride: falls have codes 1-9, integration errors 10-19, and codes 20+
-    are outcomes that are neither (``NO_APEX``: the flight after lift-off has no apex,
-    so the apex return map has no next state; docs/conventions.md)."""
+    """Outcome of a stride or a run, for the TSLIP and the biped (Appendix E) alike.
+
+    Codes: 0 ``OK``; 1-9 falls (:attr:`fell`); 10-19 integration errors
+    (:attr:`is_error`); 20+ outcomes that are neither (``T_END``: a biped run
+    stopped at its end time; ``NO_APEX``: the flight after lift-off has no apex,
+    so the apex return map has no next state, docs/conventions.md). The codes
+    are stored in caches and results, so a member keeps its number; new
+    members take a free code in their range.
+    """
 
     OK = pk.ST_OK
     FALL_BACKWARD = pk.ST_FALL_BACKWARD
@@ -42,16 +57,19 @@ class Status(enum.IntEnum):
     FALL_NO_TOUCHDOWN = pk.ST_FALL_NO_TOUCHDOWN
     FALL_TRIP = pk.ST_FALL_TRIP
     FALL_LENGTHENING = pk.ST_FALL_LENGTHENING
+    FALL_PITCH = ST_FALL_PITCH
+    FALL_LEG = ST_FALL_LEG
     STEP_UNDERFLOW = pk.ST_ERR_STEP_UNDERFLOW
     MAX_STEPS = pk.ST_ERR_MAX_STEPS
     STANCE_TIMEOUT = pk.ST_ERR_STANCE_TIMEOUT
     FLIGHT_TIMEOUT = pk.ST_ERR_FLIGHT_TIMEOUT
     NONFINITE = pk.ST_ERR_NONFINITE
+    T_END = ST_T_END
     NO_APEX = pk.ST_NO_APEX
 
     @property
     def fell(self) -> bool:
-        """True for a fall (eqs 2.10-2.11 or a trip), not for an error."""
+        """True for a fall (eqs 2.10-2.11, a trip, or a biped fall), not for an error."""
         return 0 < self.value < 10
 
     @property
@@ -68,16 +86,23 @@ class Status(enum.IntEnum):
 _REASONS = {
     Status.OK: "ok",
     Status.FALL_BACKWARD: "fall: the CoM moved backward, xdot_m < 0 (eq. 2.10)",
-    Status.FALL_HIP_GROUND: "fall: the hip reached the ground in stance (eq. 2.11)",
-    Status.FALL_NO_TOUCHDOWN: "fall: the hip reached the ground in flight before the foot",
+    Status.FALL_HIP_GROUND: ("fall: the hip reached the ground (eq. 2.11; TSLIP: in stance; "
+                             "biped: either hip, in any phase)"),
+    Status.FALL_NO_TOUCHDOWN: ("fall: no touch-down (TSLIP: the hip reached the ground in flight "
+                               "before the foot; biped: no right touch-down within "
+                               "BipedOptions.stride_time_max)"),
     Status.FALL_TRIP: "fall: the foot hit a step riser (terrain)",
     Status.FALL_LENGTHENING: ("fall: the leg touched down while lengthening (ld > 0), so the "
                               "spring would pull on the ground; it cannot push"),
-    Status.STEP_UNDERFLOW: "error: step size fell below IntegratorOptions.h_min",
-    Status.MAX_STEPS: "error: more than IntegratorOptions.max_steps steps in one stance",
+    Status.FALL_PITCH: "fall: body pitch beyond +-pi/2",
+    Status.FALL_LEG: "fall: a thigh or shank length reached zero",
+    Status.STEP_UNDERFLOW: "error: step size fell below h_min (IntegratorOptions, BipedOptions)",
+    Status.MAX_STEPS: ("error: more than max_steps integrator steps (IntegratorOptions: in one "
+                       "stance; BipedOptions: in the run)"),
     Status.STANCE_TIMEOUT: "error: stance longer than IntegratorOptions.t_max_stance",
     Status.FLIGHT_TIMEOUT: "error: flight longer than IntegratorOptions.t_max_flight",
     Status.NONFINITE: "error: the state became NaN or infinite",
+    Status.T_END: "reached the end time",
     Status.NO_APEX: ("no apex: the runner lifted off moving down (or touched down while "
                      "rising), so the flight has no apex and the apex map no next state"),
 }
