@@ -14,14 +14,19 @@ from typing import TYPE_CHECKING  # noqa: E402
 if TYPE_CHECKING:  # the same names, for type checkers and tslip._codehash
     # mypy: ``robustness`` names both a function and its submodule of tslip.gait
     from .gait import (  # type: ignore[no-redef]
+        ApexState,
         Branch,
         Floquet,
         Gait,
+        all_gaits,
+        apex_map,
+        apex_map_batch,
         continue_gait,
         find_gait,
         floquet,
         robustness,
         robustness_report,
+        stable_region,
     )
     from .model import (
         ConstantTorque,
@@ -56,7 +61,8 @@ _SUBPACKAGE = {
                      "run_batch", "simulate", "step", "step_batch", "step_map",
                      "step_jacobian"), "simulation"),
     **dict.fromkeys(("Gait", "find_gait", "Floquet", "floquet", "robustness",
-                     "robustness_report", "Branch", "continue_gait"), "gait"),
+                     "robustness_report", "Branch", "continue_gait", "all_gaits",
+                     "stable_region", "ApexState", "apex_map", "apex_map_batch"), "gait"),
 }
 
 #: Subpackages, imported on first attribute access too (``tslip.gait.analyse``).
@@ -70,7 +76,7 @@ __all__ = [
     "Disturbance", "IntegratorOptions", "Status", "StepResult", "Trajectory",
     "run_batch", "simulate", "step", "step_batch", "step_map", "step_jacobian",
     "Gait", "find_gait", "Floquet", "floquet", "robustness", "robustness_report", "Branch",
-    "continue_gait",
+    "continue_gait", "all_gaits", "stable_region", "ApexState", "apex_map", "apex_map_batch",
 ]
 
 

@@ -30,7 +30,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 EXAMPLES = sorted((ROOT / "examples").glob("plot_*.py"))
-ANALYSES = ("gait", "stability", "robustness", "impulse", "stride", "studies", "experiment",
+ANALYSES = ("gait", "stability", "slip", "robustness", "impulse", "stride", "studies", "experiment",
             "biped")
 
 
