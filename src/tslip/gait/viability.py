@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,12 +35,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._checks import check_number
+from ..model import _pack as pk
 from ..model.parameters import PARAMETER_TABLE, Params
+from ..simulation.integrate import run_batch
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status
-from . import _viable
+from . import _viable, section
 from ._gridtable import grid_columns, load_table, save_table
-from .continuation import get_param, set_param
+from .continuation import set_param
+from .stability import pitch_decoupled
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -48,7 +52,10 @@ if TYPE_CHECKING:
     from .fixed_point import Gait
 
 __all__ = ["StateActionMap", "Viability", "Basin", "state_action_map", "viability", "basin",
-           "SECTION_UNITS"]
+           "STATE_NAMES", "SECTION_UNITS", "check_map_inputs", "map_cells"]
+
+#: Apex variables a grid can span (the forward speed follows from the energy).
+STATE_NAMES = ("y", "phi", "phid")
 
 #: Units of the apex-section variables a grid can span.
 SECTION_UNITS = {"y": "L", "xd": "g^1/2 L^1/2", "phi": "rad", "phid": "rad g^1/2 L^-1/2"}
@@ -287,7 +294,7 @@ class Viability:
         return cls(smap, m["rule"], q, s, int(m["sweeps"]))
 
     def plot(self, ax: Axes | None = None) -> Any:
-        """The viable set over state and action (:func:`tslip.plotting.viability.plot_viability`)."""
+        """The viable set (:func:`tslip.plotting.viability.plot_viability`)."""
         from ..plotting.viability import plot_viability
 
         return plot_viability(self, ax=ax)
@@ -328,3 +335,290 @@ def viability(smap: StateActionMap, rule: str = "bracket") -> Viability:
     cells = _viable.successor_cells(smap.grid, smap.next.reshape(-1, d), ok, rule)
     q, s, sweeps = _viable.viable_sets(cells, ok, n_states)
     return Viability(smap, rule, q.reshape(smap.shape), s.reshape(smap.shape[:-1]), sweeps)
+
+
+# ---------------------------------------------------------------------------
+# the physical map: apex to apex at fixed energy (tslip.gait.section)
+# ---------------------------------------------------------------------------
+
+
+def _with_action(params: Params, name: str, value: float) -> Params:
+    """``params`` with the action set: ``alpha_r`` directly, others by :func:`set_param`."""
+    if name == "alpha_r":
+        return dataclasses.replace(params, alpha_r=float(value))
+    return set_param(params, name, value)
+
+
+def check_map_inputs(params: Params, states: Mapping[str, Any], actions: Any,
+                     energy: float) -> tuple[tuple[str, ...], tuple[np.ndarray, ...], str,
+                                             np.ndarray, float]:
+    """Check a physical map's inputs (one-line ``ValueError`` naming the field); return them
+    as ``(names, grid, action, actions, energy)``."""
+    if not isinstance(params, Params):
+        raise ValueError(f"params must be a tslip.Params, got {type(params).__name__}")
+    names, grid = _state_grid(states)
+    bad = [n for n in names if n not in STATE_NAMES]
+    if bad:
+        raise ValueError(f"states: unknown apex variable {bad[0]!r}; allowed: "
+                         f"{list(STATE_NAMES)} (xd follows from the energy)")
+    if "y" not in names:
+        raise ValueError("states must include the apex height 'y'")
+    action, acts = _action_grid(actions)
+    for v in (acts[0], acts[-1]):
+        try:
+            p = _with_action(params, action, v)
+        except ValueError as exc:
+            raise ValueError(f"actions[{action!r}]: {exc}") from None
+    E = float(check_number(energy, "energy [MgL]", lower=0.0, lower_open=True))
+    if not section.apex_section_ok(p):
+        section.apex_map_states(p, np.zeros((0, 4)))  # raises its one-line reason
+    j = names.index("y")
+    phid_sq = max(float(np.max(grid[names.index("phid")] ** 2)) if "phid" in names else 0.0, 0.0)
+    for v in (acts[0], acts[-1]):
+        p = _with_action(params, action, v)
+        y_max = (E - 0.5 * p.J * phid_sq) / (p.m * p.g)
+        if grid[j][-1] >= y_max:
+            raise ValueError(f"states['y'] must stay below {y_max:.6g} L at energy {E:g} MgL "
+                             f"(no forward speed left there), got up to {grid[j][-1]:g}")
+    return names, grid, action, acts, E
+
+
+def _apex_rows(params: Params, names: Sequence[str], points: np.ndarray,
+               energy: float) -> np.ndarray:
+    """Apex rows ``(y, xd, phi, phid)`` at ``points`` (n, len(names)), ``xd`` from the energy."""
+    cols = {n: points[:, j] for j, n in enumerate(names)}
+    y = cols["y"]
+    phi = cols.get("phi", np.zeros(len(y)))
+    phid = cols.get("phid", np.zeros(len(y)))
+    kin = energy - params.m * params.g * y - 0.5 * params.J * phid**2
+    xd = np.sqrt(np.maximum(2.0 * kin / params.m, 0.0))
+    return np.column_stack([y, xd, phi, phid])
+
+
+def map_cells(params: Params, names: Sequence[str], points: np.ndarray,
+              actions: tuple[str, np.ndarray], energy: float,
+              options: IntegratorOptions | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The apex map at ``points`` (n, d) x every action: next states (n, n_a, d), status.
+
+    One batched call (:func:`tslip.gait.section.apex_map_states`, whose
+    stances run in one compiled :func:`tslip.step_batch` kernel) for an
+    ``alpha_r`` action; one per action value for a parameter action.
+    """
+    options = options or IntegratorOptions.tight("dop853")
+    action, acts = actions
+    pts = np.asarray(points, dtype=float).reshape(-1, len(names))
+    n, n_a = len(pts), len(acts)
+    if action == "alpha_r":
+        rows = _apex_rows(params, names, pts, energy)
+        b = section.apex_map_states(params, np.repeat(rows, n_a, axis=0),
+                                    np.tile(acts, n), options=options)
+        nxt = np.stack([getattr(b, k) for k in names], axis=-1).reshape(n, n_a, len(names))
+        status = np.asarray(b.status, dtype=np.int64).reshape(n, n_a)
+    else:
+        nxt = np.empty((n, n_a, len(names)))
+        status = np.empty((n, n_a), dtype=np.int64)
+        for k, v in enumerate(acts):  # one batch per action value, over every state
+            p = _with_action(params, action, float(v))
+            b = section.apex_map_states(p, _apex_rows(p, names, pts, energy), options=options)
+            nxt[:, k] = np.stack([getattr(b, c) for c in names], axis=-1)
+            status[:, k] = b.status
+    nxt[status != Status.OK] = np.nan
+    return nxt, status
+
+
+def state_action_map(params: Params, states: Mapping[str, Sequence[float] | np.ndarray],
+                     actions: tuple[str, Sequence[float] | np.ndarray], *, energy: float,
+                     options: IntegratorOptions | None = None) -> StateActionMap:
+    """The apex return map at fixed total energy over a grid of apex states and actions.
+
+    Parameters
+    ----------
+    params : Params
+        Model whose apex is a Poincare section (no retraction clock from
+        lift-off; :func:`tslip.gait.section.apex_section_ok`), e.g.
+        ``preset("slip")``.
+    states : dict
+        One or two apex variables and their grids: ``{"y": heights}`` [L]
+        for the SLIP; for the TSLIP e.g. ``{"y": ..., "phid": ...}``
+        (:data:`STATE_NAMES`; the others are 0 at the apex).
+    actions : (str, array)
+        The action and its grid: ``("alpha_r", angles)`` (the leg angle set
+        at lift-off, the SLIP's touch-down angle [rad]) or any parameter
+        :func:`tslip.gait.continuation.set_param` accepts (e.g. ``"k"``).
+    energy : float
+        Total energy [MgL] (:func:`tslip.gait.section.energy`): the forward
+        speed at each apex is ``xd = sqrt(2 (E - m g y - J phid^2 / 2) / m)``.
+    options : IntegratorOptions, optional
+        Default ``IntegratorOptions.tight("dop853")`` (tolerance 1e-12).
+
+    Returns
+    -------
+    StateActionMap
+        A stride fails (status not OK) for a fall, an apex too low for the
+        leg to reach the ground (``FALL_NO_TOUCHDOWN``), a lift-off moving
+        down (``NO_APEX``) or an integration error.
+    """
+    names, grid, action, acts, E = check_map_inputs(params, states, actions, energy)
+    options = options or IntegratorOptions.tight("dop853")
+    t0 = time.perf_counter()
+    pts = np.stack(grid_columns(grid), axis=1)
+    nxt, status = map_cells(params, names, pts, (action, acts), E, options)
+    shape = tuple(len(g) for g in grid) + (len(acts),)
+    return StateActionMap(names, grid, action, acts, nxt.reshape(shape + (len(names),)),
+                          status.reshape(shape), E, params,
+                          {"options": dataclasses.asdict(options),
+                           "seconds": time.perf_counter() - t0})
+
+
+# ---------------------------------------------------------------------------
+# basins of attraction
+# ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class Basin:
+    """Where runs from a grid of apex states go under a gait's parameters.
+
+    Attributes
+    ----------
+    names, grid : as :class:`StateActionMap`
+        The start states at the apex, at the gait's energy.
+    steps : ndarray of int, shape (*grid shape)
+        Strides until the touch-down state is within ``tol`` of the gait's
+        (0: it starts there); -1 if it never was.
+    n_done : ndarray of int
+        Strides completed (``n_steps`` unless it fell).
+    status : ndarray of int
+        :class:`tslip.Status` of the last stride (OK if it did not fall).
+    n_steps : int
+    tol : float
+    energy : float
+    params : Params
+    gait : ndarray
+        The gait's touch-down section ``(beta, phi, xd, yd, phid)``.
+    """
+
+    names: tuple[str, ...]
+    grid: tuple[np.ndarray, ...]
+    steps: np.ndarray
+    n_done: np.ndarray
+    status: np.ndarray
+    n_steps: int
+    tol: float
+    energy: float
+    params: Params
+    gait: np.ndarray
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def converged(self) -> np.ndarray:
+        """Starts whose run reached the gait."""
+        return self.steps >= 0
+
+    @property
+    def fell(self) -> np.ndarray:
+        """Starts whose run fell (or failed) within ``n_steps``."""
+        return self.status != Status.OK
+
+    def __repr__(self) -> str:
+        return (f"Basin({_short(self.grid, self.names)}, {self.n_steps} strides: "
+                f"{int(self.converged.sum())} reach the gait, {int(self.fell.sum())} fall, of "
+                f"{self.steps.size})")
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per start: its coordinates, ``steps``, ``n_done``, ``status``."""
+        import pandas as pd
+
+        data: dict[str, Any] = dict(zip(self.names, grid_columns(self.grid)))
+        data.update(steps=self.steps.ravel(), n_done=self.n_done.ravel(),
+                    status=self.status.ravel())
+        df = pd.DataFrame(data)
+        df.attrs["units"] = {**{n: _unit(n) for n in self.names},
+                             "steps": "strides", "n_done": "strides", "status": "-"}
+        return df
+
+    def save(self, path: str | Path) -> Path:
+        """Write the table and the grid to a ``.parquet`` file."""
+        meta = {"kind": "Basin", "names": list(self.names),
+                "grid": [g.tolist() for g in self.grid], "n_steps": self.n_steps,
+                "tol": self.tol, "energy": self.energy, "params": self.params.to_dict(),
+                "gait": self.gait.tolist(), "meta": self.meta}
+        return save_table(self.to_dataframe(), meta, path)
+
+    @classmethod
+    def load(cls, path: str | Path) -> Basin:
+        """Read a result written by :meth:`save`."""
+        df, m = load_table(path, "Basin")
+        grid = tuple(np.array(g, dtype=float) for g in m["grid"])
+        shape = tuple(len(g) for g in grid)
+        col = {c: df[c].to_numpy(np.int64).reshape(shape) for c in ("steps", "n_done", "status")}
+        return cls(tuple(m["names"]), grid, col["steps"], col["n_done"], col["status"],
+                   int(m["n_steps"]), float(m["tol"]), float(m["energy"]),
+                   Params.from_dict(m["params"]), np.array(m["gait"], dtype=float),
+                   dict(m["meta"]))
+
+    def plot(self, ax: Axes | None = None) -> Any:
+        """Strides to the gait over the start grid (:func:`tslip.plotting.viability.plot_basin`)."""
+        from ..plotting.viability import plot_basin
+
+        return plot_basin(self, ax=ax)
+
+
+def basin(params: Params, gait: Gait, states: Mapping[str, Sequence[float] | np.ndarray],
+          n_steps: int, *, tol: float = 1e-6,
+          options: IntegratorOptions | None = None) -> Basin:
+    """Strides to reach ``gait`` (or to fall) from every grid start state at its energy.
+
+    The start states are apexes at the gait's total energy
+    (:func:`tslip.gait.section.energy` of its touch-down); each descends to
+    its touch-down under ``gait.params`` and runs ``n_steps`` strides, all
+    rows in one compiled :func:`tslip.run_batch` call. A run has reached the
+    gait at the first touch-down whose section ``(beta, phi, xd, yd, phid)``
+    is within ``tol`` (max norm) of the gait's, leaving out ``phi`` when the
+    pitch is decoupled (:func:`tslip.gait.stability.pitch_decoupled`: every
+    pitch is then a fixed point).
+
+    Parameters
+    ----------
+    params : Params
+        Checked against ``gait.params`` (the gait's solved ``alpha_r`` is used).
+    gait : Gait
+    states : dict
+        One or two apex variables and their grids (as :func:`state_action_map`).
+    n_steps : int
+    tol : float
+    options : IntegratorOptions, optional
+        Default ``IntegratorOptions.tight("dop853")``.
+    """
+    n_steps = int(check_number(n_steps, "n_steps", lower=1, integer=True))
+    tol = float(check_number(tol, "tol", lower=0.0, lower_open=True))
+    p = gait.params
+    if dataclasses.replace(params, alpha_r=p.alpha_r) != p:
+        raise ValueError("params must be the gait's parameters (gait.params) up to alpha_r")
+    E = section.energy(p, gait.state)
+    names, grid, _, _, _ = check_map_inputs(p, states, ("alpha_r", [p.alpha_r]), E)
+    options = options or IntegratorOptions.tight("dop853")
+    t0 = time.perf_counter()
+    pts = np.stack(grid_columns(grid), axis=1)
+    rows = _apex_rows(p, names, pts, E)
+    A = np.hstack([rows, np.zeros((len(rows), 2))])
+    td, st, _ = section._touchdowns(np.tile(pk.pack_params(p), (len(A), 1)), A,
+                                    options.packed())
+    shape = tuple(len(g) for g in grid)
+    steps = np.full(len(A), -1, dtype=np.int64)
+    n_done = np.zeros(len(A), dtype=np.int64)
+    status = st.astype(np.int64)
+    go = np.flatnonzero(st == Status.OK)
+    target = gait.state.section()
+    if go.size:
+        run = run_batch(p, td[go], n_steps, options=options)
+        hist = run.touchdowns[:, :, :5]
+        err = np.abs(hist - target)
+        if pitch_decoupled(p):
+            err[:, :, 1] = 0.0
+        near = np.all(err <= tol, axis=-1)  # NaN rows (after a fall) are never near
+        first = np.where(near.any(axis=1), np.argmax(near, axis=1), -1)
+        steps[go], n_done[go], status[go] = first, run.n_done, run.status
+    return Basin(names, grid, steps.reshape(shape), n_done.reshape(shape),
+                 status.reshape(shape), n_steps, tol, E, p, target,
+                 {"options": dataclasses.asdict(options), "seconds": time.perf_counter() - t0})
