@@ -6,6 +6,7 @@ apex map written in this file.
 """
 
 import itertools
+import math
 
 import numpy as np
 import pytest
@@ -158,3 +159,148 @@ def test_bad_input_is_one_line(kwargs, match):
         viability(smap, args["rule"])
     assert "\n" not in str(exc.value)
 
+
+
+# ---------------------------------------------------------------------------
+# the physical map (SLIP and TSLIP at the apex) against scipy
+# ---------------------------------------------------------------------------
+
+E_SLIP = 2.6  # both SLIP fixed points exist here for alpha_r near 1.15-1.3
+
+
+def scipy_slip_apex(p, y: float, alpha: float, energy: float) -> float:
+    """Next apex height of a SLIP (point mass, massless spring leg): apex -> touch-down at
+    l0 sin(alpha) -> stance integrated by solve_ivp (DOP853, 1e-12) -> lift-off at l = l0
+    -> apex. NaN for no touch-down, a fall, or a lift-off moving down (no apex)."""
+    from scipy.integrate import solve_ivp
+
+    m, g, k, l0 = p.m, p.g, p.k, p.l0
+    xd = math.sqrt(2.0 * (energy - m * g * y) / m)
+    drop = y - l0 * math.sin(alpha)
+    if drop <= 0:
+        return math.nan
+    yd = -math.sqrt(2.0 * g * drop)
+    foot = l0 * math.cos(alpha)  # CoM at x = 0
+
+    def rhs(_t, s):
+        dx, dy = s[0] - foot, s[1]
+        ell = math.hypot(dx, dy)
+        f = k * (l0 - ell) / (m * ell)
+        return [s[2], s[3], f * dx, f * dy - g]
+
+    def liftoff(_t, s):
+        return math.hypot(s[0] - foot, s[1]) - l0
+    liftoff.terminal, liftoff.direction = True, 1.0
+
+    def ground(_t, s):
+        return s[1]
+    ground.terminal = True
+
+    sol = solve_ivp(rhs, (0.0, 50.0), [0.0, l0 * math.sin(alpha), xd, yd], method="DOP853",
+                    rtol=1e-12, atol=1e-12, events=[liftoff, ground])
+    if not len(sol.t_events[0]):
+        return math.nan
+    x, yy, vx, vy = sol.y_events[0][0]
+    if vy < 0 or vx < 0:
+        return math.nan
+    return yy + vy * vy / (2.0 * g)
+
+
+@pytest.fixture(scope="module")
+def slip_map():
+    import tslip
+    from tslip.gait.viability import state_action_map
+
+    p = tslip.preset("slip")
+    return state_action_map(p, {"y": np.linspace(0.9, 2.2, 14)},
+                            ("alpha_r", np.linspace(1.05, 1.4, 8)), energy=E_SLIP)
+
+
+def test_slip_map_matches_scipy(slip_map):
+    m = slip_map
+    ok = np.argwhere(~m.failed)
+    assert len(ok) > 40 and m.failed.any()
+    rng = np.random.default_rng(3)
+    for i, j in ok[rng.choice(len(ok), 6, replace=False)]:
+        want = scipy_slip_apex(m.params, m.grid[0][i], m.actions[j], E_SLIP)
+        assert abs(m.next[i, j, 0] - want) < 1e-9, (i, j)
+    # where tslip finds no next apex, neither does scipy
+    bad = np.argwhere(m.failed)
+    for i, j in bad[rng.choice(len(bad), 4, replace=False)]:
+        assert math.isnan(scipy_slip_apex(m.params, m.grid[0][i], m.actions[j], E_SLIP))
+
+
+def test_slip_map_conserves_energy(slip_map):
+    """The next apex of every cell has the energy of the grid (potential m g y' plus the
+    forward speed the section returns); tslip's own xd, checked against m g y' + m xd'^2/2."""
+    from tslip.gait import section
+
+    m = slip_map
+    i, j = np.nonzero(~m.failed)
+    xd = np.sqrt(2 * (E_SLIP - m.params.g * m.grid[0][i]))
+    b = section.apex_map_states(m.params, np.column_stack([m.grid[0][i], xd, 0 * xd, 0 * xd]),
+                                m.actions[j], options=__import__("tslip").IntegratorOptions.tight(
+                                    "dop853"))
+    assert np.array_equal(b.y, m.next[i, j, 0])
+    e = m.params.m * m.params.g * b.y + 0.5 * m.params.m * b.xd**2
+    assert np.max(np.abs(e - E_SLIP)) < 1e-9
+
+
+def test_slip_viability_and_a_parameter_action(slip_map, tmp_path):
+    import tslip
+    from tslip.gait.viability import state_action_map
+
+    v = viability(slip_map)
+    assert v.s.any() and not v.q[slip_map.failed].any()
+    back = StateActionMap.load(slip_map.save(tmp_path / "m.parquet"))
+    assert back.next.tobytes() == slip_map.next.tobytes()
+    assert back.params == slip_map.params and back.energy == E_SLIP
+    # the stiffness as the action: the same cells as alpha_r = 1.19 at k = 25
+    p = tslip.preset("slip")
+    by_k = state_action_map(p, {"y": slip_map.grid[0]}, ("k", [20.0, 25.0]), energy=E_SLIP)
+    by_a = state_action_map(p, {"y": slip_map.grid[0]}, ("alpha_r", [p.alpha_r]),
+                            energy=E_SLIP)
+    assert np.array_equal(by_k.next[:, 1], by_a.next[:, 0], equal_nan=True)
+
+
+def test_tslip_two_state_variables_conserve_energy():
+    """The passive TSLIP (no leg damping, no retraction) over (y, phid): the next apex keeps
+    the energy m g y + m xd^2/2 + J phid^2/2."""
+    import dataclasses
+
+    import tslip
+    from tslip.gait import section
+    from tslip.gait.viability import state_action_map
+
+    p = dataclasses.replace(tslip.preset("table2.1"), omega_r=0.0)
+    E = 14.0
+    m = state_action_map(p, {"y": np.linspace(0.7, 1.3, 4), "phid": np.linspace(-0.5, 0.5, 3)},
+                         ("alpha_r", np.linspace(0.6, 0.9, 3)), energy=E)
+    assert m.next.shape == (4, 3, 3, 2) and (~m.failed).sum() > 5
+    i, j, k = np.nonzero(~m.failed)
+    y, phid = m.grid[0][i], m.grid[1][j]
+    xd = np.sqrt(2 * (E - p.g * y - 0.5 * p.J * phid**2) / p.m)
+    b = section.apex_map_states(p, np.column_stack([y, xd, 0 * y, phid]), m.actions[k],
+                                options=tslip.IntegratorOptions.tight("dop853"))
+    assert np.array_equal(np.stack([b.y, b.phid], -1), m.next[i, j, k])
+    e = p.m * p.g * b.y + 0.5 * p.m * b.xd**2 + 0.5 * p.J * b.phid**2
+    assert np.max(np.abs(e - E)) < 1e-9
+    assert viability(m).s.shape == (4, 3)
+
+
+@pytest.mark.parametrize(("kwargs", "match"), [
+    ({"states": {"xd": [1.0, 2.0]}}, "unknown apex variable 'xd'"),
+    ({"states": {"y": [1.0, 3.0]}}, "must stay below 2.6"),
+    ({"energy": -1.0}, r"energy \[MgL\] must be"),
+    ({"actions": ("k", [-1.0, 2.0])}, "actions\\['k'\\]"),
+])
+def test_physical_map_bad_input_is_one_line(kwargs, match):
+    import tslip
+    from tslip.gait.viability import state_action_map
+
+    args = {"states": {"y": [1.0, 1.2]}, "actions": ("alpha_r", [1.1, 1.2]), "energy": E_SLIP}
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=match) as exc:
+        state_action_map(tslip.preset("slip"), args["states"], args["actions"],
+                         energy=args["energy"])
+    assert "\n" not in str(exc.value)
