@@ -4,7 +4,8 @@ periodic gaits (fixed_point), their continuation along a parameter
 (continuation), Floquet stability (stability), robustness limits
 (robustness), the ground impulse and its response to pitch (impulse), stride
 theory and the no-slip check (stride), energy balance after ground steps
-(energy), and one report of it all (report).
+(energy), the apex section and its return map (section), and one report of it
+all (report).
 """
 
 from .continuation import Branch, continue_gait, get_param, set_param, stability_boundaries
@@ -28,6 +29,17 @@ from .impulse import (
 )
 from .report import analyse
 from .robustness import RobustnessLimit, RobustnessResult, robustness, robustness_report
+from .section import (
+    ApexBatch,
+    ApexState,
+    ApexStep,
+    apex_map,
+    apex_map_batch,
+    apex_map_states,
+    apex_to_touchdown,
+    total_energy,
+    touchdown_to_apex,
+)
 from .stability import Floquet, floquet, map_jacobian, pitch_decoupled
 from .stride import (
     FrictionCheck,
@@ -49,6 +61,8 @@ __all__ = [
     "pitch_disturbance_response", "stance_impulse", "analyse",
     "RobustnessLimit", "RobustnessResult", "robustness", "robustness_report",
     "Floquet", "floquet", "map_jacobian", "pitch_decoupled",
+    "ApexBatch", "ApexState", "ApexStep", "apex_map", "apex_map_batch", "apex_map_states",
+    "apex_to_touchdown", "total_energy", "touchdown_to_apex",
     "FrictionCheck", "StrideProperties", "bounce_time", "fast_running_index", "friction_ratio",
     "predicted_flight_time", "predicted_stance_time", "stride_properties",
 ]

@@ -32,7 +32,9 @@ class IntegrationError(RuntimeError):
 
 
 class Status(enum.IntEnum):
-    """Outcome of a stride. Falls have codes below 10, integration errors 10+."""
+    """Outcome of a stride: falls have codes 1-9, integration errors 10-19, and codes 20+
+    are outcomes that are neither (``NO_APEX``: the flight after lift-off has no apex,
+    so the apex return map has no next state; docs/conventions.md)."""
 
     OK = pk.ST_OK
     FALL_BACKWARD = pk.ST_FALL_BACKWARD
@@ -45,6 +47,7 @@ class Status(enum.IntEnum):
     STANCE_TIMEOUT = pk.ST_ERR_STANCE_TIMEOUT
     FLIGHT_TIMEOUT = pk.ST_ERR_FLIGHT_TIMEOUT
     NONFINITE = pk.ST_ERR_NONFINITE
+    NO_APEX = pk.ST_NO_APEX
 
     @property
     def fell(self) -> bool:
@@ -53,8 +56,8 @@ class Status(enum.IntEnum):
 
     @property
     def is_error(self) -> bool:
-        """True if the integration itself failed."""
-        return self.value >= 10
+        """True if the integration itself failed (codes 10-19)."""
+        return 10 <= self.value < 20
 
     @property
     def reason(self) -> str:
@@ -75,6 +78,8 @@ _REASONS = {
     Status.STANCE_TIMEOUT: "error: stance longer than IntegratorOptions.t_max_stance",
     Status.FLIGHT_TIMEOUT: "error: flight longer than IntegratorOptions.t_max_flight",
     Status.NONFINITE: "error: the state became NaN or infinite",
+    Status.NO_APEX: ("no apex: the runner lifted off moving down (or touched down while "
+                     "rising), so the flight has no apex and the apex map no next state"),
 }
 
 
