@@ -304,3 +304,36 @@ def test_physical_map_bad_input_is_one_line(kwargs, match):
         state_action_map(tslip.preset("slip"), args["states"], args["actions"],
                          energy=args["energy"])
     assert "\n" not in str(exc.value)
+
+
+def test_basin_of_the_slip_gait_against_scipy(tmp_path):
+    """Starts at the gait's own apex are there at once; the strides a converged start needs
+    bring scipy's apex map near the gait too, and a start that falls has no scipy apex
+    within its strides either."""
+    import tslip
+    from tslip.gait import section
+    from tslip.gait.viability import Basin, basin
+
+    p = tslip.preset("slip")
+    g = tslip.find_gait(p)
+    E = section.total_energy(g.params, g.state)
+    y_star = section.touchdown_to_apex(g.params, g.state).y
+    grid = np.sort(np.append(np.linspace(0.85, 1.6, 16), y_star))
+    b = basin(p, g, {"y": grid}, 40, tol=1e-7)
+    assert b.steps[np.searchsorted(grid, y_star)] == 0
+    assert b.converged.sum() >= 5 and b.fell.sum() >= 3
+    alpha = g.params.alpha_r
+    for i in np.flatnonzero(b.converged)[::3]:
+        y = grid[i]
+        for _ in range(int(b.steps[i])):
+            y = scipy_slip_apex(p, y, alpha, E)
+        assert abs(y - y_star) < 1e-5, (grid[i], b.steps[i])
+    for i in np.flatnonzero(b.fell)[:2]:
+        y = grid[i]
+        for _ in range(int(b.n_done[i]) + 1):
+            y = scipy_slip_apex(p, y, alpha, E) if np.isfinite(y) else y
+        assert math.isnan(y)
+    back = Basin.load(b.save(tmp_path / "b.parquet"))
+    assert np.array_equal(back.steps, b.steps) and np.array_equal(back.status, b.status)
+    assert back.grid[0].tobytes() == grid.tobytes() and back.params == b.params
+    assert list(b.to_dataframe().columns[:2]) == ["y", "steps"]

@@ -595,7 +595,7 @@ def basin(params: Params, gait: Gait, states: Mapping[str, Sequence[float] | np.
     p = gait.params
     if dataclasses.replace(params, alpha_r=p.alpha_r) != p:
         raise ValueError("params must be the gait's parameters (gait.params) up to alpha_r")
-    E = section.energy(p, gait.state)
+    E = section.total_energy(p, gait.state)
     names, grid, _, _, _ = check_map_inputs(p, states, ("alpha_r", [p.alpha_r]), E)
     options = options or IntegratorOptions.tight("dop853")
     t0 = time.perf_counter()
