@@ -368,7 +368,8 @@ def check_map_inputs(params: Params, states: Mapping[str, Any], actions: Any,
         try:
             p = _with_action(params, action, v)
         except ValueError as exc:
-            raise ValueError(f"actions[{action!r}]: {exc}") from None
+            also = " (or 'alpha_r', the leg angle)" if "unknown parameter" in str(exc) else ""
+            raise ValueError(f"actions[{action!r}]: {exc}{also}") from None
     E = float(check_number(energy, "energy [MgL]", lower=0.0, lower_open=True))
     if not section.apex_section_ok(p):
         section.apex_map_states(p, np.zeros((0, 4)))  # raises its one-line reason

@@ -49,7 +49,14 @@ def _edges(g: np.ndarray) -> np.ndarray:
 
 
 def plot_viability(result: Viability, ax: Axes | None = None) -> Figure:
-    """The viable state-action set (one state variable) or viable states (two)."""
+    """The viable state-action set (one state variable) or viable states (two).
+
+    One state variable: each (action, state) cell grey where its stride fails
+    at once (a fall, no touch-down, no apex), beige where it survives the
+    stride but is not viable (it fails later, or leaves the grid, which the
+    cell rule counts as not viable), green where it is viable. Two: the
+    viable states, shaded by the share of their actions that are viable.
+    """
     fig, ax = _fig(ax)
     m = result.map
     energy = "" if np.isnan(m.energy) else f" at E = {m.energy:.4g} MgL"
@@ -58,8 +65,8 @@ def plot_viability(result: Viability, ax: Axes | None = None) -> Figure:
         ax.pcolormesh(_edges(m.actions), _edges(m.grid[0]), cls, cmap=_CELLS, vmin=0, vmax=2)
         ax.set_xlabel(_label(m.action))
         ax.set_ylabel(_label(m.names[0]))
-        ax.legend(handles=[Patch(color=_CELLS(i), label=t) for i, t in
-                           enumerate(("fails at once", "fails later", "viable"))],
+        kinds = ("fails at once", "not viable (fails later or leaves the grid)", "viable")
+        ax.legend(handles=[Patch(color=_CELLS(i), label=t) for i, t in enumerate(kinds)],
                   loc="upper right", fontsize=8)
     else:
         share = np.where(result.s, result.q.mean(axis=-1), np.nan)
