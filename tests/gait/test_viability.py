@@ -139,8 +139,14 @@ def test_results_round_trip_bit_for_bit(tmp_path):
     assert back.rule == v.rule and back.sweeps == v.sweeps
     m2 = StateActionMap.load(smap.save(tmp_path / "m.parquet"))
     assert m2.next.tobytes() == smap.next.tobytes() and m2.names == ("x",)
-    with pytest.raises(ValueError, match="not a 'StateActionMap'"):
+    with pytest.raises(ValueError, match="holds a Viability, not a StateActionMap"):
         StateActionMap.load(tmp_path / "v.parquet")
+    import tslip
+
+    for suffix in (".json", ".csv"):  # the whole object as JSON; the table as text
+        again = tslip.load(v.save(tmp_path / f"v{suffix}"))
+        assert again.map.next.tobytes() == smap.next.tobytes()
+        assert np.array_equal(again.q, v.q) and np.array_equal(again.s, v.s)
     assert "viable" in repr(v) and len(repr(v)) < 200
 
 

@@ -54,7 +54,7 @@ def viability_cmd(
         console.print(f"{spec.name}: {res.q.size} cells, {int(res.map.failed.sum())} fail at "
                       f"once, {int(res.q.sum())} viable ({100 * res.viable_fraction:.1f} %), "
                       f"{int(res.s.sum())} of {res.s.size} states viable, {res.sweeps} sweeps")
-        console.print(f"wrote {out_dir / 'results.parquet'} and run.json")
+        console.print(f"wrote {out_dir / 'results.parquet'} (with results.json) and run.json")
         if plot:
             fig = res.plot().figure
             fig.savefig(out_dir / "viability.png", dpi=120)

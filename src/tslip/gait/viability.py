@@ -17,9 +17,11 @@ Three results, all numpy arrays on a grid with its coordinates:
 
 A map of any discrete system can be built from arrays
 (:meth:`StateActionMap.from_arrays`); :func:`viability` works on it the
-same way. Each result has ``to_dataframe()`` (one row per cell, grid
-coordinates first, units in ``df.attrs["units"]``) and ``save``/``load``
-to Parquet that round-trip bit for bit (:mod:`tslip.gait._gridtable`).
+same way. Each result is a :class:`tslip._results.Result`:
+``to_dataframe()`` has one row per cell, grid coordinates first, units in
+``df.attrs["units"]``; ``save``/``load`` (and ``tslip.load``) to
+``.parquet`` (the table, with the grid and parameters in the ``.json``
+record beside it), ``.csv`` or ``.json`` round-trip bit for bit.
 """
 
 from __future__ import annotations
@@ -29,19 +31,18 @@ import math
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .._checks import check_number
+from .._results import Result, with_units
 from ..model import _pack as pk
 from ..model.parameters import PARAMETER_TABLE, Params
 from ..simulation.integrate import run_batch
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status
 from . import _viable, section
-from ._gridtable import grid_columns, load_table, save_table
 from .continuation import set_param
 from .stability import pitch_decoupled
 
@@ -70,12 +71,9 @@ def _short(axes: Sequence[np.ndarray], names: Sequence[str]) -> str:
     return " x ".join(f"{n} {len(g)} [{g[0]:.4g}, {g[-1]:.4g}]" for n, g in zip(names, axes))
 
 
-def _params_dict(p: Params | None) -> dict[str, Any] | None:
-    return None if p is None else p.to_dict()
-
-
-def _params_from(d: dict[str, Any] | None) -> Params | None:
-    return None if d is None else Params.from_dict(d)
+def grid_columns(axes: Sequence[np.ndarray]) -> list[np.ndarray]:
+    """The coordinates of every cell of a grid, one column per axis (C order)."""
+    return [m.ravel() for m in np.meshgrid(*axes, indexing="ij")]
 
 
 # ---------------------------------------------------------------------------
@@ -83,8 +81,8 @@ def _params_from(d: dict[str, Any] | None) -> Params | None:
 # ---------------------------------------------------------------------------
 
 
-@dataclass(frozen=True, eq=False)
-class StateActionMap:
+@dataclass(frozen=True, eq=False, repr=False)
+class StateActionMap(Result):
     """One stride from every grid state with every grid action.
 
     Attributes
@@ -180,39 +178,20 @@ class StateActionMap:
         for j, n in enumerate(self.names):
             data[f"next_{n}"] = self.next[..., j].ravel()
         data["status"] = self.status.ravel()
-        df = pd.DataFrame(data)
         units = {n: _unit(n) for n in list(self.names) + [self.action]}
-        units.update({f"next_{n}": _unit(n) for n in self.names})
-        units["status"] = "-"
-        df.attrs["units"] = units
-        return df
+        units.update({f"next_{n}": _unit(n) for n in self.names}, status="-")
+        return with_units(pd.DataFrame(data), units)
 
-    def _meta(self) -> dict[str, Any]:
-        return {"kind": "StateActionMap", "names": list(self.names),
-                "grid": [g.tolist() for g in self.grid], "action": self.action,
-                "actions": self.actions.tolist(), "energy": self.energy,
-                "params": _params_dict(self.params), "meta": self.meta}
+    def _table_fields(self) -> tuple[str, ...]:
+        return ("next", "status")
 
     @classmethod
-    def _from(cls, df: pd.DataFrame, m: dict[str, Any]) -> StateActionMap:
-        grid = tuple(np.array(g, dtype=float) for g in m["grid"])
-        acts = np.array(m["actions"], dtype=float)
-        shape = tuple(len(g) for g in grid) + (len(acts),)
-        nxt = np.stack([df[f"next_{n}"].to_numpy(float).reshape(shape) for n in m["names"]],
-                       axis=-1)
-        return cls(tuple(m["names"]), grid, m["action"], acts, nxt,
-                   df["status"].to_numpy(np.int64).reshape(shape), float(m["energy"]),
-                   _params_from(m["params"]), dict(m["meta"]))
-
-    def save(self, path: str | Path) -> Path:
-        """Write the table and the grid to a ``.parquet`` file."""
-        return save_table(self.to_dataframe(), self._meta(), path)
-
-    @classmethod
-    def load(cls, path: str | Path) -> StateActionMap:
-        """Read a map written by :meth:`save`."""
-        df, m = load_table(path, "StateActionMap")
-        return cls._from(df, m)
+    def _from_table(cls, df: pd.DataFrame, fields: dict[str, Any]) -> dict[str, Any]:
+        """``next`` and ``status`` back from the table; the grid comes from the record."""
+        shape = tuple(len(g) for g in fields["grid"]) + (len(fields["actions"]),)
+        nxt = np.stack([df[f"next_{n}"].to_numpy(float).reshape(shape)
+                        for n in fields["names"]], axis=-1)
+        return dict(fields, next=nxt, status=df["status"].to_numpy(np.int64).reshape(shape))
 
 
 def _state_grid(states: Mapping[str, Any]) -> tuple[tuple[str, ...], tuple[np.ndarray, ...]]:
@@ -235,8 +214,8 @@ def _action_grid(actions: Any) -> tuple[str, np.ndarray]:
 # ---------------------------------------------------------------------------
 
 
-@dataclass(frozen=True, eq=False)
-class Viability:
+@dataclass(frozen=True, eq=False, repr=False)
+class Viability(Result):
     """The viable part of a state-action map.
 
     Attributes
@@ -273,25 +252,30 @@ class Viability:
     def to_dataframe(self) -> pd.DataFrame:
         """The map's table plus ``viable`` (the pair) and ``state_viable``."""
         df = self.map.to_dataframe()
-        n_a = len(self.map.actions)
         df["viable"] = self.q.ravel()
-        df["state_viable"] = np.repeat(self.s.ravel(), n_a)
-        df.attrs["units"].update(viable="-", state_viable="-")
-        return df
+        df["state_viable"] = np.repeat(self.s.ravel(), len(self.map.actions))
+        return with_units(df, dict(df.attrs["units"], viable="-", state_viable="-"))
 
-    def save(self, path: str | Path) -> Path:
-        """Write the table, grid and rule to a ``.parquet`` file."""
-        meta = dict(self.map._meta(), kind="Viability", rule=self.rule, sweeps=self.sweeps)
-        return save_table(self.to_dataframe(), meta, path)
+    def _fields(self) -> dict[str, Any]:
+        """The map's fields (flat, so a table holds its arrays once) and the kernel's."""
+        return dict(self.map._fields(), rule=self.rule, q=self.q, s=self.s,
+                    sweeps=self.sweeps)
 
     @classmethod
-    def load(cls, path: str | Path) -> Viability:
-        """Read a result written by :meth:`save`."""
-        df, m = load_table(path, "Viability")
-        smap = StateActionMap._from(df, m)
-        q = df["viable"].to_numpy(bool).reshape(smap.shape)
-        s = df["state_viable"].to_numpy(bool).reshape(smap.shape)[..., 0]
-        return cls(smap, m["rule"], q, s, int(m["sweeps"]))
+    def _from_fields(cls, fields: dict[str, Any]) -> Viability:
+        f = dict(fields)
+        own = {k: f.pop(k) for k in ("rule", "q", "s", "sweeps")}
+        return cls(StateActionMap(**f), **own)
+
+    def _table_fields(self) -> tuple[str, ...]:
+        return ("next", "status", "q", "s")
+
+    @classmethod
+    def _from_table(cls, df: pd.DataFrame, fields: dict[str, Any]) -> dict[str, Any]:
+        out = StateActionMap._from_table(df, fields)
+        shape = out["status"].shape
+        q = df["viable"].to_numpy(bool).reshape(shape)
+        return dict(out, q=q, s=df["state_viable"].to_numpy(bool).reshape(shape)[..., 0])
 
     def plot(self, ax: Axes | None = None) -> Any:
         """The viable set (:func:`tslip.plotting.viability.plot_viability`)."""
@@ -476,8 +460,8 @@ def state_action_map(params: Params, states: Mapping[str, Sequence[float] | np.n
 # ---------------------------------------------------------------------------
 
 
-@dataclass(frozen=True, eq=False)
-class Basin:
+@dataclass(frozen=True, eq=False, repr=False)
+class Basin(Result):
     """Where runs from a grid of apex states go under a gait's parameters.
 
     Attributes
@@ -533,30 +517,17 @@ class Basin:
         data: dict[str, Any] = dict(zip(self.names, grid_columns(self.grid)))
         data.update(steps=self.steps.ravel(), n_done=self.n_done.ravel(),
                     status=self.status.ravel())
-        df = pd.DataFrame(data)
-        df.attrs["units"] = {**{n: _unit(n) for n in self.names},
-                             "steps": "strides", "n_done": "strides", "status": "-"}
-        return df
+        return with_units(pd.DataFrame(data), {**{n: _unit(n) for n in self.names},
+                                               "steps": "-", "n_done": "-", "status": "-"})
 
-    def save(self, path: str | Path) -> Path:
-        """Write the table and the grid to a ``.parquet`` file."""
-        meta = {"kind": "Basin", "names": list(self.names),
-                "grid": [g.tolist() for g in self.grid], "n_steps": self.n_steps,
-                "tol": self.tol, "energy": self.energy, "params": self.params.to_dict(),
-                "gait": self.gait.tolist(), "meta": self.meta}
-        return save_table(self.to_dataframe(), meta, path)
+    def _table_fields(self) -> tuple[str, ...]:
+        return ("steps", "n_done", "status")
 
     @classmethod
-    def load(cls, path: str | Path) -> Basin:
-        """Read a result written by :meth:`save`."""
-        df, m = load_table(path, "Basin")
-        grid = tuple(np.array(g, dtype=float) for g in m["grid"])
-        shape = tuple(len(g) for g in grid)
-        col = {c: df[c].to_numpy(np.int64).reshape(shape) for c in ("steps", "n_done", "status")}
-        return cls(tuple(m["names"]), grid, col["steps"], col["n_done"], col["status"],
-                   int(m["n_steps"]), float(m["tol"]), float(m["energy"]),
-                   Params.from_dict(m["params"]), np.array(m["gait"], dtype=float),
-                   dict(m["meta"]))
+    def _from_table(cls, df: pd.DataFrame, fields: dict[str, Any]) -> dict[str, Any]:
+        shape = tuple(len(g) for g in fields["grid"])
+        return dict(fields, **{c: df[c].to_numpy(np.int64).reshape(shape)
+                               for c in ("steps", "n_done", "status")})
 
     def plot(self, ax: Axes | None = None) -> Any:
         """Strides to the gait over the start grid (:func:`tslip.plotting.viability.plot_basin`)."""

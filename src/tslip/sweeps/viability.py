@@ -13,7 +13,8 @@ actions and the code behind them, so an interrupted run resumes with the
 missing chunks, a finished one reruns instantly, and any worker count
 gives the same bytes (every cell is computed on its own). The viability
 iteration then runs here on the whole map (it is cheap) and the result is
-written to ``results.parquet`` (:meth:`tslip.gait.viability.Viability.save`)
+written to ``results.parquet`` and its record ``results.json``
+(:meth:`tslip.gait.viability.Viability.save`)
 with ``run.json``; one run at a time per folder (``.lock``)::
 
     name = "slip"
