@@ -79,6 +79,8 @@ __all__ = [
     "apex_map_states",
     "apex_map_batch",
     "apex_section_ok",
+    "touchdown_to_apex_jacobian",
+    "apex_to_touchdown_jacobian",
 ]
 
 #: Names of the 4-D apex-section vector, in order.
@@ -469,3 +471,58 @@ def apex_map_batch(params: Params, y: np.ndarray | float, alpha_r: np.ndarray | 
     O = (options or IntegratorOptions()).packed()  # noqa: E741
     nxt, st, _, ts, tt = _map_rows(_rows_params(params, af, n), S, O)
     return _batch(nxt, st, ts, tt, shape)
+
+
+# ---------------------------------------------------------------------------
+# derivatives of the conversions (the apex multipliers, tslip.gait.floquet)
+# ---------------------------------------------------------------------------
+
+
+def touchdown_to_apex_jacobian(params: Params, state: TouchdownState) -> np.ndarray:
+    """``d(y, xd, phi, phid)_apex / d(beta, phi, xd, yd, phid)_td`` (4 x 5), of
+    :func:`touchdown_to_apex`: ``y = l0 sin beta - r cos phi + yd^2/(2g)``,
+    ``phi_apex = phi + phid yd / g``."""
+    p = params
+    D = np.zeros((4, 5))
+    D[0, 0] = p.l0 * math.cos(state.beta)
+    D[0, 1] = p.r * math.sin(state.phi)
+    D[0, 3] = state.yd / p.g
+    D[1, 2] = 1.0
+    D[2, 1] = 1.0
+    D[2, 3] = state.phid / p.g
+    D[2, 4] = state.yd / p.g
+    D[3, 4] = 1.0
+    return D
+
+
+def apex_to_touchdown_jacobian(params: Params, apex: ApexState,
+                               state: TouchdownState) -> np.ndarray:
+    """``d(beta, phi, xd, yd, phid)_td / d(y, xd, phi, phid)_apex`` (5 x 4) of
+    :func:`apex_to_touchdown`, ``state`` being its touch-down.
+
+    The descent time ``T`` solves eq. 2.9, ``F(T, a) = y - g T^2/2 + r cos(phi +
+    phid T) - l0 sin beta(T, a) = 0`` with ``beta = alpha_r + omega T`` (``- phi(T)``
+    for the local reset; ``omega = omega_r`` only with retraction from the
+    apex), so ``dT/da = -F_a / F_T`` (implicit function theorem).
+    """
+    _check_section(params)
+    p = params
+    local = p.leg_reset == "local"
+    T = -state.yd / p.g
+    om = p.omega_r  # 0 unless the retraction runs from the apex (_check_section)
+    ph_t = apex.phi + apex.phid * T
+    b = state.beta
+    cb, sph = math.cos(b), math.sin(ph_t)
+    # partial derivatives of beta(T, a) and F(T, a) over a = (y, xd, phi, phid)
+    db_dT = om - (apex.phid if local else 0.0)
+    db_da = np.array([0.0, 0.0, -1.0 if local else 0.0, -T if local else 0.0])
+    F_T = -p.g * T - p.r * sph * apex.phid - p.l0 * cb * db_dT  # the foot's vertical speed
+    F_a = np.array([1.0, 0.0, -p.r * sph, -p.r * sph * T]) - p.l0 * cb * db_da
+    dT = -F_a / F_T
+    D = np.zeros((5, 4))
+    D[0] = db_da + db_dT * dT
+    D[1] = np.array([0.0, 0.0, 1.0, T]) + apex.phid * dT
+    D[2, 1] = 1.0
+    D[3] = -p.g * dT
+    D[4, 3] = 1.0
+    return D
