@@ -4,8 +4,8 @@ periodic gaits (fixed_point), their continuation along a parameter
 (continuation), Floquet stability (stability), robustness limits
 (robustness), the ground impulse and its response to pitch (impulse), stride
 theory and the no-slip check (stride), energy balance after ground steps
-(energy), the apex section and its return map (section), and one report of it
-all (report).
+(energy), the apex section and its return map (section), viability kernels
+and basins of attraction on it (viability), and one report of it all (report).
 """
 
 from .continuation import Branch, continue_gait, get_param, set_param, stability_boundaries
@@ -51,6 +51,7 @@ from .stride import (
     predicted_stance_time,
     stride_properties,
 )
+from .viability import Basin, StateActionMap, Viability, basin, state_action_map, viability
 
 __all__ = [
     "Branch", "continue_gait", "get_param", "set_param", "stability_boundaries",
@@ -65,4 +66,5 @@ __all__ = [
     "apex_to_touchdown", "total_energy", "touchdown_to_apex",
     "FrictionCheck", "StrideProperties", "bounce_time", "fast_running_index", "friction_ratio",
     "predicted_flight_time", "predicted_stance_time", "stride_properties",
+    "Basin", "StateActionMap", "Viability", "basin", "state_action_map", "viability",
 ]
