@@ -343,3 +343,28 @@ def test_basin_of_the_slip_gait_against_scipy(tmp_path):
     assert np.array_equal(back.steps, b.steps) and np.array_equal(back.status, b.status)
     assert back.grid[0].tobytes() == grid.tobytes() and back.params == b.params
     assert list(b.to_dataframe().columns[:2]) == ["y", "steps"]
+
+
+def test_plots_draw_on_a_given_axes():
+    from matplotlib.figure import Figure
+
+    import tslip
+    from tslip.gait.viability import Basin
+
+    x, a, nxt = _doubling()
+    one = viability(StateActionMap.from_arrays({"x": x}, ("a", a), nxt))
+    X, Y, A = np.meshgrid(x, x[::4], a, indexing="ij")
+    two = viability(StateActionMap.from_arrays({"x": x, "y": x[::4]}, ("a", a),
+                                               np.stack([2 * X + A, Y / 2], axis=-1)))
+    steps = np.where(np.abs(x) < 0.5, 3, -1)
+    b1 = Basin(("y",), (x,), steps, np.full(x.shape, 10), np.where(steps < 0, 1, 0), 10, 1e-6,
+               2.0, tslip.preset("slip"), np.zeros(5))
+    b2 = Basin(("y", "phid"), (x, x[::4]), np.add.outer(steps, 0 * x[::4]),
+               np.full((33, 9), 10), np.zeros((33, 9), dtype=np.int64), 10, 1e-6, 2.0,
+               tslip.preset("slip"), np.zeros(5))
+    for res in (one, two, b1, b2):
+        fig = Figure()
+        ax = fig.add_subplot()
+        assert res.plot(ax) is fig
+        assert ax.collections or ax.lines
+    assert "reach the gait" in repr(b1)
