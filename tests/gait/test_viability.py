@@ -299,15 +299,17 @@ def test_tslip_two_state_variables_conserve_energy():
     ({"states": {"y": [1.0, 3.0]}}, "must stay below 2.6"),
     ({"energy": -1.0}, r"energy \[MgL\] must be"),
     ({"actions": ("k", [-1.0, 2.0])}, "actions\\['k'\\]"),
+    ({"params": "table2.1"}, "params: the apex is a Poincare section only"),
 ])
 def test_physical_map_bad_input_is_one_line(kwargs, match):
     import tslip
     from tslip.gait.viability import state_action_map
 
-    args = {"states": {"y": [1.0, 1.2]}, "actions": ("alpha_r", [1.1, 1.2]), "energy": E_SLIP}
+    args = {"states": {"y": [1.0, 1.2]}, "actions": ("alpha_r", [1.1, 1.2]), "energy": E_SLIP,
+            "params": "slip"}
     args.update(kwargs)
     with pytest.raises(ValueError, match=match) as exc:
-        state_action_map(tslip.preset("slip"), args["states"], args["actions"],
+        state_action_map(tslip.preset(args["params"]), args["states"], args["actions"],
                          energy=args["energy"])
     assert "\n" not in str(exc.value)
 

@@ -356,7 +356,9 @@ def check_map_inputs(params: Params, states: Mapping[str, Any], actions: Any,
             raise ValueError(f"actions[{action!r}]: {exc}{also}") from None
     E = float(check_number(energy, "energy [MgL]", lower=0.0, lower_open=True))
     if not section.apex_section_ok(p):
-        section.apex_map_states(p, np.zeros((0, 4)))  # raises its one-line reason
+        raise ValueError("params: the apex is a Poincare section only if the touch-down angle "
+                         "follows from the apex state (omega_r = 0, or retraction timed from "
+                         f"the apex), got omega_r={p.omega_r!r} with the lift-off clock")
     j = names.index("y")
     phid_sq = max(float(np.max(grid[names.index("phid")] ** 2)) if "phid" in names else 0.0, 0.0)
     for v in (acts[0], acts[-1]):

@@ -45,6 +45,7 @@ with ``run.json``; one run at a time per folder (``.lock``)::
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import io
 import json
@@ -112,7 +113,7 @@ class ViabilitySpec:
     action: Axis
     energy: float
     rule: str = "bracket"
-    options: IntegratorOptions = field(default_factory=IntegratorOptions.tight)
+    options: IntegratorOptions = field(default_factory=lambda: IntegratorOptions.tight("dop853"))
     description: str = ""
 
     def __post_init__(self) -> None:
@@ -147,9 +148,7 @@ class ViabilitySpec:
     def to_dict(self) -> dict[str, Any]:
         return {"name": self.name, "description": self.description, "energy": self.energy,
                 "rule": self.rule, "params": self.base.to_dict(),
-                "options": {k: getattr(self.options, k) for k in
-                            ("rtol", "atol", "h0", "max_steps", "t_max_stance", "t_max_flight",
-                             "h_min", "method")},
+                "options": dataclasses.asdict(self.options),
                 "state": [{"name": a.param, "values": list(a.values)} for a in self.states],
                 "action": {"name": self.action.param, "values": list(self.action.values)}}
 
@@ -174,8 +173,7 @@ class ViabilitySpec:
         opts = data.get("options", {})
         if not isinstance(opts, dict):
             raise ValueError("[options] must be a table")
-        known = {"rtol", "atol", "h0", "max_steps", "t_max_stance", "t_max_flight", "h_min",
-                 "method"}
+        known = {f.name for f in dataclasses.fields(IntegratorOptions)}
         if set(opts) - known:
             raise ValueError(f"unknown option {sorted(set(opts) - known)[0]!r} in [options]; "
                              f"allowed: {sorted(known)}")
