@@ -95,9 +95,9 @@ class StateActionMap(Result):
         Name of the action, e.g. ``"alpha_r"``.
     actions : ndarray
         The action grid (strictly increasing).
-    next : ndarray, shape (*state shape, n_actions, n_names)
+    next : ndarray, shape (grid shape..., n_actions, n_names)
         The next state; NaN where the stride failed.
-    status : ndarray of int, shape (*state shape, n_actions)
+    status : ndarray of int, shape (grid shape..., n_actions)
         :class:`tslip.Status` codes; 0 (``OK``) where the stride succeeded.
     energy : float
         Total energy of every cell [MgL] (NaN for a map built from arrays).
@@ -131,7 +131,7 @@ class StateActionMap(Result):
                     failed: np.ndarray | None = None) -> StateActionMap:
         """A map of any discrete system: its grids, successors and failures.
 
-        ``next`` has shape (*state shape, n_actions[, n_states]) (the last
+        ``next`` has shape ``(*grid shape, n_actions[, n_states])`` (the last
         axis may be left out for one state variable); ``failed`` (bool, same
         shape without that axis) marks the pairs that fail at once (status
         1), default: where ``next`` is not finite.
@@ -155,7 +155,8 @@ class StateActionMap(Result):
 
     @property
     def shape(self) -> tuple[int, ...]:
-        """(*state grid shape, n_actions)."""
+        # (grid shape..., n_actions); no docstring, so the API docs leave it out: a second
+        # documented ``shape`` makes numpydoc's "shape (n,)" type cross-references ambiguous
         return tuple(len(g) for g in self.grid) + (len(self.actions),)
 
     @property
@@ -226,7 +227,7 @@ class Viability(Result):
     q : ndarray of bool, shape map.shape
         Viable state-action pairs: the stride does not fail and leads to a
         state from which some action is again viable, for ever.
-    s : ndarray of bool, shape (*state shape)
+    s : ndarray of bool, shape (grid shape...)
         Viable states: some action is viable.
     sweeps : int
         Sweeps of the iteration that removed pairs.
@@ -470,7 +471,7 @@ class Basin(Result):
     ----------
     names, grid : as :class:`StateActionMap`
         The start states at the apex, at the gait's energy.
-    steps : ndarray of int, shape (*grid shape)
+    steps : ndarray of int, shape (grid shape...)
         Strides until the touch-down state is within ``tol`` of the gait's
         (0: it starts there); -1 if it never was.
     n_done : ndarray of int
