@@ -370,3 +370,21 @@ def test_plots_draw_on_a_given_axes():
         assert res.plot(ax) is fig
         assert ax.collections or ax.lines
     assert "reach the gait" in repr(b1)
+
+
+def test_basin_over_two_section_variables_keeps_the_slip_pitch_rate():
+    """At r = 0 with no hip torque the trunk spins at its apex rate for ever (no moment
+    about the CoM), and at the gait's total energy its spin J phid^2 / 2 is missing from
+    the point-mass motion: over (y, phid) only the phid = 0 row can reach the gait, and it
+    is the one-variable basin (the 2-D grid's rows and coordinates are laid out right)."""
+    import tslip
+    from tslip.gait.viability import basin
+
+    p = tslip.preset("slip")
+    g = tslip.find_gait(p)
+    y = np.linspace(0.85, 1.3, 6)
+    two = basin(p, g, {"y": y, "phid": [-0.2, 0.0, 0.2]}, 30, tol=1e-7)
+    one = basin(p, g, {"y": y}, 30, tol=1e-7)
+    assert two.steps.shape == (6, 3)
+    assert np.array_equal(two.steps[:, 1], one.steps) and one.converged.any()
+    assert not two.converged[:, [0, 2]].any()
