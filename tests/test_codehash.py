@@ -66,3 +66,28 @@ def test_an_edit_changes_exactly_the_hashes_that_depend_on_it(tmp_path, monkeypa
     assert all(core[m] != again[m] for m in core)
     ch.module_closure.cache_clear()
     ch.code_hash.cache_clear()
+
+
+def test_a_plot_method_importing_plotting_is_not_followed(tmp_path, monkeypatch):
+    """A result's .plot imports tslip.plotting; a figure changes no number, so no hash."""
+    root = tmp_path / "tslip"
+    (root / "gait").mkdir(parents=True)
+    (root / "plotting").mkdir()
+    for init in ("__init__.py", "gait/__init__.py", "plotting/__init__.py"):
+        (root / init).write_text("")
+    (root / "plotting" / "fig.py").write_text("X = 1\n")
+    (root / "gait" / "a.py").write_text(
+        "class R:\n    def plot(self, ax=None):\n        from ..plotting.fig import X\n")
+    (root / "gait" / "b.py").write_text(
+        "class R:\n    def draw(self, ax=None):\n        from ..plotting.fig import X\n")
+    (root / "gait" / "c.py").write_text(  # a plot method importing something else
+        "class R:\n    def plot(self, ax=None):\n        from . import b\n")
+    monkeypatch.setattr(ch, "_ROOT", root)
+    ch.module_closure.cache_clear()
+    try:
+        assert ch.module_closure("tslip.gait.a") == ("tslip.gait.a",)
+        assert "tslip.plotting.fig" in ch.module_closure("tslip.gait.b")
+        assert {"tslip.gait.b", "tslip.plotting.fig"} <= set(ch.module_closure("tslip.gait.c"))
+    finally:
+        ch.module_closure.cache_clear()
+        ch.code_hash.cache_clear()

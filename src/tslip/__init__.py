@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING  # noqa: E402
 
 if TYPE_CHECKING:  # the same names, for type checkers and tslip._codehash
     # mypy: ``robustness`` names both a function and its submodule of tslip.gait
+    from ._results import load
     from .gait import (  # type: ignore[no-redef]
         ApexState,
         Branch,
@@ -53,7 +54,7 @@ if TYPE_CHECKING:  # the same names, for type checkers and tslip._codehash
         step_map,
     )
 
-#: The subpackage each public name is imported from.
+#: The subpackage (or private module) each public name is imported from.
 _SUBPACKAGE = {
     **dict.fromkeys(("ConstantTorque", "GlobalPD", "LocalVelocity", "Params", "Passive",
                      "Terrain", "TouchdownState", "preset", "presets"), "model"),
@@ -63,6 +64,7 @@ _SUBPACKAGE = {
     **dict.fromkeys(("Gait", "find_gait", "Floquet", "floquet", "robustness",
                      "robustness_report", "Branch", "continue_gait", "all_gaits",
                      "stable_region", "ApexState", "apex_map", "apex_map_batch"), "gait"),
+    "load": "_results",
 }
 
 #: Subpackages, imported on first attribute access too (``tslip.gait.analyse``).
@@ -77,6 +79,7 @@ __all__ = [
     "run_batch", "simulate", "step", "step_batch", "step_map", "step_jacobian",
     "Gait", "find_gait", "Floquet", "floquet", "robustness", "robustness_report", "Branch",
     "continue_gait", "all_gaits", "stable_region", "ApexState", "apex_map", "apex_map_batch",
+    "load",
 ]
 
 

@@ -91,14 +91,36 @@ def _provider(package: str, name: str) -> str:
     return f"{package}:self"
 
 
+def _plot_imports(tree: ast.AST) -> set[int]:
+    """``id``s of the import statements inside a function named ``plot``.
+
+    A result's ``.plot`` method imports :mod:`tslip.plotting` when called
+    (the one import upwards the layering allows): figures do not change a
+    computed number, so those imports are not followed.
+    """
+    out: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and node.name == "plot":
+            out.update(id(n) for n in ast.walk(node) if isinstance(n, (ast.Import,
+                                                                         ast.ImportFrom)))
+    return out
+
+
 def _imports(module: str) -> set[str]:
-    """The ``tslip`` modules that ``module``'s source imports (anywhere in the file)."""
+    """The ``tslip`` modules that ``module``'s source imports (anywhere in the file).
+
+    Except :mod:`tslip.plotting` imported inside a ``plot`` method (:func:`_plot_imports`).
+    """
     path = _file(module)
     if path is None:
         return set()
     package = _package_of(module)
     out: set[str] = set()
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    in_plot = _plot_imports(tree)
+    for node in ast.walk(tree):
+        if id(node) in in_plot and _targets(node, package) <= {f"{_PKG}.plotting"}:
+            continue
         if isinstance(node, ast.Import):
             out.update(a.name for a in node.names if a.name.split(".")[0] == _PKG)
         elif isinstance(node, ast.ImportFrom):
@@ -112,6 +134,19 @@ def _imports(module: str) -> set[str]:
             else:
                 out.add(base)
     return {m for m in out if _file(m.removesuffix(":self")) is not None}
+
+
+def _targets(node: ast.AST, package: str) -> set[str]:
+    """The ``tslip`` subpackages (``tslip.x``) an import statement reads from."""
+    if isinstance(node, ast.Import):
+        names = [a.name for a in node.names]
+    elif isinstance(node, ast.ImportFrom):
+        base = _resolve(node, package)
+        names = [base] if node.module or base != _PKG else [f"{base}.{a.name}"
+                                                              for a in node.names]
+    else:
+        return set()
+    return {".".join(n.split(".")[:2]) for n in names}
 
 
 @functools.cache

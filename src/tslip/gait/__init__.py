@@ -5,7 +5,8 @@ periodic gaits (fixed_point), their continuation along a parameter
 (robustness), the ground impulse and its response to pitch (impulse), stride
 theory and the no-slip check (stride), energy balance after ground steps
 (energy), the apex section and its return map (section), every gait at fixed
-energy and the stable region (allgaits), and one report of it all (report).
+energy and the stable region (allgaits), viability kernels and basins of
+attraction on the apex section (viability), and one report of it all (report).
 """
 
 from .allgaits import GaitSet, StableRegion, all_gaits, stable_region
@@ -60,6 +61,7 @@ from .stride import (
     predicted_stance_time,
     stride_properties,
 )
+from .viability import Basin, StateActionMap, Viability, basin, state_action_map, viability
 
 __all__ = [
     "GaitSet", "StableRegion", "all_gaits", "stable_region", "nominal_energy", "apex_jacobian",
@@ -75,4 +77,5 @@ __all__ = [
     "apex_to_touchdown", "total_energy", "touchdown_to_apex",
     "FrictionCheck", "StrideProperties", "bounce_time", "fast_running_index", "friction_ratio",
     "predicted_flight_time", "predicted_stance_time", "stride_properties",
+    "Basin", "StateActionMap", "Viability", "basin", "state_action_map", "viability",
 ]
