@@ -14,6 +14,9 @@ DOCTEST_MODULES = [
     "tslip.model.units",
     "tslip.simulation.integrate",
     "tslip.gait.robustness",
+    "tslip.gait.section",
+    "tslip.gait.allgaits",
+    "tslip.gait.problem",
 ]
 
 

@@ -145,9 +145,18 @@ def test_results_without_a_figure_have_no_plot(objects, name):
 def test_every_result_class_is_covered(objects):
     """Each Result subclass of the TSLIP's modules is in the table above."""
 
+    import tslip.gait.viability  # noqa: F401 - its classes are Result subclasses too
+
     mods = ("tslip.simulation", "tslip.gait", "tslip.sweeps", "tslip.experiment")
     classes = {c.__name__ for c in _subclasses(Result) if c.__module__.startswith(mods)}
-    assert classes <= {type(o).__name__ for o in objects.values()}
+    assert classes - ELSEWHERE.keys() <= {type(o).__name__ for o in objects.values()}
+
+
+#: Result classes whose round trips, tables and plots other test files check, and bases
+#: checked through their subclasses.
+ELSEWHERE = {**dict.fromkeys(("StateActionMap", "Viability", "Basin"),
+                             "tests/gait/test_viability.py"),
+             "RobustnessLimits": "RobustnessResult here, the biped's in tests/biped/test_results.py"}
 
 
 def _subclasses(cls):

@@ -13,6 +13,12 @@
 
 A file is rewritten only when its text changes, so an unchanged build stays
 incremental.
+
+The two models share their class names (``Trajectory``, ``StepResult``, ...:
+docs/model.md, "Vocabulary"), so an unqualified name in a docstring or an
+annotation outside ``tslip.biped`` would match both. :func:`_prefer_tslip`
+reads it as the TSLIP's; inside ``tslip.biped`` the biped's own name is found
+first anyway (Sphinx looks in the current module before anywhere else).
 """
 
 from __future__ import annotations
@@ -193,6 +199,27 @@ def figure_scraper(block: Any, block_vars: dict[str, Any], gallery_conf: dict[st
     return figure_rst(paths, gallery_conf["src_dir"])
 
 
+def _prefer_tslip() -> None:
+    """Resolve an unqualified shared class name outside ``tslip.biped`` to the TSLIP's."""
+    from sphinx.domains.python import PythonDomain
+
+    find_obj = PythonDomain.find_obj
+    if getattr(find_obj, "_tslip", False):
+        return
+
+    def find(self: Any, env: Any, modname: Any, classname: Any, name: str, type: Any,
+             searchmode: int = 0) -> list[Any]:
+        matches = find_obj(self, env, modname, classname, name, type, searchmode)
+        if len(matches) > 1 and not str(modname or "").startswith("tslip.biped"):
+            tslip_side = [m for m in matches if not m[0].startswith("tslip.biped.")]
+            matches = tslip_side or matches
+        return matches
+
+    find._tslip = True  # type: ignore[attr-defined]
+    PythonDomain.find_obj = find  # type: ignore[method-assign]
+
+
 def setup(app: Any) -> dict[str, Any]:
     app.connect("config-inited", _generate)  # before html_extra_path is checked
+    _prefer_tslip()
     return {"parallel_read_safe": True, "parallel_write_safe": True}

@@ -15,14 +15,19 @@ if TYPE_CHECKING:  # the same names, for type checkers and tslip._codehash
     # mypy: ``robustness`` names both a function and its submodule of tslip.gait
     from ._results import load
     from .gait import (  # type: ignore[no-redef]
+        ApexState,
         Branch,
         Floquet,
         Gait,
+        all_gaits,
+        apex_map,
+        apex_map_batch,
         continue_gait,
         find_gait,
         floquet,
         robustness,
         robustness_report,
+        stable_region,
     )
     from .model import (
         ConstantTorque,
@@ -57,12 +62,14 @@ _SUBPACKAGE = {
                      "run_batch", "simulate", "step", "step_batch", "step_map",
                      "step_jacobian"), "simulation"),
     **dict.fromkeys(("Gait", "find_gait", "Floquet", "floquet", "robustness",
-                     "robustness_report", "Branch", "continue_gait"), "gait"),
+                     "robustness_report", "Branch", "continue_gait", "all_gaits",
+                     "stable_region", "ApexState", "apex_map", "apex_map_batch"), "gait"),
     "load": "_results",
 }
 
 #: Subpackages, imported on first attribute access too (``tslip.gait.analyse``).
-_SUBPACKAGES = ("biped", "cli", "experiment", "gait", "model", "plotting", "simulation", "sweeps")
+_SUBPACKAGES = ("biped", "cli", "experiment", "gait", "model", "plotting", "protocols",
+               "simulation", "sweeps")
 
 __all__ = [
     "__version__",
@@ -71,7 +78,8 @@ __all__ = [
     "Disturbance", "IntegratorOptions", "Status", "StepResult", "Trajectory",
     "run_batch", "simulate", "step", "step_batch", "step_map", "step_jacobian",
     "Gait", "find_gait", "Floquet", "floquet", "robustness", "robustness_report", "Branch",
-    "continue_gait", "load",
+    "continue_gait", "all_gaits", "stable_region", "ApexState", "apex_map", "apex_map_batch",
+    "load",
 ]
 
 

@@ -110,3 +110,18 @@ def test_stored_gaits_load_by_name_and_bad_sources_are_one_line(tmp_path):
         load_gait(tmp_path / "bad.json")
     r = CliRunner().invoke(app, ["biped", "simulate", "--gait", "optimised", "-n", "1"])
     assert r.exit_code == 0 and "1 strides" in r.output, r.output
+
+
+def test_cli_report_robustness_finds_the_limits_the_gait_file_records(tmp_path):
+    """`--robustness` searches with the shared robustness_report; the optimised gait's
+    file records the limits an earlier bisection found (-0.1625, -0.8237, -3.2556), which
+    the search must find again to the 3 % of test_design (the integrator changed since)."""
+    gait = str(gait_path("optimised"))
+    r = CliRunner().invoke(app, ["biped", "report", "--gait", gait, "--out-dir",
+                                 str(tmp_path), "-n", "2", "--robustness"])
+    assert r.exit_code == 0, r.output
+    got = json.loads((tmp_path / "robustness.json").read_text())
+    recorded = json.loads(Path(gait).read_text())["robustness_25_strides"]
+    assert set(got) == {"step_down", "push", "pitch_rate"}
+    for kind, limit in recorded.items():
+        assert got[kind] == pytest.approx(limit, rel=0.03), kind

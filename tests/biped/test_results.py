@@ -7,11 +7,13 @@ import pytest
 
 import tslip
 from _result_checks import check_frozen, check_plot, check_repr, check_round_trip, check_units
-from tslip.biped import BipedParams, BipedState, simulate, step
+from tslip.biped import BipedOptions, BipedParams, BipedState, Status, simulate, step
 from tslip.biped.design import DesignSearch
 from tslip.biped.gait import find_periodic_gait, floquet, to_section
 from tslip.biped.metacentre import metacentric_test
+from tslip.biped.robustness import RobustnessResult
 from tslip.biped.stored import load_gait
+from tslip.gait.robustness import RobustnessLimit
 
 
 @pytest.fixture(scope="module")
@@ -28,6 +30,12 @@ def objects():
         "Floquet": floquet(p, z),
         "PitchResponse": metacentric_test(p, BipedState.from_array(y), t0,
                                           pitches=(0.0, 0.1)),
+        "RobustnessResult": RobustnessResult(
+            limits=(RobustnessLimit("step_down", -1, -0.1625, -0.1626, 3, Status.FALL_TRIP, 9,
+                                    40, 0),
+                    RobustnessLimit("push", -1, -0.8237, -0.8238, 1, Status.FALL_BACKWARD, 8,
+                                    35, 1)),
+            params=p, z=z, n_steps=25, tol=1e-3, options=BipedOptions()),
         "DesignSearch": DesignSearch(
             best={"score": 0.81, "residual": 3e-9, "params": p.to_dict(), "z": z.tolist(),
                   "largest": 0.81, "message": "ok", "design": {"Kp_h": 1.25}},
@@ -36,7 +44,7 @@ def objects():
 
 
 NAMES = ["Trajectory", "Trajectory, short", "StepResult", "Gait", "Floquet", "PitchResponse",
-         "DesignSearch"]
+         "RobustnessResult", "DesignSearch"]
 NO_PLOT = {"StepResult"}
 
 

@@ -81,7 +81,7 @@ def test_the_cli_modules_import_each_other_without_a_cycle():
 
 def test_subcommands_share_only_common_and_main_assembles_them():
     graph = import_graph()
-    subcommands = {"biped", "experiment", "gait", "simulate", "studies"}
+    subcommands = {"biped", "experiment", "gait", "simulate", "studies", "viability"}
     assert {m.rsplit(".", 1)[1] for m in graph["tslip.cli.main"]} >= subcommands | {"_common"}
     for name in subcommands | {"_common"}:
         allowed = set() if name == "_common" else {f"{PKG}._common"}

@@ -30,7 +30,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 EXAMPLES = sorted((ROOT / "examples").glob("plot_*.py"))
-ANALYSES = ("gait", "stability", "robustness", "impulse", "stride", "studies", "experiment",
+ANALYSES = ("gait", "stability", "slip", "robustness", "impulse", "stride", "studies", "experiment",
             "biped")
 
 
@@ -52,7 +52,7 @@ def test_every_page_is_built(site: Path) -> None:
              "changelog", "_generated/cli", "api/index", "gallery/index",
              *(f"analyses/{a}" for a in ANALYSES),
              *(f"api/{m}" for m in ("model", "simulation", "gait", "sweeps", "biped",
-                                    "experiment", "plotting")),
+                                    "experiment", "plotting", "protocols")),
              *(f"gallery/{e.stem}" for e in EXAMPLES)]
     missing = [p for p in pages if not (site / f"{p}.html").is_file()]
     assert not missing

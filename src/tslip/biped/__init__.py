@@ -2,17 +2,19 @@
 
 Bodies, equations of motion (TMT, eqs E.1-E.22), ground contact (eqs
 E.23-E.24), phase-based controller (eqs E.25-E.34) and the compiled
-simulator; :mod:`.gait` holds the periodic-gait search and analyses.
+simulator; :mod:`.gait` holds the step map, the periodic-gait search and
+Floquet multipliers, :mod:`.robustness` the robustness limits.
 
 The biped speaks the TSLIP's vocabulary (docs/model.md, "Vocabulary"): one
 stride is :func:`step` -> :class:`StepResult`, a run is :func:`simulate` ->
 :class:`Trajectory`, and both report the shared :class:`tslip.Status`. The
 old names (``BipedStatus``, ``BipedTrajectory``, ``stride``, ``StrideResult``)
-warn and are removed in 0.4.
+warn and are removed in 0.4. What both models' results share is written down
+as the protocols of :mod:`tslip.protocols`.
 """
 
 from .._renamed import module_getattr
-from ..simulation.result import Status
+from ..simulation.result import Status as Status  # the shared enum, also here
 from ._legacy import SIMULATE_ALIASES
 from .dynamics import accelerations, energy, mass_matrix
 from .parameters import BIPED_PARAMETER_TABLE, BipedParams, BipedState
@@ -23,7 +25,6 @@ __all__ = [
     "BipedParams",
     "BipedState",
     "BipedOptions",
-    "Status",
     "StepResult",
     "Trajectory",
     "simulate",

@@ -51,6 +51,7 @@ __all__ = [
     "REFINE_OPTIONS",
     "DISTURBANCES",
     "survives_disturbance",
+    "disturbed_outcome",
     "disturbance_limit",
 ]
 
@@ -559,12 +560,28 @@ def survives_disturbance(params: BipedParams, z: NDArray[np.float64], kind: str,
                          options: BipedOptions | None = None) -> tuple[bool, str]:
     """Run ``n_steps`` from the gait ``z`` with one disturbance; (survived, status).
 
+    The run of :func:`disturbed_outcome`; the status is its name, or
+    ``"NO_FLIGHT"`` if a step-down finds no flight phase to be placed in.
+    """
+    st, done = disturbed_outcome(params, z, kind, value, n_steps, options)
+    if st is None:
+        return False, "NO_FLIGHT"
+    return done >= n_steps, st.name
+
+
+def disturbed_outcome(params: BipedParams, z: NDArray[np.float64], kind: str, value: float,
+                      n_steps: int = 25, options: BipedOptions | None = None
+                      ) -> tuple[Status | None, int]:
+    """``(status, strides done)`` of ``n_steps`` strides from the gait ``z``, disturbed once.
+
     ``step_down``: the ground is shifted by ``value`` [L] (negative: down)
     for every touch-down after the first right stance (the body is shifted by
     ``-value`` in the middle of the first flight phase after a lift-off).
     ``push``: ``value`` added to ``xd_b`` of the section state.
     ``pitch_rate``: ``value`` added to the body pitch rate with the leg
     (absolute) angular rates kept, i.e. subtracted from both hip-angle rates.
+    The status is ``None`` if a step-down finds no flight phase; a fall in
+    the first right stance of a step-down has 0 strides done.
     """
     if kind not in DISTURBANCES:
         raise ValueError(f"unknown disturbance {kind!r}; known: {list(DISTURBANCES)}")
@@ -577,7 +594,7 @@ def survives_disturbance(params: BipedParams, z: NDArray[np.float64], kind: str,
         y[17] -= value
     if kind != "step_down":
         tr = simulate(params, y, n_steps, t0=t0, options=options)
-        return tr.n_steps >= n_steps, tr.status.name
+        return tr.status, tr.n_steps
     # first right stance on the original ground; cut in the middle of the first
     # interval after a lift-off in which both feet are in the air
     first = simulate(params, y, 1, t0=t0, options=options)
@@ -591,15 +608,15 @@ def survives_disturbance(params: BipedParams, z: NDArray[np.float64], kind: str,
                 t_cut = tm
                 break
     if not math.isfinite(t_cut):
-        return False, "NO_FLIGHT"
+        return None, 0
     part = simulate(params, y, 1, t0=t0, t_end=t_cut, options=options)
-    if part.status.name != "T_END":
-        return False, part.status.name
+    if part.status != Status.T_END:
+        return part.status, 0
     y1 = part.final_state.copy()
     y1[1] -= value
     tr = simulate(params, y1, n_steps, t0=float(part.stats["t_end"]),
                   contact=part.final_contact, options=options)
-    return tr.n_steps >= n_steps, tr.status.name
+    return tr.status, tr.n_steps
 
 
 @accepts_n_strides

@@ -49,7 +49,6 @@ __all__ = [
     "BipedEvent",
     "Trajectory",
     "StepResult",
-    "Status",
     "to_status",
     "MIN_CONTACT_FRACTION",
     "count_strides",

@@ -19,6 +19,14 @@ from typing import Annotated, Any
 
 import typer
 from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
 
 from .._checks import check_output, parse_number
 from ..model.parameters import PARAMETER_TABLE, Params, preset, presets, read_params_file
@@ -26,7 +34,7 @@ from ..model.parameters import PARAMETER_TABLE, Params, preset, presets, read_pa
 __all__ = [
     "DATA_SUFFIXES", "Failed", "ParamsOpt", "PresetOpt", "SetOpt", "build_params",
     "build_params_and_preset", "check_plot_suffix", "check_suffix", "echo_error", "errors",
-    "fail", "file_size", "make_console", "run",
+    "fail", "file_size", "interruptible", "make_console", "progress_bar", "run", "stopped",
 ]
 
 #: Table files the commands read and write.
@@ -98,6 +106,42 @@ def errors() -> Iterator[None]:
         fail(str(exc), 2)
     except OSError as exc:  # e.g. an output directory that cannot be written
         fail(f"{exc.strerror or exc}: {exc.filename}" if exc.filename else str(exc), 1)
+
+
+def stopped(message: str) -> None:
+    """Ctrl-C: one line on stderr, exit code 130 (128 + SIGINT), no traceback."""
+    typer.echo(message, err=True)
+    raise typer.Exit(code=130)
+
+
+@contextmanager
+def interruptible() -> Iterator[None]:
+    """A Ctrl-C outside the work itself (e.g. while loading) also ends quietly."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        stopped("interrupted")
+
+
+class _Rate(TextColumn):
+    """Items per second, e.g. ``12.0 pt/s``."""
+
+    def __init__(self, unit: str) -> None:
+        super().__init__("")
+        self.unit = unit
+
+    def render(self, task):  # noqa: ANN001, ANN201
+        from rich.text import Text
+
+        speed = task.finished_speed or task.speed
+        return Text(f"{speed:5.1f} {self.unit}/s" if speed else f"   -- {self.unit}/s")
+
+
+def progress_bar(unit: str) -> Progress:
+    """The progress bar of long runs on stderr: done of total, rate in ``unit``/s, time left."""
+    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                    _Rate(unit), TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(),
+                    console=make_console(stderr=True), transient=False)
 
 
 def run(app: typer.Typer, prog_name: str) -> int:

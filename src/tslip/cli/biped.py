@@ -266,10 +266,12 @@ def report_cmd(
         c.print(f"largest multiplier {fr.max_nontrivial:.3f} "
                 f"(periodicity residual {fr.residual:.2e})")
         if robustness:
-            from ..biped.gait import DISTURBANCES, disturbance_limit
+            from ..biped.gait import Gait
+            from ..biped.robustness import robustness_report
 
-            z = fr.z
-            lim = {k: -float(disturbance_limit(p, z, k, sign=-1.0).lo) for k in DISTURBANCES}
+            start = Gait(True, fr.residual, fr.z, p, "the report's start", 0)
+            rep = robustness_report(start, n_steps=25, tol=1e-3, check=False)
+            lim = {r.kind: r.limit for r in rep.limits}
             c.print("robustness (25 strides): " + ", ".join(
                 f"{k} {v:.4f}" for k, v in lim.items()) + "  (TSLIP Table 6.1: step_down "
                 "-0.119, push -0.725, pitch_rate -0.733)")

@@ -3,25 +3,15 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated
 
 import typer
 from rich import box
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TextColumn,
-    TimeElapsedColumn,
-    TimeRemainingColumn,
-)
 from rich.table import Table
 
 from .._checks import check_output
-from ._common import errors, make_console
+from ._common import errors, interruptible, make_console, progress_bar, stopped
 
 __all__ = ["commands", "study_cmd", "reproduce_cmd"]
 
@@ -32,34 +22,6 @@ WorkersOpt = Annotated[int | None, typer.Option("--workers", min=1,
                                                 help="Worker processes (default: all cores).")]
 SchedulerOpt = Annotated[str | None, typer.Option(
     "--scheduler", help="Dask scheduler address (needs tslip\\[dask]).")]
-
-
-class _Rate(TextColumn):
-    """Points per second."""
-
-    def __init__(self) -> None:
-        super().__init__("")
-
-    def render(self, task):  # noqa: ANN001, ANN201
-        from rich.text import Text
-
-        speed = task.finished_speed or task.speed
-        return Text(f"{speed:5.1f} pt/s" if speed else "   -- pt/s")
-
-
-def _stopped(message: str) -> None:
-    """Ctrl-C: one line on stderr, exit code 130 (128 + SIGINT), no traceback."""
-    typer.echo(message, err=True)
-    raise typer.Exit(code=130)
-
-
-@contextmanager
-def _interruptible() -> Iterator[None]:
-    """A Ctrl-C outside the study itself (e.g. while loading) also ends quietly."""
-    try:
-        yield
-    except KeyboardInterrupt:
-        _stopped("interrupted")
 
 
 def _saved_message(out: Path, quick: bool) -> str:
@@ -92,13 +54,11 @@ def study_cmd(
     from ..sweeps.run import StudyInterrupted
 
     console = make_console()
-    with errors(), _interruptible():
+    with errors(), interruptible():
         spec = StudySpec.from_toml(spec_path)
         out_dir = out if out is not None else Path("studies") / spec.name
         check_output(out_dir / "run.json", "--out")  # before any work, naming the user's path
-        with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                      _Rate(), TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(),
-                      console=make_console(stderr=True), transient=False) as bar:
+        with progress_bar("pt") as bar:
             task = bar.add_task(f"study {spec.name}", total=spec.n_points)
             try:
                 res = run_study(spec, out_dir, workers=workers, scheduler=scheduler, csv=csv,
@@ -106,7 +66,7 @@ def study_cmd(
                                 progress=lambda done, total: bar.update(task, completed=done))
             except StudyInterrupted as exc:
                 bar.stop()
-                _stopped(str(exc))
+                stopped(str(exc))
     f = res.frame
     n_stable = int(f["stability"].isin(["asymptotic", "neutral"]).sum())
     console.print(f"{spec.name}: {len(f)} points ({res.meta['cached']} cached), "
@@ -145,13 +105,13 @@ def reproduce_cmd(
         elif stage == "figure":
             console.print(f"[{el:6.1f} s] figure {name} ({seconds:.1f} s)")
 
-    with errors(), _interruptible():
+    with errors(), interruptible():
         check_output(out / "index.html", "--out")  # before any work, naming the user's path
         try:
             path = reproduce(out, quick=quick, workers=workers, scheduler=scheduler,
                              progress=progress)
         except KeyboardInterrupt:
-            _stopped(_saved_message(out, quick))
+            stopped(_saved_message(out, quick))
     import json
 
     claims = json.loads(path.with_name("claims.json").read_text())

@@ -4,9 +4,12 @@ periodic gaits (fixed_point), their continuation along a parameter
 (continuation), Floquet stability (stability), robustness limits
 (robustness), the ground impulse and its response to pitch (impulse), stride
 theory and the no-slip check (stride), energy balance after ground steps
-(energy), and one report of it all (report).
+(energy), the apex section and its return map (section), every gait at fixed
+energy and the stable region (allgaits), viability kernels and basins of
+attraction on the apex section (viability), and one report of it all (report).
 """
 
+from .allgaits import GaitSet, StableRegion, all_gaits, stable_region
 from .continuation import Branch, continue_gait, get_param, set_param, stability_boundaries
 from .energy import (
     HeightChangeResult,
@@ -17,7 +20,15 @@ from .energy import (
     velocity_after_height_change,
     velocity_angle_effect,
 )
-from .fixed_point import CMAReport, Gait, GaitProblem, cma_minimize, find_gait, gait_residual
+from .fixed_point import (
+    CMAReport,
+    Gait,
+    GaitProblem,
+    cma_minimize,
+    find_gait,
+    gait_residual,
+    nominal_energy,
+)
 from .impulse import (
     Impulse,
     ImpulseLinearisation,
@@ -28,7 +39,18 @@ from .impulse import (
 )
 from .report import GaitReport, analyse
 from .robustness import RobustnessLimit, RobustnessResult, robustness, robustness_report
-from .stability import Floquet, floquet, map_jacobian, pitch_decoupled
+from .section import (
+    ApexBatch,
+    ApexState,
+    ApexStep,
+    apex_map,
+    apex_map_batch,
+    apex_map_states,
+    apex_to_touchdown,
+    total_energy,
+    touchdown_to_apex,
+)
+from .stability import Floquet, apex_jacobian, floquet, map_jacobian, pitch_decoupled
 from .stride import (
     FrictionCheck,
     StrideProperties,
@@ -39,8 +61,10 @@ from .stride import (
     predicted_stance_time,
     stride_properties,
 )
+from .viability import Basin, StateActionMap, Viability, basin, state_action_map, viability
 
 __all__ = [
+    "GaitSet", "StableRegion", "all_gaits", "stable_region", "nominal_energy", "apex_jacobian",
     "Branch", "continue_gait", "get_param", "set_param", "stability_boundaries",
     "HeightChangeResult", "StepDownResponse", "VelocityAngleCase", "expected_velocity_change",
     "step_down_response", "velocity_after_height_change", "velocity_angle_effect",
@@ -49,6 +73,9 @@ __all__ = [
     "pitch_disturbance_response", "stance_impulse", "analyse", "GaitReport",
     "RobustnessLimit", "RobustnessResult", "robustness", "robustness_report",
     "Floquet", "floquet", "map_jacobian", "pitch_decoupled",
+    "ApexBatch", "ApexState", "ApexStep", "apex_map", "apex_map_batch", "apex_map_states",
+    "apex_to_touchdown", "total_energy", "touchdown_to_apex",
     "FrictionCheck", "StrideProperties", "bounce_time", "fast_running_index", "friction_ratio",
     "predicted_flight_time", "predicted_stance_time", "stride_properties",
+    "Basin", "StateActionMap", "Viability", "basin", "state_action_map", "viability",
 ]

@@ -17,6 +17,13 @@ Parameter names: the :class:`~tslip.model.parameters.Params` fields (``v0``,
 ``k``, ``beta0``, ``r``, ``omega_r``, ``c_l``, ``m``, ``J``, ``l0``, ``g``),
 ``"omega_r_bar"`` (eq. 2.18, at the point's ``v0``) and controller gains by
 dotted name (``"controller.c_h"``, ``"controller.Kd"``, ``"controller.Kp"``).
+
+What the branch holds besides the parameter (``fix``, ``energy``, ``section``
+of :func:`~tslip.gait.fixed_point.find_gait`): the speed ``v0`` at the
+touch-down (the thesis's studies) or at the apex, or the total energy (the
+SLIP literature's): a continuation along ``beta0`` at fixed speed changes the
+energy, and its stability boundaries move. :func:`stability_boundaries`
+re-solves with what the branch held.
 """
 
 from __future__ import annotations
@@ -37,6 +44,8 @@ from ..model.parameters import PARAMETER_TABLE, Params
 from ..model.units import COLUMN_UNITS, param_unit
 from ..simulation.options import IntegratorOptions
 from .fixed_point import Gait, GaitProblem, find_gait
+from .problem import Fix, Section, nominal_energy
+from .section import apex_section_ok
 from .stability import floquet
 
 __all__ = [
@@ -143,9 +152,10 @@ class Branch(Result):
         Best max-norm residual (NaN where not attempted).
     stance_time, flight_time : ndarray, shape (n,)
         [g^-1/2 L^1/2], NaN where there is no gait.
-    multipliers : ndarray of complex, shape (n, 5)
-        Floquet multipliers (exact Jacobian), largest first; NaN where none.
-    trivial : ndarray of bool, shape (n, 5)
+    multipliers : ndarray of complex, shape (n, 5) or (n, 4)
+        Floquet multipliers (exact Jacobian) on the branch's section, largest
+        first; NaN where none.
+    trivial : ndarray of bool, shape (n, 5) or (n, 4)
         Structural multipliers (energy; pitch rate at ``r = 0``).
     max_nontrivial : ndarray, shape (n,)
         Largest non-trivial magnitude, NaN where none.
@@ -164,6 +174,13 @@ class Branch(Result):
         Integrator settings used (None: the default, tolerance 1e-12).
     seconds : ndarray, shape (n,)
         Wall time per point [s] (solve plus multipliers).
+    fix : {"speed", "energy"}
+        What each point held besides the parameter: the speed ``params.v0`` at
+        the section, or the total energy ``energy``.
+    energy : float
+        The energy held [MgL] (NaN with ``fix="speed"``).
+    section : {"touchdown", "apex"}
+        The section of the speed held and of the multipliers.
     """
 
     param: str
@@ -183,15 +200,25 @@ class Branch(Result):
     tol: float
     options: IntegratorOptions | None
     seconds: np.ndarray = field(repr=False)
+    fix: Fix = "speed"
+    energy: float = math.nan
+    section: Section = "touchdown"
 
     def __len__(self) -> int:
         return len(self.values)
 
-    def _repr_fields(self) -> dict[str, Any]:
-        lo, hi = self.exists()
-        return {"param": self.param, "points": len(self.values),
-                "converged": int(np.count_nonzero(self.converged)), "exists_from": lo,
-                "exists_to": hi, "stable": int(np.count_nonzero(self.stable))}
+    def __repr__(self) -> str:
+        """One line: parameter, range, points with a gait, what was held."""
+        held = (f"energy {self.energy:.6g}" if self.fix == "energy"
+                else f"{self.section} speed {self.params.v0:.6g}")
+        return (f"Branch({self.param} {self.values[0]:.6g} to {self.values[-1]:.6g}, "
+                f"{int(self.converged.sum())} of {len(self)} with a gait, {held})")
+
+    @property
+    def hold(self) -> dict[str, Any]:
+        """``find_gait`` keywords of what the branch held (``fix``, ``energy``, ``section``)."""
+        return {"fix": self.fix, "section": self.section,
+                "energy": self.energy if self.fix == "energy" else None}
 
     def plot(self, ax: Any = None) -> Any:
         """Non-trivial multiplier magnitudes against the parameter (thesis Figure 4.8)."""
@@ -215,8 +242,9 @@ class Branch(Result):
         Columns: ``param``, ``value``, ``converged``, ``residual``, ``delta``,
         ``phi``, ``phid``, ``alpha_r``, the controller reference
         (``alphad_ref`` or ``tau_c`` when the controller has one),
-        ``stance_time``, ``flight_time``, ``abs_lambda_1`` ... ``abs_lambda_5``
-        (descending), ``max_nontrivial``, ``stability``, ``message``.
+        ``stance_time``, ``flight_time``, ``energy`` (total, MgL),
+        ``abs_lambda_1`` ... ``abs_lambda_5`` (descending; 4 on the apex
+        section), ``max_nontrivial``, ``stability``, ``message``.
         """
         ctrl = self.params.controller
         ref = next((n for n in ("alphad_ref", "tau_c") if hasattr(ctrl, n)), None)
@@ -234,6 +262,7 @@ class Branch(Result):
                 row[ref] = float(getattr(g.params.controller, ref)) if g else math.nan
             row["stance_time"] = float(self.stance_time[i])
             row["flight_time"] = float(self.flight_time[i])
+            row["energy"] = g.energy if g else math.nan
             mags = np.sort(np.abs(self.multipliers[i]))[::-1]
             for j, m in enumerate(mags, 1):
                 row[f"abs_lambda_{j}"] = float(m)
@@ -253,11 +282,17 @@ class Branch(Result):
 
 def _solve_point(
     base: Params, param: str, value: float, history: list[tuple[float, Gait]], tol: float,
-    options: IntegratorOptions | None, predictor: str,
+    options: IntegratorOptions | None, predictor: str, hold: dict[str, Any] | None = None,
 ) -> tuple[Gait, str]:
-    """One point: secant predictor, then the neighbour, then the automatic guesses."""
-    p = set_param(history[-1][1].params if history else base, param, value)
-    prob = GaitProblem.from_params(p, options)
+    """One point: secant predictor, then the neighbour, then the automatic guesses.
+
+    ``base`` carries the speed held (a gait's ``params.v0`` is its touch-down
+    speed, not the apex speed a branch may hold); ``hold``: ``find_gait``'s
+    ``fix``, ``energy``, ``section``.
+    """
+    hold = hold or {}
+    p = set_param(base, param, value)
+    prob = GaitProblem.from_params(p, options, **hold)
     starts: list[tuple[str, np.ndarray]] = []
     if history:
         z1 = prob.encode(history[-1][1])
@@ -269,12 +304,12 @@ def _solve_point(
         starts.append(("neighbour", z1))
     best: Gait | None = None
     for how, z in starts:
-        g = find_gait(p, guess=z, tol=tol, options=options)
+        g = find_gait(p, guess=z, tol=tol, options=options, **hold)
         if g.converged:
             return g, f"{g.message} (warm start: {how})"
         if best is None or g.residual < best.residual:
             best = g
-    g = find_gait(p, tol=tol, options=options)
+    g = find_gait(p, tol=tol, options=options, **hold)
     if g.converged or best is None or g.residual < best.residual:
         best = g
     how = "automatic guess" + (" after the warm start failed" if starts else "")
@@ -292,6 +327,9 @@ def continue_gait(
     predictor: str = "secant",
     max_failures: int | None = 2,
     multipliers: bool = True,
+    fix: Fix = "speed",
+    energy: float | None = None,
+    section: Section = "touchdown",
 ) -> Branch:
     """Follow a periodic gait along one scalar parameter.
 
@@ -327,7 +365,12 @@ def continue_gait(
         Consecutive failures that end the branch in one direction; None
         attempts every value.
     multipliers : bool
-        Compute the Floquet multipliers (exact Jacobian) of each gait.
+        Compute the Floquet multipliers (exact Jacobian) of each gait, on ``section``.
+    fix, energy, section
+        What every point holds besides the parameter, as in ``find_gait``: the
+        speed ``v0`` at the section, or the total energy (default: the
+        starting parameters' :func:`~tslip.gait.problem.nominal_energy`, held
+        along the whole branch).
 
     Returns
     -------
@@ -346,7 +389,22 @@ def continue_gait(
     >>> b.converged.tolist(), b.stability
     ([True, True, True], ('asymptotic', 'asymptotic', 'asymptotic'))
     """
-    params = gait_or_params.params if isinstance(gait_or_params, Gait) else gait_or_params
+    if isinstance(gait_or_params, Gait):
+        params = gait_or_params.params
+        if gait_or_params.section == "apex" and gait_or_params.fix == "speed":
+            params = dataclasses.replace(params, v0=gait_or_params.state.xd)  # the speed held
+    else:
+        params = gait_or_params
+    if fix == "energy":
+        if param == "v0":
+            raise ValueError("param 'v0' is not held with fix='energy': the energy sets the "
+                             "speed")
+        energy = nominal_energy(params) if energy is None else energy
+    hold: dict[str, Any] = {"fix": fix, "energy": energy, "section": section}
+    GaitProblem.from_params(params, options, **hold)  # checks fix, section and energy
+    if section == "apex" and multipliers and not apex_section_ok(params):
+        raise ValueError("the apex multipliers need omega_r = 0 or retraction from the apex, "
+                         f"got omega_r={params.omega_r!r}")
     base_value = get_param(params, param)
     vals = np.sort(np.asarray(values, dtype=float).ravel())
     if vals.size == 0 or not np.all(np.isfinite(vals)):
@@ -361,8 +419,9 @@ def continue_gait(
     msgs = ["not attempted: past the end of the branch"] * n
     seconds = np.full(n, math.nan)
 
-    lam = np.full((n, 5), np.nan, dtype=complex)
-    triv = np.zeros((n, 5), dtype=bool)
+    nm = 4 if section == "apex" else 5
+    lam = np.full((n, nm), np.nan, dtype=complex)
+    triv = np.zeros((n, nm), dtype=bool)
     mnt = np.full(n, math.nan)
     stab = ["none"] * n
 
@@ -370,7 +429,7 @@ def continue_gait(
         # right after the solve: the exact Jacobian Newton computed at the gait is
         # still kept (tslip.simulation._packed), so this costs no stride
         try:
-            f = floquet(g, method="exact", options=options)
+            f = floquet(g, method="exact", options=options, section=section)
         except ValueError:
             stab[i] = "unknown"
         else:
@@ -378,8 +437,12 @@ def continue_gait(
                 f.stability
 
     anchor = gait_or_params if isinstance(gait_or_params, Gait) else None
+    if anchor is not None and anchor.converged and not _holds(anchor, hold):
+        # a gait of another constraint: the warm start of one that holds the branch's
+        z = GaitProblem.from_params(params, options, **hold).encode(anchor)
+        anchor = find_gait(params, guess=z, tol=tol, options=options, **hold)
     if anchor is None or not anchor.converged:
-        anchor = find_gait(params, tol=tol, options=options)
+        anchor = find_gait(params, tol=tol, options=options, **hold)
     start: list[tuple[float, Gait]] = [(base_value, anchor)] if anchor.converged else []
     i0 = int(np.argmin(np.abs(vals - base_value)))
     done = 0
@@ -392,7 +455,7 @@ def continue_gait(
                 break
             t0 = time.perf_counter()
             g, msg = _solve_point(params, param, float(vals[i]), history, tol, options,
-                                  predictor)
+                                  predictor, hold)
             best[i], msgs[i] = g, msg
             if g.converged:
                 gaits[i] = g
@@ -422,8 +485,16 @@ def continue_gait(
         stance_time=arr("stance_time"), flight_time=arr("flight_time"),
         multipliers=lam, trivial=triv, max_nontrivial=mnt, stability=tuple(stab),
         messages=tuple(msgs), base=base_value, params=params, tol=tol, options=options,
-        seconds=seconds,
+        seconds=seconds, fix=fix, energy=math.nan if energy is None else float(energy),
+        section=section,
     )
+
+
+def _holds(gait: Gait, hold: dict[str, Any]) -> bool:
+    """Whether ``gait`` satisfies the constraint ``hold`` (to 1e-9 in the energy)."""
+    if gait.fix != hold["fix"] or gait.section != hold["section"]:
+        return False
+    return hold["fix"] != "energy" or abs(gait.energy - float(hold["energy"])) <= 1e-9
 
 
 # ---------------------------------------------------------------------------
@@ -478,12 +549,13 @@ def stability_boundaries(
         def f(x: float, ga: Gait = ga, gb: Gait = gb, va: float = v[i],
               vb: float = v[i + 1]) -> float:
             near = ga if abs(x - va) <= abs(x - vb) else gb
-            p = set_param(near.params, branch.param, x)
-            z = GaitProblem.from_params(p, branch.options).encode(near)
-            g = find_gait(p, guess=z, tol=branch.tol, options=branch.options)
+            p = set_param(branch.params, branch.param, x)  # holds what the branch held
+            z = GaitProblem.from_params(p, branch.options, **branch.hold).encode(near)
+            g = find_gait(p, guess=z, tol=branch.tol, options=branch.options, **branch.hold)
             if not g.converged:
                 raise RuntimeError(f"no gait at {branch.param} = {x}: {g.message}")
-            return floquet(g, options=branch.options).max_nontrivial - level
+            f = floquet(g, options=branch.options, section=branch.section)
+            return f.max_nontrivial - level
 
         try:
             out.append(float(brentq(f, float(v[i]), float(v[i + 1]), xtol=xtol)))

@@ -7,10 +7,12 @@ damping); ``v0`` and ``beta0`` are fixed. The residual is the next
 touch-down's ``(beta, phi, phid, delta, v)`` minus ``(beta0, phi, phid,
 delta, v0)``.
 
-:class:`GaitProblem` states the search as pure functions of the free
-variables ``z``: the residual, the thesis's cost ``C1`` (eq. 2.20) and the
-two-stage cost ``C`` (eqs 2.21-2.22) within bounds (eqs 2.23-2.24). Two
-searches work on it, both outside the simulation:
+:class:`GaitProblem` (:mod:`tslip.gait.problem`) states the search as pure
+functions of the free variables ``z``: the residual, the thesis's cost ``C1``
+(eq. 2.20) and the two-stage cost ``C`` (eqs 2.21-2.22) within bounds (eqs
+2.23-2.24). It holds the speed (``fix="speed"``, at the touch-down or the
+apex section) or the total energy (``fix="energy"``), and at ``r = 0`` the
+undetermined pitch. Two searches work on it, both outside the simulation:
 
 * ``method="newton"`` (default): damped Newton on the residual with its
   exact Jacobian (variational equations, :meth:`GaitProblem.residual_jacobian`),
@@ -39,24 +41,31 @@ import dataclasses
 import itertools
 import math
 import time
-import warnings
-from collections.abc import Callable, Iterable, Iterator, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from scipy.optimize import least_squares
 
 from .._results import Result, frame
-from ..model import _pack as pk
-from ..model.controllers import ConstantTorque, GlobalPD, LocalVelocity
+from ..model.controllers import GlobalPD
 from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..model.units import COLUMN_UNITS
-from ..simulation import _packed
-from ..simulation.integrate import step_map
 from ..simulation.options import IntegratorOptions
-from ..simulation.result import Status
+from ._cma import CMAReport, cma_minimize
+from .problem import (
+    C1_OFFSET,
+    C1_THRESHOLD,
+    TIGHT,
+    Fix,
+    GaitProblem,
+    Section,
+    gait_residual,
+    nominal_energy,
+)
+from .section import ApexState, total_energy, touchdown_to_apex
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -73,63 +82,14 @@ __all__ = [
     "cma_minimize",
     "C1_THRESHOLD",
     "C1_OFFSET",
+    "TIGHT",
+    "nominal_energy",
 ]
 
 Method = Literal["newton", "cma"]
 
-#: ``epsilon`` of eq. 2.22: switch from ``C1`` to ``C2`` below this.
-C1_THRESHOLD = 1e-4
-#: Offset added to ``C1`` in eq. 2.22 so it exceeds ``C2`` for ``|lambda| < 5``.
-C1_OFFSET = 25.0
-
-#: Default options of gait search and Floquet multipliers, built (and checked) once:
-#: tolerance 1e-12 with DOP853.
-TIGHT = IntegratorOptions.tight("dop853")
-
-_FALL_PENALTY = 10.0
 _MAX_STARTS = 13  # automatic guesses tried by Newton: the first 5 plus the 8 best of the scan
 _TWO_PI = 2.0 * math.pi
-
-
-@dataclass(frozen=True, slots=True)
-class CMAReport:
-    """What the CMA-ES search of eq. 2.22 found, before any polish.
-
-    Attributes
-    ----------
-    seed : int
-        Seed of the run; the same seed reproduces it exactly.
-    evaluations, iterations : int
-        Cost evaluations and CMA-ES generations used.
-    z : tuple of float
-        Best free variables ``(delta, phi, phid, alpha_r[, alphad_ref | tau_c])``.
-    c1 : float
-        Eq. 2.20 at ``z``: squared periodicity residual [-].
-    c2 : float
-        Eq. 2.21 at ``z``: largest squared non-trivial multiplier magnitude,
-        NaN when ``c1 >= C1_THRESHOLD``.
-    cost : float
-        Eq. 2.22 at ``z``.
-    stop : str
-        Why CMA-ES stopped (its termination criteria).
-    seconds : float
-        Wall time of the CMA-ES run [s] (not compared by ``==``).
-    """
-
-    seed: int
-    evaluations: int
-    iterations: int
-    z: tuple[float, ...]
-    c1: float
-    c2: float
-    cost: float
-    stop: str
-    seconds: float = field(default=math.nan, compare=False)
-
-    @property
-    def max_nontrivial(self) -> float:
-        """``sqrt(c2)``: the largest non-trivial multiplier magnitude at ``z``."""
-        return math.sqrt(self.c2) if math.isfinite(self.c2) else math.nan
 
 
 @dataclass(frozen=True, slots=True, repr=False)
@@ -155,6 +115,12 @@ class Gait(Result):
         The search that produced the gait.
     cma : CMAReport or None
         The CMA-ES result before polishing (``method="cma"`` only).
+    fix : {"speed", "energy"}
+        What the search held: the speed at the section (``held``) or the total
+        energy. ``params.v0`` is the gait's touch-down speed either way.
+    section : {"touchdown", "apex"}
+        The section the gait was searched on: it sets which speed ``fix="speed"``
+        held, and the section of :func:`~tslip.gait.floquet` by default.
     """
 
     state: TouchdownState
@@ -166,6 +132,8 @@ class Gait(Result):
     message: str
     method: str = "newton"
     cma: CMAReport | None = None
+    fix: Fix = "speed"
+    section: Section = "touchdown"
 
     def _repr_fields(self) -> dict[str, Any]:
         return {"converged": self.converged, "residual": self.residual, "v": self.state.v,
@@ -180,7 +148,8 @@ class Gait(Result):
                        "alpha_r": self.params.alpha_r, "stance_time": self.stance_time,
                        "flight_time": self.flight_time, "residual": self.residual,
                        "converged": self.converged, "method": self.method,
-                       "message": self.message}], COLUMN_UNITS)
+                       "fix": self.fix, "section": self.section,
+                       "message": self.message}], {**COLUMN_UNITS, "fix": "-", "section": "-"})
 
     def plot(self, ax: Axes | None = None) -> Figure:
         """The CoM path over two strides of the gait."""
@@ -188,379 +157,26 @@ class Gait(Result):
 
         return plot_gait(self, ax)
 
-
-# ---------------------------------------------------------------------------
-# the problem: pure functions of the free variables
-# ---------------------------------------------------------------------------
-
-
-def _unknown_names(params: Params) -> tuple[str, ...]:
-    names = ["delta", "phi", "phid", "alpha_r"]
-    if isinstance(params.controller, LocalVelocity):
-        names.append("alphad_ref")
-    elif isinstance(params.controller, ConstantTorque) and (
-        params.c_l > 0 or params.controller.c_h > 0
-    ):
-        names.append("tau_c")
-    return tuple(names)
-
-
-def gait_residual(params: Params, state: TouchdownState,
-                  options: IntegratorOptions | None = None) -> tuple[np.ndarray, float, float]:
-    """Periodicity residual ``(beta, phi, phid, delta, v)`` of one stride.
-
-    Parameters
-    ----------
-    params : Params
-        Model, with the gait's ``beta0`` and ``v0``.
-    state : TouchdownState
-        Candidate touch-down state.
-    options : IntegratorOptions, optional
-        Integrator settings.
-
-    Returns
-    -------
-    residual : ndarray, shape (5,)
-        Next touch-down's ``(beta, phi, phid, delta, v)`` minus
-        ``(beta0, phi, phid, delta, v0)`` [rad, rad, rad g^1/2 L^-1/2, rad,
-        g^1/2 L^1/2]; after a fall a constant penalty vector (10 each).
-    stance_time, flight_time : float
-        Phase durations [g^-1/2 L^1/2] (NaN after a fall in that phase).
-    """
-    q = state.section()
-    res = step_map(params, q, h=0.0, options=options)
-    out = np.full(pk.NOUT, math.nan)
-    out[pk.OUT_TD : pk.OUT_TD + 5] = res.q
-    out[pk.OUT_TS], out[pk.OUT_TF] = res.stance_time, res.flight_time
-    return _section_residual(q, int(res.status), out, params)
-
-
-def _section_residual(q: np.ndarray, status: int, out: np.ndarray,
-                      params: Params) -> tuple[np.ndarray, float, float]:
-    """:func:`gait_residual` of the stride from section ``q`` that filled ``out``."""
-    ts, tf = float(out[pk.OUT_TS]), float(out[pk.OUT_TF])
-    if status != Status.OK:
-        return np.full(5, _FALL_PENALTY), ts, tf
-    b, ph, xd, yd, phd = out[pk.OUT_TD : pk.OUT_TD + 5].tolist()
-    r = np.array([
-        b - params.beta0,
-        ph - q[1],
-        phd - q[4],
-        math.atan2(yd, xd) - math.atan2(q[3], q[2]),
-        math.hypot(xd, yd) - params.v0,
-    ])
-    return r, ts, tf
-
-
-@dataclass(frozen=True, slots=True)
-class GaitProblem:
-    """The periodic-gait search of Section 2.8 as pure functions of ``z``.
-
-    ``z = (delta, phi, phid, alpha_r[, alphad_ref | tau_c])``: touch-down
-    velocity angle [rad], pitch [rad], pitch rate [rad g^1/2 L^-1/2], leg
-    reset angle [rad], and the controller reference hip rate
-    [rad g^1/2 L^-1/2] or constant torque [MgL].
-
-    Parameters
-    ----------
-    params : Params
-        Model with the gait's fixed ``v0`` and ``beta0``. ``alpha_r`` and the
-        controller reference are overwritten by ``z``; a constant-torque
-        controller without leg or hip damping gets ``tau_c = 0`` (energy
-        balance, Section 2.4).
-    options : IntegratorOptions
-        Integrator settings for every stride.
-
-    Examples
-    --------
-    >>> import tslip
-    >>> prob = GaitProblem.from_params(tslip.preset("table2.1"))
-    >>> prob.names
-    ('delta', 'phi', 'phid', 'alpha_r')
-    >>> g = find_gait(prob.params)
-    >>> bool(prob.c1(prob.encode(g)) < 1e-20)
-    True
-    """
-
-    params: Params
-    options: IntegratorOptions
-    names: tuple[str, ...] = ()
-    # packed once (validation happened when params and options were built):
-    # P with z's alpha_r and controller reference written in per evaluation
-    _P: np.ndarray = field(init=False, repr=False, compare=False)
-    _O: np.ndarray = field(init=False, repr=False, compare=False)
-    _ref_gain: float = field(init=False, repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        if not self.names:
-            object.__setattr__(self, "names", _unknown_names(self.params))
-        base = ("delta", "phi", "phid", "alpha_r")
-        if self.names[:4] != base or not (
-                len(self.names) == 4 or self.names[4:] in (("alphad_ref",), ("tau_c",))):
-            raise ValueError(f"names must be {base} and at most one of 'alphad_ref', 'tau_c', "
-                             f"got {self.names}")
-        # as pack_params(decode(z)[0]) but for alpha_r and the reference, which
-        # _stride writes in: tau = P[P_C0] + ..., P_C0 = Kd * alphad_ref (eq. 2.14)
-        # or tau_c (eq. 2.15; 0 without damping, as in decode)
-        P = pk.pack_params(self.params)
-        ctrl = self.params.controller
-        if isinstance(ctrl, ConstantTorque) and "tau_c" not in self.names:
-            P[pk.P_C0] = 0.0
-        object.__setattr__(self, "_P", P)
-        object.__setattr__(self, "_O", self.options.packed())
-        gain = getattr(ctrl, "Kd", 1.0) if "alphad_ref" in self.names else 1.0
-        object.__setattr__(self, "_ref_gain", float(gain))
-
-    @classmethod
-    def from_params(cls, params: Params, options: IntegratorOptions | None = None) -> GaitProblem:
-        """Problem for ``params``.
-
-        Default options: tolerance 1e-12 with DOP853, which needs about a
-        third of dopri5's right-hand sides there (``IntegratorOptions.tight``).
-        """
-        return cls(params=params, options=options or TIGHT)
+    @property
+    def energy(self) -> float:
+        """Total mechanical energy [MgL] (:func:`tslip.gait.section.total_energy`)."""
+        return total_energy(self.params, self.state)
 
     @property
-    def size(self) -> int:
-        """Number of free variables."""
-        return len(self.names)
+    def apex(self) -> ApexState:
+        """The apex of the flight that ends in this touch-down (the parabola's vertex).
 
-    # -- z <-> (params, state) ------------------------------------------------
-    def decode(self, z: Sequence[float] | np.ndarray) -> tuple[Params, TouchdownState]:
-        """Parameters and touch-down state for the free variables ``z``."""
-        if len(z) != self.size:
-            raise ValueError(f"guess must have {self.size} entries {list(self.names)}, "
-                             f"got {len(z)}")
-        values = dict(zip(self.names, map(float, z)))
-        ctrl = self.params.controller
-        if "alphad_ref" in values and isinstance(ctrl, LocalVelocity):  # (the name implies it)
-            ctrl = dataclasses.replace(ctrl, alphad_ref=values["alphad_ref"])
-        if "tau_c" in values and isinstance(ctrl, ConstantTorque):
-            ctrl = dataclasses.replace(ctrl, tau_c=values["tau_c"])
-        elif isinstance(ctrl, ConstantTorque) and ctrl.tau_c != 0.0:
-            ctrl = dataclasses.replace(ctrl, tau_c=0.0)  # no damping: no torque
-        p = dataclasses.replace(self.params, alpha_r=values["alpha_r"], controller=ctrl)
-        s = TouchdownState.from_velocity(
-            v=p.v0, delta=values["delta"], beta=p.beta0, phi=values["phi"], phid=values["phid"]
-        )
-        return p, s
-
-    def encode(self, gait: Gait) -> np.ndarray:
-        """Free variables of a gait (a warm start for nearby parameters)."""
-        s, p = gait.state, gait.params
-        out = {"delta": s.delta, "phi": s.phi, "phid": s.phid, "alpha_r": p.alpha_r,
-               "alphad_ref": getattr(p.controller, "alphad_ref", math.nan),
-               "tau_c": getattr(p.controller, "tau_c", math.nan)}
-        z = np.array([out[n] for n in self.names], dtype=float)
-        if not np.all(np.isfinite(z)):
-            raise ValueError(f"the gait's controller has no {list(self.names)[-1]!r}")
-        return z
-
-    # -- costs ----------------------------------------------------------------
-    def _stride(self, z: Sequence[float] | np.ndarray, jacobian: bool = False,
-                ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray | None]:
-        """``P``, section ``q`` and one stride at ``z`` on the packed arrays.
-
-        Writes ``alpha_r`` and the controller reference of ``z`` into ``P``
-        exactly as :meth:`decode` followed by ``pack_params`` would.
+        For a gait whose lift-off moves down this vertex lies before the lift-off,
+        outside the flight (the apex map reports ``Status.NO_APEX`` there).
         """
-        if len(z) != self.size:
-            raise ValueError(f"guess must have {self.size} entries {list(self.names)}, "
-                             f"got {len(z)}")
-        zf = [float(v) for v in z]
-        if not all(map(math.isfinite, zf)):
-            raise ValueError(f"z must be finite, got {zf}")
-        P = self._P.copy()
-        P[pk.P_ALPHA] = zf[3]
-        if self.size == 5:
-            P[pk.P_C0] = self._ref_gain * zf[4]
-        p = self.params
-        delta = zf[0]
-        q = np.array([p.beta0, zf[1], p.v0 * math.cos(delta), p.v0 * math.sin(delta), zf[2]])
-        out = np.empty(pk.NOUT)
-        if jacobian:
-            J = np.empty((5, 5))
-            return P, q, _packed.stride_jacobian(P, self._O, q, 0.0, J, out), out, J
-        return P, q, _packed.stride_map(P, self._O, q, 0.0, out), out, None
+        return touchdown_to_apex(self.params, self.state)
 
-    def evaluate(self, z: Sequence[float] | np.ndarray) -> tuple[np.ndarray, float, float]:
-        """Residual, stance and flight time at ``z`` (see :func:`gait_residual`)."""
-        _, q, st, out, _ = self._stride(z)
-        return _section_residual(q, st, out, self.params)
-
-    def residual_jacobian(self, z: Sequence[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Residual (5,) and its Jacobian ``dr/dz`` (5 x size) at ``z``.
-
-        The chain ``z -> q -> q' -> r``: ``dq'/dq`` exact from the variational
-        equations (:func:`tslip.step_jacobian`), ``dq'/d alpha_r`` exact from
-        the flight's touch-down time, ``dq'/d(alphad_ref | tau_c)`` by a
-        central difference (the reference acts in stance, outside the
-        variational equations). After a fall the Jacobian is NaN.
-        """
-        P, q, st, out, Jq = self._stride(z, jacobian=True)
-        r, _, _ = _section_residual(q, st, out, self.params)
-        n = self.size
-        if st != Status.OK or Jq is None or not np.all(np.isfinite(Jq)):
-            return r, np.full((5, n), math.nan)
-        delta = float(z[0])
-        v0 = self.params.v0
-        dq = np.zeros((5, n))  # dq/dz, q = (beta0, phi, v0 cos delta, v0 sin delta, phid)
-        dq[2, 0], dq[3, 0] = -v0 * math.sin(delta), v0 * math.cos(delta)
-        dq[1, 1] = 1.0
-        dq[4, 2] = 1.0
-        dqn = Jq @ dq  # dq'/dz through the state
-        dqn[:, 3] += _packed.alpha_r_column(P, out)
-        if n == 5:
-            ref = float(z[4])
-            h = 1e-5 * max(1.0, abs(ref))
-            cols = []
-            for sgn in (1.0, -1.0):
-                zz = np.array(z, dtype=float)
-                zz[4] = ref + sgn * h
-                _, _, s2, o2, _ = self._stride(zz)
-                if s2 != Status.OK:
-                    return r, np.full((5, n), math.nan)
-                cols.append(o2[pk.OUT_TD : pk.OUT_TD + 5].copy())
-            dqn[:, 4] += (cols[0] - cols[1]) / (2.0 * h)
-        # r = (beta', phi' - phi, phid' - phid, atan2(yd', xd') - delta, |v'| - v0)
-        _, _, xd, yd, _ = out[pk.OUT_TD : pk.OUT_TD + 5]
-        v2 = xd * xd + yd * yd
-        v = math.sqrt(v2)
-        D = np.zeros((5, 5))  # dr/dq'
-        D[0, 0] = D[1, 1] = D[2, 4] = 1.0
-        D[3, 2], D[3, 3] = -yd / v2, xd / v2
-        D[4, 2], D[4, 3] = xd / v, yd / v
-        Jr = D @ dqn
-        Jr[1, 1] -= 1.0
-        Jr[2, 2] -= 1.0
-        Jr[3, 0] -= 1.0
-        return r, Jr
-
-    def residual(self, z: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Periodicity residual (5,) at ``z``; the Newton search's function."""
-        return self.evaluate(z)[0]
-
-    def c1(self, z: Sequence[float] | np.ndarray) -> float:
-        """Eq. 2.20: squared periodicity residual ``|r(z)|^2`` [-]."""
-        r = self.residual(z)
-        return float(r @ r)
-
-    def c2(self, z: Sequence[float] | np.ndarray,
-           jacobian: Literal["fd", "exact"] = "fd") -> float:
-        """Eq. 2.21: largest squared non-trivial multiplier magnitude at ``z``.
-
-        The structural multipliers (the energy's; the decoupled pitch's at
-        ``r = 0``) are removed by :func:`~tslip.gait.stability.nontrivial_jacobian`.
-        NaN when a perturbed stride falls.
-        """
-        from .stability import map_jacobian, nontrivial_jacobian
-
-        p, s = self.decode(z)
-        q = s.section()
-        try:
-            A = map_jacobian(p, q, method=jacobian, options=self.options)
-        except ValueError:
-            return math.nan
-        if not np.all(np.isfinite(A)):
-            return math.nan
-        lam = np.linalg.eigvals(nontrivial_jacobian(p, q, A))
-        return float(np.max(np.abs(lam)) ** 2) if lam.size else 0.0
-
-    def cost(self, z: Sequence[float] | np.ndarray, *, eps: float = C1_THRESHOLD,
-             offset: float = C1_OFFSET, jacobian: Literal["fd", "exact"] = "fd") -> float:
-        """Eq. 2.22: ``C1 + offset`` if ``C1 > eps``, else ``C2``.
-
-        Where ``C2`` cannot be evaluated (a perturbed stride falls) the
-        candidate counts as not periodic, ``C1 + offset``.
-        """
-        c1 = self.c1(z)
-        if c1 > eps:
-            return c1 + offset
-        c2 = self.c2(z, jacobian)
-        return c2 if math.isfinite(c2) else c1 + offset
-
-    # -- bounds and starting guesses -------------------------------------------
-    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Lower and upper bounds of ``z`` (eqs 2.23-2.24).
-
-        ``delta`` in [-pi/2, 0] (landing while moving down), ``phi`` in
-        [-pi/2, pi/2], ``phid`` in [-10, 10] rad g^1/2 L^-1/2, ``alpha_r`` in
-        [-2 pi, 2 pi] (long flights retract the leg by more than pi),
-        ``alphad_ref`` in [0, 5 v0/l0 + 10] rad g^1/2 L^-1/2 (positive in
-        stance, docs/conventions.md; the nominal hip rate is about ``v0/l0``),
-        ``|tau_c| <= 10 + 2 (c_l + c_h) v0 / l0`` MgL (the torque balances the
-        dampers, about ``c_h v0 / l0`` at the hip). They span every gait found
-        over the thesis's parameter ranges (Sections 3.4-3.7) and keep CMA-ES
-        away from strides that cannot be integrated.
-        """
-        p = self.params
-        tau_max = 10.0 + 2.0 * (p.c_l + getattr(p.controller, "c_h", 0.0)) * p.v0 / p.l0
-        lo = {"delta": -math.pi / 2, "phi": -math.pi / 2, "phid": -10.0, "alpha_r": -_TWO_PI,
-              "alphad_ref": 0.0, "tau_c": -tau_max}
-        hi = {"delta": 0.0, "phi": math.pi / 2, "phid": 10.0, "alpha_r": _TWO_PI,
-              "alphad_ref": 5.0 * p.v0 / p.l0 + 10.0, "tau_c": tau_max}
-        return (np.array([lo[n] for n in self.names]), np.array([hi[n] for n in self.names]))
-
-    def scales(self) -> np.ndarray:
-        """Initial CMA-ES standard deviation of each free variable.
-
-        0.2 rad for ``delta`` and ``phi``, 0.5 for ``phid`` and ``alpha_r``,
-        ``0.5 max(1, v0/l0)`` for ``alphad_ref`` and ``0.2 (1 + (c_l + c_h)
-        v0/l0)`` for ``tau_c``: wide enough to leave the basin of a poor
-        starting guess (smaller steps often stalled at ``C1 ~ 1e-2``).
-        """
-        p = self.params
-        damping = (p.c_l + getattr(p.controller, "c_h", 0.0)) * p.v0 / p.l0
-        s = {"delta": 0.2, "phi": 0.2, "phid": 0.5, "alpha_r": 0.5,
-             "alphad_ref": 0.5 * max(1.0, p.v0 / p.l0), "tau_c": 0.2 * (1.0 + damping)}
-        return np.array([s[n] for n in self.names])
-
-    def guesses(self) -> Iterator[np.ndarray]:
-        """Automatic starting points, most likely first (lazily).
-
-        The first five are the original list (``delta`` from -0.05 to -0.4,
-        level trunk, ``alpha_r`` from the symmetric flight time of eq. 3.11
-        and the retraction of eq. 2.17). Then a scan: ``delta`` on a grid
-        from -0.005 to -1.2 with ``alpha_r`` offsets of +-0.15 rad and
-        controller references from an energy balance (x0.5, x1, x2), ranked
-        by ``C1`` after one stride each; candidates that fall are dropped.
-        """
-        first = (-0.05, -0.12, -0.25, -0.4, -0.02)
-        for d in first:
-            yield self._guess(d)
-        scored: list[tuple[float, int, np.ndarray]] = []
-        for d in (-0.005, -0.01, -0.02, -0.035, -0.05, -0.075, -0.1, -0.15, -0.2, -0.3, -0.4,
-                  -0.5, -0.65, -0.8, -1.0, -1.2):
-            for da in (0.0, -0.15, 0.15):
-                for f in ((1.0, 0.5, 2.0) if self.size == 5 else (1.0,)):
-                    if d in first and da == 0.0 and f == 1.0:
-                        continue  # already tried
-                    z = self._guess(d, f)
-                    z[3] += da
-                    c1 = self.c1(z)
-                    if math.isfinite(c1) and c1 < 5 * _FALL_PENALTY**2:
-                        scored.append((c1, len(scored), z))
-        scored.sort(key=lambda t: (t[0], t[1]))
-        for _, _, z in scored:
-            yield z
-
-    def _guess(self, delta: float, factor: float = 1.0) -> np.ndarray:
-        p = self.params
-        tf = 2.0 * p.v0 * math.sin(-delta) / p.g  # eq. 3.11, symmetric stance
-        z = [delta, 0.0, 0.0, p.beta0 - p.omega_r * tf]  # eq. 2.17 with phi = 0
-        ts = 2.0 * p.l0 * (math.pi / 2 - p.beta0) / p.v0  # eq. 3.10
-        if "alphad_ref" in self.names:
-            z.append(factor * (math.pi - 2 * p.beta0) / ts)
-        if "tau_c" in self.names:
-            # energy balance: tau_c * (pi - 2 beta0) = dissipated energy, with
-            # ldot(t) = ldot0 cos(pi t / ts) in the leg and alpha_dot = const
-            # at the hip
-            dalpha = max(math.pi - 2 * p.beta0, 0.1)
-            ldot0 = p.v0 * math.cos(p.beta0 + delta)
-            c_h = p.controller.c_h if isinstance(p.controller, ConstantTorque) else 0.0
-            loss = p.c_l * ldot0**2 * ts / 2 + c_h * dalpha**2 / ts
-            z.append(0.1 if loss == 0 else factor * loss / dalpha)
-        return np.array(z)
+    @property
+    def held(self) -> float:
+        """The value the search held: touch-down speed, apex forward speed, or energy."""
+        if self.fix == "energy":
+            return self.energy
+        return self.state.v if self.section == "touchdown" else self.state.xd
 
 
 # ---------------------------------------------------------------------------
@@ -688,96 +304,6 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
     return None, math.inf  # not reached
 
 
-def _cma_seed(seed: int) -> int:
-    """A non-zero 32-bit seed for ``cma`` (which reads 0 as "use the clock")."""
-    s = int(np.random.SeedSequence(seed).generate_state(1)[0])
-    return s or 1
-
-
-def cma_minimize(
-    cost: Callable[[np.ndarray], float],
-    x0: np.ndarray,
-    *,
-    sigma0: float = 1.0,
-    stds: np.ndarray | None = None,
-    lower: np.ndarray | None = None,
-    upper: np.ndarray | None = None,
-    seed: int = 1,
-    max_evals: int = 3000,
-    popsize: int | None = None,
-) -> tuple[np.ndarray, float, int, int, str]:
-    """Minimise ``cost`` with CMA-ES (``cma`` package, ask/tell), quietly.
-
-    Parameters
-    ----------
-    cost : callable
-        Pure function ``z -> float``.
-    x0 : ndarray, shape (n,)
-        Initial mean.
-    sigma0 : float
-        Initial step size, multiplied per coordinate by ``stds``.
-    stds : ndarray, shape (n,), optional
-        Per-coordinate scaling of ``sigma0``.
-    lower, upper : ndarray, shape (n,), optional
-        Box bounds (eqs 2.23-2.24), handled by ``cma``'s bound transform.
-    seed : int
-        Any non-negative integer; equal seeds give identical runs. The
-        global NumPy random state is restored afterwards.
-    max_evals : int
-        Budget of cost evaluations.
-    popsize : int, optional
-        Population size (default ``4 + 3 ln n``).
-
-    Returns
-    -------
-    x : ndarray
-        Best point evaluated.
-    f : float
-        Its cost.
-    evaluations, iterations : int
-    stop : str
-        Termination criteria that fired.
-
-    References
-    ----------
-    N. Hansen, "The CMA Evolution Strategy: A Tutorial", arXiv:1604.00772.
-    """
-    import cma
-
-    x0 = np.asarray(x0, dtype=float)
-    opts: dict[str, Any] = {
-        "seed": _cma_seed(seed), "verbose": -9, "verb_disp": 0, "verb_log": 0,
-        "maxfevals": int(max_evals), "tolfun": 1e-13, "tolfunhist": 1e-14, "tolx": 1e-14,
-        "tolflatfitness": 20,
-    }
-    if stds is not None:
-        opts["CMA_stds"] = list(map(float, stds))
-    if lower is not None or upper is not None:
-        lo = None if lower is None else list(map(float, lower))
-        hi = None if upper is None else list(map(float, upper))
-        opts["bounds"] = [lo, hi]
-    if popsize is not None:
-        opts["popsize"] = int(popsize)
-    # cma seeds and draws from NumPy's legacy global generator: put it back after
-    state = np.random.get_state()  # noqa: NPY002
-    try:
-        with warnings.catch_warnings():
-            warnings.filterwarnings("ignore", module=r"cma(\.|$)")
-            es = cma.CMAEvolutionStrategy(x0, sigma0, opts)
-            best_x, best_f = x0.copy(), math.inf
-            while not es.stop():
-                X = es.ask()
-                F = [float(cost(np.asarray(x))) for x in X]
-                es.tell(X, F)
-                i = int(np.argmin(F))
-                if F[i] < best_f:
-                    best_x, best_f = np.array(X[i], dtype=float), F[i]
-            stop = ", ".join(f"{k}={v}" for k, v in es.stop().items())
-            return best_x, best_f, int(es.countevals), int(es.countiter), stop
-    finally:
-        np.random.set_state(state)  # noqa: NPY002
-
-
 # ---------------------------------------------------------------------------
 # the entry point
 # ---------------------------------------------------------------------------
@@ -790,12 +316,15 @@ def _wrap(prob: GaitProblem, z: np.ndarray) -> np.ndarray:
     so the gait is unchanged; this matters at ``r = 0``, where the pitch is
     undetermined and the solver may wander.
     """
-    turns = math.floor((z[1] + math.pi) / _TWO_PI)
+    if "phi" not in prob.names:  # held at 0
+        return z
+    i, j = prob.names.index("phi"), prob.names.index("alpha_r")
+    turns = math.floor((z[i] + math.pi) / _TWO_PI)
     if turns == 0 or prob.params.leg_reset != "local":
         return z
     z = z.copy()
-    z[1] -= turns * _TWO_PI
-    z[3] -= turns * _TWO_PI
+    z[i] -= turns * _TWO_PI
+    z[j] -= turns * _TWO_PI
     return z
 
 
@@ -805,7 +334,8 @@ def _make_gait(prob: GaitProblem, z: np.ndarray, tol: float, message: str,
     r, ts, tf = prob.evaluate(z)
     err = float(np.max(np.abs(r)))
     return Gait(state=s, params=p, residual=err, stance_time=ts, flight_time=tf,
-                converged=bool(err <= tol), message=message, method=method, cma=cma)
+                converged=bool(err <= tol), message=message, method=method, cma=cma,
+                fix=prob.fix, section=prob.section)
 
 
 def _failure_reason(prob: GaitProblem, err: float, n_starts: int) -> str:
@@ -826,6 +356,8 @@ def _newton_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float,
     z, err, n = newton_solve(prob.residual, itertools.chain([first], starts), tol=tol,
                              max_starts=max_starts,
                              jacobian=prob.residual_jacobian if exact else None)
+    if z is not None and not prob.exists(z):  # least squares left the energy's states
+        z = None
     if z is None:  # every start failed inside the solver
         g = _make_gait(prob, first, tol, "")
         return dataclasses.replace(
@@ -891,8 +423,11 @@ def find_gait(
     max_evals: int = 3000,
     polish: bool = True,
     jacobian: Literal["fd", "exact"] = "fd",
+    fix: Fix = "speed",
+    energy: float | None = None,
+    section: Section = "touchdown",
 ) -> Gait:
-    """Find a periodic gait at the nominal speed ``v0`` and angle ``beta0``.
+    """Find a periodic gait at the nominal speed ``v0`` (or energy) and angle ``beta0``.
 
     Parameters
     ----------
@@ -900,6 +435,17 @@ def find_gait(
         Model; ``params.v0`` and ``params.beta0`` are used unless overridden.
     v0, beta0 : float, optional
         Override the nominal speed [g^1/2 L^1/2] and touch-down angle [rad].
+    fix : {"speed", "energy"}
+        Hold the speed ``v0`` at the section (default), or the total energy
+        ``energy`` (:func:`tslip.gait.section.total_energy`), which the SLIP
+        literature fixes; the returned ``gait.params.v0`` is the touch-down
+        speed found.
+    energy : float, optional
+        Total energy [MgL] with ``fix="energy"``; default :func:`nominal_energy`
+        (touch-down at ``v0`` and ``beta0`` with a level trunk).
+    section : {"touchdown", "apex"}
+        With ``fix="speed"``, ``v0`` is the touch-down speed or the apex's
+        forward speed. Also the default section of the gait's Floquet multipliers.
     guess : ndarray, optional
         Starting unknowns ``(delta, phi, phid, alpha_r[, alphad_ref | tau_c])``;
         by default the automatic guesses of :meth:`GaitProblem.guesses`.
@@ -960,7 +506,7 @@ def find_gait(
             params, v0=params.v0 if v0 is None else v0,
             beta0=params.beta0 if beta0 is None else beta0,
         )
-    prob = GaitProblem.from_params(params, options)
+    prob = GaitProblem.from_params(params, options, fix=fix, section=section, energy=energy)
     if guess is not None:
         z0 = np.asarray(guess, dtype=float)
         if z0.shape != (prob.size,):

@@ -65,8 +65,12 @@ once (:func:`tslip.simulation._packed.run`), and stops at the first that
 fails: the limit is the same as with every point run, with fewer runs (the
 flight placements still run each batch as one :func:`tslip.run_batch`).
 
-Runs that end in an integration error (:class:`Status` >= 10) are not falls;
+Runs that end in an integration error (:attr:`Status.is_error`) are not falls;
 they count as failures of the disturbance, and the result records the reason.
+
+The biped (:mod:`tslip.biped.robustness`) searches its limits with the same
+:func:`search_limit` and reports them in the same :class:`RobustnessLimit`
+and :class:`RobustnessLimits`.
 """
 
 from __future__ import annotations
@@ -100,9 +104,11 @@ __all__ = [
     "PLACEMENTS",
     "LimitSearch",
     "RobustnessLimit",
+    "RobustnessLimits",
     "RobustnessResult",
     "check_gait",
     "limit_search",
+    "search_limit",
     "robustness",
     "robustness_report",
     "run_disturbed",
@@ -490,32 +496,23 @@ _LIMIT_UNITS = {**dict.fromkeys(("kind", "sign", "unit", "fall_stride", "status"
 
 
 @dataclass(frozen=True, slots=True, repr=False)
-class RobustnessResult(Result):
-    """Robustness limits of a periodic gait (thesis Section 3.1.3).
+class RobustnessLimits(Result):
+    """The limits of a robustness search, for either model (thesis Section 3.1.3).
+
+    The base of the TSLIP's :class:`RobustnessResult` and the biped's
+    :class:`tslip.biped.robustness.RobustnessResult`, which add what the
+    search started from (their parameters, start and options differ in type).
 
     Attributes
     ----------
     limits : tuple of RobustnessLimit
         One per searched kind and sign.
-    params : Params
-    state : TouchdownState
-        The gait's touch-down state the disturbances start from.
-    n_steps : int
-        Strides a disturbed run must survive.
-    tol : float
-        Bracket width of the search.
-    options : IntegratorOptions
     """
 
     limits: tuple[RobustnessLimit, ...]
-    params: Params
-    state: TouchdownState
-    n_steps: int
-    tol: float
-    options: IntegratorOptions
 
     def _repr_fields(self) -> dict[str, Any]:
-        out: dict[str, Any] = {"n_steps": self.n_steps}
+        out: dict[str, Any] = {"n_steps": getattr(self, "n_steps", None)}
         for lim in self.limits:
             out[lim.kind if lim.sign < 0 else f"{lim.kind}_up"] = lim.limit
         return out
@@ -557,6 +554,31 @@ class RobustnessResult(Result):
     def n_batches(self) -> int:
         """Batched evaluations over all searches."""
         return sum(lim.n_batches for lim in self.limits)
+
+
+@dataclass(frozen=True, slots=True, repr=False)
+class RobustnessResult(RobustnessLimits):
+    """Robustness limits of a periodic TSLIP gait (thesis Section 3.1.3).
+
+    Attributes
+    ----------
+    limits : tuple of RobustnessLimit
+        One per searched kind and sign.
+    params : Params
+    state : TouchdownState
+        The gait's touch-down state the disturbances start from.
+    n_steps : int
+        Strides a disturbed run must survive.
+    tol : float
+        Bracket width of the search.
+    options : IntegratorOptions
+    """
+
+    params: Params
+    state: TouchdownState
+    n_steps: int
+    tol: float
+    options: IntegratorOptions
 
 
 def robustness(
@@ -686,25 +708,60 @@ def robustness_report(
 def _limit(gait: Gait, kind: Kind, sign: int, *, n_steps: int, tol: float,
            options: IntegratorOptions | None, start: float, ladder: int, k: int,
            max_magnitude: float, placement: Placement = "touchdown") -> RobustnessLimit:
+    _check_sign_and_steps(sign, n_steps)
+    if placement in ("touchdown", "touchdown_hip"):
+        run_one = _touchdown_runner(gait, kind, placement, int(n_steps), options)
+        return search_limit(kind, sign, run_one, n_steps=int(n_steps), tol=tol, start=start,
+                            ladder=ladder, k=k, max_magnitude=max_magnitude)
+
+    def run_many(d: np.ndarray) -> tuple[list[int], list[int]]:  # flight placements: one batch
+        run = run_disturbed(gait.params, gait.state, kind, d, n_steps=int(n_steps),
+                            options=options, placement=placement)
+        return run.status.tolist(), run.n_done.tolist()
+
+    return search_limit(kind, sign, run_many=run_many, n_steps=int(n_steps), tol=tol,
+                        start=start, ladder=ladder, k=k, max_magnitude=max_magnitude)
+
+
+def _check_sign_and_steps(sign: int, n_steps: int) -> None:
     if sign not in (-1, 1):
         raise ValueError(f"sign must be -1 or +1, got {sign!r}")
     if not isinstance(n_steps, (int, np.integer)) or n_steps < 1:
         raise ValueError(f"n_steps must be an integer >= 1, got {n_steps!r}")
+
+
+def search_limit(kind: str, sign: int,
+                 run_one: Callable[[float], tuple[int, int]] | None = None, *,
+                 run_many: Callable[[np.ndarray], tuple[list[int], list[int]]] | None = None,
+                 n_steps: int, tol: float, start: float = 0.01, ladder: int = 8, k: int = 3,
+                 max_magnitude: float = 100.0) -> RobustnessLimit:
+    """The robustness limit of one disturbance and direction, for either model.
+
+    ``run_one(d) -> (status, strides done)`` runs one disturbed run of signed
+    size ``d``; a run survives if it ends :attr:`Status.OK` after ``n_steps``
+    strides. :func:`limit_search` asks ascending magnitudes and uses only a
+    batch's first failure, so the batch runs in order and stops there (the
+    rest count as failures, unrun). ``run_many(d_array) -> (statuses,
+    strides done)`` instead runs a whole batch at once.
+
+    Returns
+    -------
+    RobustnessLimit
+        With the status and stride of the failing run that bounds the limit.
+    """
+    _check_sign_and_steps(sign, n_steps)
+    if (run_one is None) == (run_many is None):
+        raise ValueError("give exactly one of run_one and run_many")
     outcome: dict[float, tuple[int, int]] = {}  # magnitude -> (status, n_done)
     n_errors = 0
     n_runs = 0
-    serial = placement in ("touchdown", "touchdown_hip")
-    run_one = _touchdown_runner(gait, kind, placement, int(n_steps), options) if serial else None
 
     def survives(m: np.ndarray) -> np.ndarray:
         nonlocal n_errors, n_runs
-        if run_one is None:  # flight placements: one batch
-            run = run_disturbed(gait.params, gait.state, kind, sign * m, n_steps=int(n_steps),
-                                options=options, placement=placement)
-            sts, nds = run.status.tolist(), run.n_done.tolist()
+        if run_many is not None:
+            sts, nds = run_many(sign * m)
         else:
-            # limit_search asks ascending magnitudes and uses only the first failure:
-            # run them in order and stop there (the rest count as failures, unrun)
+            assert run_one is not None
             sts, nds = [], []
             for mi in m.tolist():
                 st, nd = run_one(sign * mi)
@@ -716,7 +773,7 @@ def _limit(gait: Gait, kind: Kind, sign: int, *, n_steps: int, tol: float,
         for i, (st, nd) in enumerate(zip(sts, nds)):
             outcome[float(m[i])] = (st, nd)
             ok[i] = st == Status.OK and nd == n_steps
-        n_errors += sum(st >= 10 for st in sts)
+        n_errors += sum(Status(st).is_error for st in sts)
         n_runs += len(sts)
         return ok
 

@@ -19,6 +19,15 @@ stride as ``(phi + phid T, phid)``, a Jordan block with two multipliers exactly
 1. The stability is then evaluated on the section that excludes the decoupled
 pitch, ``(beta, xd, yd)``, and the two pitch multipliers are reported as
 trivial (docs/conventions.md, "Poincare section and periodic gaits").
+
+``section="apex"``: the multipliers of the apex return map on ``(y, xd, phi,
+phid)`` (:mod:`tslip.gait.section`), ``A_apex = dpi/dq A dsigma/da`` with the
+closed-form derivatives of the touch-down -> apex (``pi``) and apex ->
+touch-down (``sigma``) conversions, or by central differences of the apex
+map itself (``method="fd"``). They are the touch-down multipliers without the
+one that is exactly 0 when the touch-down angle follows from the rest of the
+state (a leg set at a fixed angle): return maps of one flow on two sections
+are conjugate.
 """
 
 from __future__ import annotations
@@ -36,19 +45,28 @@ from ..simulation import _packed
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status
 from .fixed_point import TIGHT, Gait
+from .section import (
+    apex_map_states,
+    apex_to_touchdown,
+    apex_to_touchdown_jacobian,
+    touchdown_to_apex,
+    touchdown_to_apex_jacobian,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["Floquet", "floquet", "map_jacobian", "conserved_gradients", "pitch_decoupled",
-           "nontrivial_jacobian", "classify_stability"]
+__all__ = ["Floquet", "floquet", "map_jacobian", "apex_jacobian", "conserved_gradients",
+           "pitch_decoupled", "nontrivial_jacobian", "classify_stability"]
 
 Stability = Literal["asymptotic", "neutral", "unstable"]
 TrivialKind = Literal["", "energy", "pitch"]
 #: Indices of the section without the pitch: (beta, xd, yd) of (beta, phi, xd, yd, phid).
 _NO_PITCH = [0, 2, 3]
+#: The same on the apex section (y, xd, phi, phid): (y, xd).
+_NO_PITCH_APEX = [0, 1]
 
 
 @dataclass(frozen=True, repr=False)
@@ -57,8 +75,9 @@ class Floquet(Result):
 
     Attributes
     ----------
-    multipliers : ndarray of complex, shape (5,)
-        Eigenvalues of the stride map's Jacobian, largest magnitude first.
+    multipliers : ndarray of complex, shape (5,) or (4,)
+        Eigenvalues of the stride map's Jacobian, largest magnitude first
+        (4 on the apex section).
     trivial : ndarray of bool, shape (5,)
         Structural multipliers at 1: the conserved energy, and the decoupled
         pitch (:func:`pitch_decoupled`).
@@ -68,7 +87,7 @@ class Floquet(Result):
         From the non-trivial multipliers only: a conservative gait labelled
         "asymptotic" is asymptotically stable on its energy level (a change
         of energy moves it to the neighbouring gait of its family).
-    jacobian : ndarray, shape (5, 5)
+    jacobian : ndarray, shape (5, 5) or (4, 4)
     method : str
     trivial_kinds : tuple of str, length 5
         Why each multiplier is trivial: ``"energy"``, ``"pitch"`` (two, with
@@ -82,6 +101,7 @@ class Floquet(Result):
     jacobian: np.ndarray = field(repr=False)
     method: str = "exact"
     trivial_kinds: tuple[TrivialKind, ...] = ()
+    section: str = "touchdown"
 
     def _repr_fields(self) -> dict[str, Any]:
         return {"stability": self.stability, "max_nontrivial": self.max_nontrivial,
@@ -111,6 +131,17 @@ class Floquet(Result):
     def stable(self) -> bool:
         """At least neutrally stable (the thesis's condition for robustness)."""
         return self.stability != "unstable"
+
+
+def classify_stability(max_nontrivial: float, unit_tol: float = 1e-6) -> Stability:
+    """The stability rule of both models' :class:`Floquet` (eq. 2.21's largest multiplier).
+
+    "unstable" above ``1 + unit_tol`` (and for NaN: a perturbed stride fell),
+    "neutral" within ``unit_tol`` of 1, "asymptotic" below.
+    """
+    if not max_nontrivial <= 1.0 + unit_tol:
+        return "unstable"
+    return "neutral" if max_nontrivial >= 1.0 - unit_tol else "asymptotic"
 
 
 def conserved_gradients(params: Params, q: np.ndarray) -> list[np.ndarray]:
@@ -209,6 +240,45 @@ def map_jacobian(
     return (nxt[:5] - nxt[5:]).T / (2.0 * step)
 
 
+def apex_jacobian(
+    gait: Gait,
+    *,
+    method: Literal["exact", "fd"] = "exact",
+    step: float = 1e-5,
+    options: IntegratorOptions | None = None,
+) -> np.ndarray:
+    """Jacobian of the apex return map (4 x 4) at the gait's apex (module docstring).
+
+    ``"exact"``: the touch-down map's exact Jacobian between the closed-form
+    conversion derivatives; ``"fd"``: central differences of
+    :func:`tslip.gait.section.apex_map_states`, one batch of 8 rows.
+
+    Raises
+    ------
+    ValueError
+        If the apex is no section for the gait's parameters (a retraction
+        clock from lift-off) or a stride fails.
+    """
+    p = gait.params
+    apex = touchdown_to_apex(p, gait.state)
+    if method == "exact":
+        td = apex_to_touchdown(p, apex)
+        A = map_jacobian(p, td.section(), method="exact", options=options)
+        return (touchdown_to_apex_jacobian(p, gait.state) @ A
+                @ apex_to_touchdown_jacobian(p, apex, td))
+    if method != "fd":
+        raise ValueError(f"method must be 'exact' or 'fd', got {method!r}")
+    if not (math.isfinite(step) and step > 0):
+        raise ValueError(f"step must be in (0, inf), got {step!r}")
+    a = apex.section()
+    E = np.eye(4) * step
+    b = apex_map_states(p, np.vstack([a + E, a - E]), options=options or TIGHT)
+    if not np.all(b.ok):
+        raise ValueError("a perturbed apex map fails; use a smaller step")
+    nxt = np.column_stack([b.y, b.xd, b.phi, b.phid])
+    return (nxt[:4] - nxt[4:]).T / (2.0 * step)
+
+
 def floquet(
     gait: Gait,
     *,
@@ -216,6 +286,7 @@ def floquet(
     step: float = 1e-5,
     options: IntegratorOptions | None = None,
     unit_tol: float = 1e-6,
+    section: Literal["touchdown", "apex"] | None = None,
 ) -> Floquet:
     """Floquet multipliers and stability of a periodic gait.
 
@@ -224,27 +295,42 @@ def floquet(
     gait : Gait
         From :func:`tslip.find_gait`.
     method : {"exact", "fd"}
-        Variational equations with saltation, or central differences (eq. B.2).
+        Variational equations with saltation, or central differences (eq. B.2;
+        on the apex section, of the apex map).
     step : float
         Finite-difference step (``method="fd"``); results are insensitive to
         it between about 1e-6 and 1e-4 at the default tolerance 1e-12.
     unit_tol : float
         Magnitudes within this of 1 count as neutral.
+    section : {"touchdown", "apex"}, optional
+        The return map's section; default the gait's (``gait.section``). On
+        the apex, 4 multipliers: the touch-down ones less the 0 of a leg set
+        at a fixed angle (module docstring).
 
     Returns
     -------
     Floquet
     """
+    section = gait.section if section is None else section
+    if section not in ("touchdown", "apex"):
+        raise ValueError(f"section must be 'touchdown' or 'apex', got {section!r}")
     q = gait.state.section()
-    A = map_jacobian(gait.params, q, method=method, step=step, options=options)
+    if section == "apex":
+        A = apex_jacobian(gait, method=method, step=step, options=options)
+        keep = _NO_PITCH_APEX
+    else:
+        A = map_jacobian(gait.params, q, method=method, step=step, options=options)
+        keep = _NO_PITCH
+    n = len(A)
     n_energy = len(conserved_gradients(gait.params, q)) > 0  # 0 or 1 energy multiplier
     if pitch_decoupled(gait.params):
         # the section without the decoupled pitch; its Jordan block [[1, T], [0, 1]]
-        lam = np.concatenate([np.linalg.eigvals(A[np.ix_(_NO_PITCH, _NO_PITCH)]), [1.0, 1.0]])
-        kinds: list[TrivialKind] = ["", "", "", "pitch", "pitch"]
+        lam = np.concatenate([np.linalg.eigvals(A[np.ix_(keep, keep)]), [1.0, 1.0]])
+        kinds: list[TrivialKind] = [""] * len(keep)
+        kinds += ["pitch", "pitch"]
     else:
         lam = np.linalg.eigvals(A)
-        kinds = [""] * 5
+        kinds = [""] * n
     # the energy multiplier: the one closest to 1 (the tolerance is loose: a
     # double root at 1 splits by sqrt(eps))
     cand = [i for i in np.argsort(np.abs(lam - 1.0)) if kinds[i] == ""]
@@ -257,17 +343,7 @@ def floquet(
     trivial = np.array([k != "" for k in kinds])
     others = np.abs(lam[~trivial])
     max_nt = float(others.max()) if others.size else 0.0
+    stability = classify_stability(max_nt, unit_tol)
     return Floquet(multipliers=lam, trivial=trivial, max_nontrivial=max_nt,
-                   stability=classify_stability(max_nt, unit_tol), jacobian=A, method=method,
-                   trivial_kinds=tuple(kinds))
-
-
-def classify_stability(max_nontrivial: float, unit_tol: float = 1e-6) -> Stability:
-    """The stability rule of both models' :class:`Floquet` (eq. 2.21's largest multiplier).
-
-    "unstable" above ``1 + unit_tol`` (and for NaN: a perturbed stride fell),
-    "neutral" within ``unit_tol`` of 1, "asymptotic" below.
-    """
-    if not max_nontrivial <= 1.0 + unit_tol:
-        return "unstable"
-    return "neutral" if max_nontrivial >= 1.0 - unit_tol else "asymptotic"
+                   stability=stability, jacobian=A, method=method,
+                   trivial_kinds=tuple(kinds), section=section)

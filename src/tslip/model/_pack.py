@@ -79,6 +79,8 @@ ST_ERR_MAX_STEPS = 11
 ST_ERR_STANCE_TIMEOUT = 12
 ST_ERR_FLIGHT_TIMEOUT = 13
 ST_ERR_NONFINITE = 14
+# 20+: outcomes that are neither a fall nor an error (the analyses set them, not the kernels)
+ST_NO_APEX = 20  # the flight after lift-off has no apex (apex map); 21 is the biped's T_END
 
 
 def pack_params(p: Params) -> np.ndarray:

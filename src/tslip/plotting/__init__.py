@@ -14,9 +14,11 @@ from .gait import (
 )
 from .sweeps import plot_branch
 from .trajectories import flight_intervals, ground_profile, plot_touchdowns, plot_trajectory
+from .viability import plot_basin, plot_viability
 
 __all__ = [
     "animate",
+    "plot_basin",
     "plot_branch",
     "flight_intervals",
     "frame_times",
@@ -28,5 +30,6 @@ __all__ = [
     "plot_touchdowns",
     "plot_trajectory",
     "plot_velocity_angle_effect",
+    "plot_viability",
     "render_frames",
 ]

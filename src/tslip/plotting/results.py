@@ -17,7 +17,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
     from ..gait.fixed_point import Gait
-    from ..gait.robustness import RobustnessResult
+    from ..gait.robustness import RobustnessLimits
     from ..gait.stability import Floquet
     from ..simulation.integrate import BatchRun
     from ..simulation.result import StepResult
@@ -69,7 +69,7 @@ def plot_floquet(fl: Floquet, ax: Axes | None = None) -> Figure:
     return fig
 
 
-def plot_robustness(res: RobustnessResult, ax: Axes | None = None) -> Figure:
+def plot_robustness(res: RobustnessLimits, ax: Axes | None = None) -> Figure:
     """One bar per searched disturbance and direction: its limit, in its unit."""
     fig, ax = _axes(ax)
     labels = [f"{lim.kind} {'+' if lim.sign > 0 else '-'}\n[{lim.unit}]" for lim in res.limits]
@@ -82,7 +82,8 @@ def plot_robustness(res: RobustnessResult, ax: Axes | None = None) -> Figure:
     ax.set_xticks(range(len(vals)), labels, fontsize="small")
     ax.axhline(0.0, color="k", lw=0.5)
     ax.set_ylabel("largest survived disturbance")
-    ax.set_title(f"robustness over {res.n_steps} strides", fontsize="medium")
+    n = getattr(res, "n_steps", None)
+    ax.set_title("robustness" + (f" over {n} strides" if n else ""), fontsize="medium")
     return fig
 
 

@@ -21,9 +21,11 @@ from matplotlib.patches import Patch
 from .sweeps import _STABLE_GREEN, _runs, param_label
 
 if TYPE_CHECKING:
+    from ..gait.allgaits import StableRegion
     from ..sweeps.run import StudyResult
 
 __all__ = ["plot_study_multipliers", "plot_study_robustness", "plot_stable_grid",
+           "plot_stable_region",
            "plot_stride_times", "plot_controllers_multipliers", "plot_controllers_robustness"]
 
 _ROB = (("step_down", "max step-down Δh [L]"), ("push", "max push Δẋ [g^1/2 L^1/2]"),
@@ -136,6 +138,25 @@ def plot_stable_grid(results: Mapping[float, StudyResult]) -> Figure:
     fig.legend(handles=[Patch(facecolor=c, edgecolor="0.4", lw=0.5, label=t)
                         for c, t in GRID_CLASSES],
                loc="outside lower center", ncols=len(GRID_CLASSES), fontsize=8)
+    return fig
+
+
+def plot_stable_region(region: StableRegion, ax: Axes | None = None) -> Figure:
+    """A :func:`tslip.gait.stable_region` grid in the classes of Figure 4.10, with the
+    most stable gait's largest non-trivial ``|lambda|`` printed in each cell."""
+    fig, a = _fig(ax, (5.0, 4.0))
+    code = np.where(region.n_stable > 0, 2, np.where(region.n_gaits > 0, 1, 0))
+    y, x = region.values
+    a.pcolormesh(x, y, code, cmap=ListedColormap([c for c, _ in GRID_CLASSES]), vmin=0, vmax=2,
+                 shading="nearest", edgecolors="0.85", linewidth=0.3)
+    if code.size <= 400:
+        for (i, j), m in np.ndenumerate(region.max_nontrivial):
+            if np.isfinite(m):
+                a.text(float(x[j]), float(y[i]), f"{m:.2f}", ha="center", va="center", fontsize=6)
+    a.set(xlabel=param_label(region.names[1]), ylabel=param_label(region.names[0]),
+          title=f"energy {region.energy:g} MgL: stable {np.mean(code == 2):.0%}")
+    a.legend(handles=[Patch(facecolor=c, edgecolor="0.4", lw=0.5, label=t)
+                      for c, t in GRID_CLASSES], fontsize=7, loc="best")
     return fig
 
 

@@ -529,11 +529,21 @@ def step_batch(
     (:mod:`tslip.simulation._threads`).
     """
     Ps, S, TX, TH = _batch_inputs(params, states, terrain)
+    return step_batch_packed(Ps, _options(options), S, TX, TH)
+
+
+def step_batch_packed(Ps: np.ndarray, O: np.ndarray, S: np.ndarray,  # noqa: E741
+                      TX: np.ndarray | None = None, TH: np.ndarray | None = None) -> BatchStep:
+    """:func:`step_batch` on packed, checked rows: parameters ``Ps`` (n, NP), options
+    ``O``, touch-down states ``S`` (n, 7); flat ground at height 0 unless ``TX``/``TH``
+    (the analyses that write per-row unknowns into ``Ps``, e.g. the apex map)."""
     n = len(S)
+    if TX is None or TH is None:
+        TX, TH = np.empty((n, 0)), np.zeros((n, 1))
     OUT = np.empty((n, pk.NOUT))
     status = np.empty(n, dtype=np.int64)
     kernel = choose(kn.stride_batch_serial, kn.stride_batch, n)
-    kernel(Ps, _options(options), S, TX, TH, OUT, status)
+    kernel(Ps, O, S, TX, TH, OUT, status)
     nxt = OUT[:, pk.OUT_TD : pk.OUT_TD + 7].copy()
     nxt[status != 0] = np.nan
     return BatchStep(nxt, OUT[:, pk.OUT_TS].copy(), OUT[:, pk.OUT_TF].copy(), status, OUT)

@@ -33,12 +33,13 @@ class IntegrationError(RuntimeError):
     """The integrator could not proceed (not a fall: a numerical failure)."""
 
 
-#: Codes of outcomes that are neither a fall nor an error (20+). The TSLIP's
-#: kernels return codes 0-19 (``model._pack.ST_*``); the biped's own codes are
-#: translated to these at one boundary (:func:`tslip.biped._pack.to_status`).
+#: Codes only the biped reaches (the TSLIP's kernels return those of
+#: ``model._pack.ST_*``); the biped kernels' own codes are translated to the
+#: shared ones at one boundary (:func:`tslip.biped.simulate.to_status`). 20 is
+#: left for the apex map's ``NO_APEX``.
 ST_FALL_PITCH = 6
 ST_FALL_LEG = 7
-ST_T_END = 20
+ST_T_END = 21
 
 
 @enum.unique  # two names on one code would silently make one an alias of the other
@@ -47,8 +48,10 @@ class Status(enum.IntEnum):
 
     Codes: 0 ``OK``; 1-9 falls (:attr:`fell`); 10-19 integration errors
     (:attr:`is_error`); 20+ outcomes that are neither (``T_END``: a biped run
-    stopped at its end time). The codes are stored in caches and results, so
-    a member keeps its number; new members take a free code in their range.
+    stopped at its end time; ``NO_APEX``: the flight after lift-off has no apex,
+    so the apex return map has no next state, docs/conventions.md). The codes
+    are stored in caches and results, so a member keeps its number; new
+    members take a free code in their range.
     """
 
     OK = pk.ST_OK
@@ -65,6 +68,7 @@ class Status(enum.IntEnum):
     FLIGHT_TIMEOUT = pk.ST_ERR_FLIGHT_TIMEOUT
     NONFINITE = pk.ST_ERR_NONFINITE
     T_END = ST_T_END
+    NO_APEX = pk.ST_NO_APEX
 
     @property
     def fell(self) -> bool:
@@ -102,6 +106,8 @@ _REASONS = {
     Status.FLIGHT_TIMEOUT: "error: flight longer than IntegratorOptions.t_max_flight",
     Status.NONFINITE: "error: the state became NaN or infinite",
     Status.T_END: "reached the end time",
+    Status.NO_APEX: ("no apex: the runner lifted off moving down (or touched down while "
+                     "rising), so the flight has no apex and the apex map no next state"),
 }
 
 

@@ -1,0 +1,142 @@
+"""Robustness of a biped gait: the largest survivable disturbances (Section 3.1.3, Appendix E).
+
+The TSLIP's names and search (:mod:`tslip.gait.robustness`) on the biped:
+:func:`robustness` gives one limit, :func:`robustness_report` a
+:class:`RobustnessResult` of :class:`~tslip.gait.robustness.RobustnessLimit`.
+The three disturbances are applied as :func:`tslip.biped.gait.disturbed_outcome`
+describes; a run survives if it completes ``n_steps`` strides. The search is
+:func:`tslip.gait.robustness.search_limit`: a doubling ladder, then
+k-section, each batch run in order and stopped at its first failure.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..gait.robustness import RobustnessLimit, RobustnessLimits, search_limit
+from .gait import DISTURBANCES, REFINE_OPTIONS, Gait, disturbed_outcome, floquet
+from .parameters import BipedParams
+from .simulate import BipedOptions
+
+__all__ = ["RobustnessResult", "check_gait", "robustness", "robustness_report"]
+
+
+@dataclass(frozen=True, slots=True, repr=False)
+class RobustnessResult(RobustnessLimits):
+    """Robustness limits of a periodic biped gait (the TSLIP's, Section 3.1.3).
+
+    Attributes
+    ----------
+    limits : tuple of RobustnessLimit
+        One per searched kind and sign.
+    params : BipedParams
+    z : ndarray, shape (18,)
+        The gait's section vector the disturbances start from.
+    n_steps : int
+        Strides a disturbed run must survive.
+    tol : float
+        Bracket width of the search.
+    options : BipedOptions
+    """
+
+    params: BipedParams
+    z: NDArray[np.float64] = field(repr=False)
+    n_steps: int
+    tol: float
+    options: BipedOptions
+
+
+def check_gait(gait: Gait, options: BipedOptions | None = None) -> None:
+    """Refuse a gait the thesis would not analyse: unconverged or unstable (Section 3.1.3).
+
+    Raises
+    ------
+    ValueError
+        If ``gait.converged`` is False, or a Floquet multiplier
+        (:func:`tslip.biped.gait.floquet`) lies outside the unit circle.
+    """
+    if not gait.converged:
+        raise ValueError(f"robustness needs a periodic gait, but this one is not converged "
+                         f"({gait.message}); pass check=False to analyse it anyway")
+    f = floquet(gait.params, gait.z, options=options or REFINE_OPTIONS)
+    if not f.stable:
+        raise ValueError(f"robustness is computed only for at least neutrally stable gaits "
+                         f"(thesis Section 3.1.3), but this one is {f.stability} (largest "
+                         f"multiplier {f.max_nontrivial:.4g}); pass check=False to analyse it "
+                         f"anyway")
+
+
+def robustness(gait: Gait, kind: str, *, n_steps: int = 25, sign: int = -1, tol: float = 1e-3,
+               options: BipedOptions | None = None, check: bool = True, start: float = 0.01,
+               ladder: int = 8, k: int = 1, max_magnitude: float = 10.0) -> float:
+    """Largest disturbance of one kind the biped gait survives for ``n_steps`` strides.
+
+    As :func:`tslip.robustness`: ``kind`` is ``"step_down"`` [L], ``"push"``
+    [g^1/2 L^1/2] or ``"pitch_rate"`` [rad g^1/2 L^-1/2]; ``sign=-1`` searches
+    down, backward and negative pitch rates; ``tol`` is the accuracy of the
+    limit; ``start``, ``ladder``, ``k`` and ``max_magnitude`` set the search
+    (:func:`tslip.gait.robustness.limit_search`). ``options`` are the
+    disturbed runs' (default :class:`BipedOptions`, the thesis's 1e-8).
+
+    Returns
+    -------
+    float
+        The signed limit (``sign * inf`` if nothing failed up to ``max_magnitude``).
+
+    Raises
+    ------
+    ValueError
+        For a bad ``kind``, ``sign`` or ``n_steps``, or (with ``check``) an
+        unconverged or unstable gait.
+    """
+    return robustness_report(gait, n_steps=n_steps, kinds=(kind,), signs=(sign,), tol=tol,
+                             options=options, check=check, start=start, ladder=ladder, k=k,
+                             max_magnitude=max_magnitude).limits[0].limit
+
+
+def robustness_report(gait: Gait, *, n_steps: int = 25, kinds: Sequence[str] = DISTURBANCES,
+                      both_signs: bool = False, signs: Sequence[int] | None = None,
+                      tol: float = 1e-3, options: BipedOptions | None = None,
+                      check: bool = True, start: float = 0.01, ladder: int = 8, k: int = 1,
+                      max_magnitude: float = 10.0) -> RobustnessResult:
+    """Robustness limits of a biped gait for several disturbances, with reasons.
+
+    Parameters are those of :func:`robustness`; ``kinds`` selects the
+    disturbances and ``both_signs`` adds the +1 direction to the thesis's -1
+    (``signs`` names the directions explicitly instead).
+
+    Returns
+    -------
+    RobustnessResult
+        Per kind and sign: the limit, the failing disturbance that bounds it,
+        and the stride in which and the :class:`tslip.Status` with which that
+        run ended.
+    """
+    for kind in kinds:
+        if kind not in DISTURBANCES:
+            raise ValueError(f"kind must be one of {DISTURBANCES}, got {kind!r}")
+    signs = tuple(signs) if signs is not None else (-1, 1) if both_signs else (-1,)
+    if check:
+        check_gait(gait)
+    opts = options or BipedOptions()
+    limits: list[RobustnessLimit] = []
+    for kind in kinds:
+        for sign in signs:
+
+            def run_one(d: float, kind: str = kind) -> tuple[int, int]:
+                st, done = disturbed_outcome(gait.params, gait.z, kind, d, n_steps, opts)
+                if st is None:
+                    raise ValueError("a step-down needs a flight phase, and this gait has none")
+                return int(st), done
+
+            limits.append(search_limit(kind, sign, run_one, n_steps=n_steps, tol=tol,
+                                       start=start, ladder=ladder, k=k,
+                                       max_magnitude=max_magnitude))
+    return RobustnessResult(limits=tuple(limits), params=gait.params,
+                            z=np.asarray(gait.z, dtype=np.float64), n_steps=int(n_steps),
+                            tol=float(tol), options=opts)
+

@@ -1,0 +1,157 @@
+"""The viability iteration on a discrete state-action map (vibly's ``compute_QV``).
+
+A state-action map on a grid gives, for every grid state ``s`` and grid
+action ``a``, whether the step fails and, if not, the successor state
+``s' = f(s, a)`` (any real value, on the grid or between its points). The
+viability kernel is the largest set of state-action pairs from which the
+system never fails (Zaytsev, Wolfslag & Ruina 2018; Heim & Sprowitz 2019,
+the *vibly* package). It is found by iterating from "every pair that does
+not fail at once" and removing, each sweep, every pair whose successor does
+not land in the current set of viable states, until nothing changes. The
+iteration only removes pairs, so it ends, after at most as many sweeps as
+there are pairs.
+
+What "lands in a viable state" means for a successor between grid points is
+the *cell rule*:
+
+``"bracket"`` (default, conservative, as vibly's bracketing of off-grid
+    successors): the successor counts viable only if **every** grid point
+    of the grid cell around it is a viable state: the two bracketing points
+    in one dimension, the four corners of its grid rectangle in two. A
+    successor on a grid point (within :data:`SNAP` of a grid spacing)
+    needs only that point.
+``"nearest"``: the successor counts viable if the nearest grid point is.
+
+Under both rules a successor outside the grid's range (beyond
+:data:`SNAP` of a spacing) counts as not viable: the grid must cover the
+states of interest, and nothing is assumed about what lies outside it.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+
+import numpy as np
+
+__all__ = ["RULES", "SNAP", "check_grid", "successor_cells", "viable_sets"]
+
+#: Cell rules of :func:`successor_cells`.
+RULES = ("bracket", "nearest")
+#: A successor within this fraction of a grid spacing of a grid point is on it.
+SNAP = 1e-9
+
+
+def check_grid(values: object, name: str) -> np.ndarray:
+    """A grid axis as a float array: finite, 1-D, non-empty, strictly increasing."""
+    try:
+        g = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a sequence of numbers, got {values!r}") from None
+    if g.ndim != 1 or g.size == 0:
+        raise ValueError(f"{name} must be a non-empty 1-D grid, got shape {g.shape}")
+    if not np.all(np.isfinite(g)):
+        raise ValueError(f"{name} must be finite")
+    if g.size > 1 and not np.all(np.diff(g) > 0):
+        raise ValueError(f"{name} must be strictly increasing")
+    return g
+
+
+def _bracket_1d(g: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per value: index of the grid point below and above it, and whether it is inside."""
+    n = g.size
+    if n == 1:
+        inside = np.abs(x - g[0]) <= SNAP * max(1.0, abs(g[0]))
+        zero = np.zeros(x.shape, dtype=np.int64)
+        return zero, zero, inside
+    lo = np.clip(np.searchsorted(g, x, side="right") - 1, 0, n - 2)
+    hi = lo + 1
+    width = g[hi] - g[lo]
+    on_lo = np.abs(x - g[lo]) <= SNAP * width
+    on_hi = np.abs(x - g[hi]) <= SNAP * width
+    hi = np.where(on_lo, lo, hi)
+    lo = np.where(on_hi & ~on_lo, hi, lo)
+    inside = ((x >= g[0]) & (x <= g[-1])) | on_lo | on_hi
+    return lo.astype(np.int64), hi.astype(np.int64), inside
+
+
+def successor_cells(axes: Sequence[np.ndarray], nxt: np.ndarray, ok: np.ndarray,
+                    rule: str = "bracket") -> np.ndarray:
+    """Flat state indices each successor needs viable; ``-1`` where it cannot be.
+
+    Parameters
+    ----------
+    axes : sequence of d 1-D arrays
+        The state grid (strictly increasing axes).
+    nxt : ndarray, shape (n, d)
+        Successor states (ignored where ``ok`` is false).
+    ok : ndarray of bool, shape (n,)
+        The step did not fail.
+    rule : {"bracket", "nearest"}
+        The cell rule (module docstring).
+
+    Returns
+    -------
+    ndarray of int64, shape (n, 2**d) for ``"bracket"``, (n, 1) for ``"nearest"``
+        Indices into the flattened (C-order) state grid; a row with a ``-1``
+        is a successor that counts as not viable whatever the states are.
+    """
+    if rule not in RULES:
+        raise ValueError(f"rule must be one of {list(RULES)}, got {rule!r}")
+    nxt = np.asarray(nxt, dtype=float)
+    n, d = nxt.shape
+    shape = tuple(len(g) for g in axes)
+    valid = np.asarray(ok, dtype=bool) & np.all(np.isfinite(nxt), axis=1)
+    x = np.where(valid[:, None], nxt, np.array([g[0] for g in axes]))
+    brackets = [_bracket_1d(g, x[:, j]) for j, g in enumerate(axes)]
+    for _, _, inside in brackets:
+        valid &= inside
+    if rule == "nearest":
+        idx = []
+        for j, (lo, hi, _) in enumerate(brackets):
+            g = axes[j]
+            idx.append(np.where(np.abs(x[:, j] - g[hi]) < np.abs(x[:, j] - g[lo]), hi, lo))
+        cells = np.ravel_multi_index(tuple(idx), shape)[:, None]
+    else:
+        corners = [np.ravel_multi_index(tuple(brackets[j][c] for j, c in enumerate(pick)), shape)
+                   for pick in itertools.product((0, 1), repeat=d)]
+        cells = np.stack(corners, axis=1)
+    cells = cells.astype(np.int64)
+    cells[~valid] = -1
+    return cells
+
+
+def viable_sets(cells: np.ndarray, ok: np.ndarray, n_states: int,
+                max_iter: int | None = None) -> tuple[np.ndarray, np.ndarray, int]:
+    """Iterate to the viable state-action pairs and viable states.
+
+    ``cells`` (n_states * n_actions, m) from :func:`successor_cells`, rows in
+    (state, action) C order; ``ok`` the same rows' "did not fail". Starting
+    from ``Q = ok``, each sweep sets ``S = any over actions of Q`` and keeps
+    in ``Q`` only the pairs whose ``m`` cells are all in ``S`` (a ``-1`` is
+    never in it), until ``Q`` stops changing.
+
+    Returns
+    -------
+    q : ndarray of bool, shape (n_states, n_actions)
+        Viable state-action pairs.
+    s : ndarray of bool, shape (n_states,)
+        Viable states (some action is viable).
+    sweeps : int
+        Sweeps that removed something.
+    """
+    n = cells.shape[0]
+    if n % n_states:
+        raise ValueError(f"{n} rows are not a multiple of {n_states} states")
+    q = (np.asarray(ok, dtype=bool) & np.all(cells >= 0, axis=1)).reshape(n_states, -1)
+    cells = cells.reshape(n_states, q.shape[1], -1)
+    limit = q.size + 1 if max_iter is None else max_iter
+    sweeps = 0
+    while True:
+        s = q.any(axis=1)
+        s_pad = np.append(s, False)  # index -1: never viable
+        q_new = q & s_pad[cells].all(axis=-1)
+        if np.array_equal(q_new, q) or sweeps >= limit:
+            return q, s, sweeps
+        q = q_new
+        sweeps += 1

@@ -1,0 +1,347 @@
+"""Every periodic gait at fixed energy, and the self-stable region over two parameters.
+
+At given total energy and leg angle the SLIP has two periodic gaits, one of
+them self-stable (Seyfarth et al. 2002): a flat one with a short flight and
+a steep one. They merge at a fold and vanish (a saddle-node). A gait search
+returns one of them depending on its start, and a continuation often follows
+the unstable twin past the stable one's end, so neither answers "which gaits
+exist here, and which are stable".
+
+:func:`all_gaits` scans the touch-down velocity angle ``delta`` at fixed
+energy (the other unknowns at the starting guesses of
+:meth:`~tslip.gait.problem.GaitProblem.guesses`: level trunk, ``alpha_r``
+from the flight time), brackets each sign change of the ``delta`` residual
+(``delta' - delta``, the one-dimensional apex-height map at fixed energy in
+the SLIP), solves each bracket with Newton and keeps the distinct gaits,
+each with its Floquet multipliers. Two gaits closer than one grid step
+(near a fold) can be missed: pass a finer ``deltas``. For the TSLIP the scan
+runs along the level-trunk line, so a gait far from it may be missed too.
+
+:func:`stable_region` solves every cell of a two-parameter grid
+independently with :func:`all_gaits`, so a cell's answer does not depend on
+a path through the grid.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..model.parameters import PARAMETER_TABLE, Params
+from ..simulation.options import IntegratorOptions
+from .continuation import get_param, set_param
+from .fixed_point import Gait, find_gait
+from .problem import GaitProblem, Section
+from .stability import Floquet, floquet
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["GaitSet", "StableRegion", "all_gaits", "stable_region", "DEFAULT_DELTAS"]
+
+#: The default scan of touch-down velocity angles [rad]: geometric near 0 (the flat
+#: gaits' short flights), then every 0.025 rad to -1.5.
+DEFAULT_DELTAS = -np.unique(np.concatenate([np.geomspace(1e-3, 0.1, 12),
+                                             np.arange(0.1, 1.5 + 1e-9, 0.025)]))
+_SAME = 1e-7  # two solutions with delta and alpha_r this close are one gait
+
+
+@dataclass(frozen=True, eq=False)
+class GaitSet:
+    """The periodic gaits found at one energy and one set of parameters.
+
+    Attributes
+    ----------
+    params : Params
+        The parameters scanned.
+    energy : float
+        Total energy held [MgL].
+    gaits : tuple of Gait
+        Distinct gaits, flattest touch-down first (``delta`` closest to 0).
+    floquets : tuple of (Floquet or None)
+        Their multipliers on ``section`` (None where a perturbed stride fails).
+    section : {"touchdown", "apex"}
+    deltas : ndarray
+        The scanned touch-down velocity angles [rad].
+    seconds : float
+        Wall time [s].
+    """
+
+    params: Params
+    energy: float
+    gaits: tuple[Gait, ...]
+    floquets: tuple[Floquet | None, ...]
+    section: Section = "touchdown"
+    deltas: np.ndarray = field(default_factory=lambda: DEFAULT_DELTAS, repr=False)
+    seconds: float = field(default=math.nan, repr=False)
+
+    def __len__(self) -> int:
+        return len(self.gaits)
+
+    def __iter__(self) -> Iterator[Gait]:
+        return iter(self.gaits)
+
+    def __getitem__(self, i: int) -> Gait:
+        return self.gaits[i]
+
+    @property
+    def stability(self) -> tuple[str, ...]:
+        """Each gait's label (``"unknown"`` where its multipliers failed)."""
+        return tuple(f.stability if f is not None else "unknown" for f in self.floquets)
+
+    @property
+    def max_nontrivial(self) -> np.ndarray:
+        """Each gait's largest non-trivial multiplier magnitude (NaN if unknown)."""
+        return np.array([f.max_nontrivial if f is not None else math.nan
+                         for f in self.floquets])
+
+    @property
+    def stable(self) -> tuple[Gait, ...]:
+        """The gaits at least neutrally stable."""
+        return tuple(g for g, f in zip(self.gaits, self.floquets)
+                     if f is not None and f.stable)
+
+    def __repr__(self) -> str:
+        what = ", ".join(f"{s} {m:.4g}" for s, m in zip(self.stability, self.max_nontrivial))
+        return (f"GaitSet({len(self)} gaits at energy {self.energy:.6g}"
+                + (f": {what})" if what else ")"))
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per gait: ``delta``, ``v``, ``apex_y``, ``alpha_r``, times,
+        ``max_nontrivial``, ``stability``, ``residual``; units in ``df.attrs["units"]``."""
+        import pandas as pd
+
+        rows = [{"delta": g.state.delta, "v": g.state.v, "apex_y": g.apex.y,
+                 "alpha_r": g.params.alpha_r, "stance_time": g.stance_time,
+                 "flight_time": g.flight_time, "energy": g.energy,
+                 "max_nontrivial": float(m), "stability": s, "residual": g.residual}
+                for g, m, s in zip(self.gaits, self.max_nontrivial, self.stability)]
+        cols = ["delta", "v", "apex_y", "alpha_r", "stance_time", "flight_time", "energy",
+                "max_nontrivial", "stability", "residual"]
+        df = pd.DataFrame(rows, columns=cols)
+        df.attrs["units"] = {"delta": "rad", "v": "g^1/2 L^1/2", "apex_y": "L", "alpha_r": "rad",
+                             "stance_time": "g^-1/2 L^1/2", "flight_time": "g^-1/2 L^1/2",
+                             "energy": "MgL", "max_nontrivial": "-", "stability": "-",
+                             "residual": "-"}
+        return df
+
+
+def _brackets(prob: GaitProblem, deltas: np.ndarray) -> list[np.ndarray]:
+    """Starts at the sign changes of the ``delta`` residual along the scan (interpolated)."""
+    zs = [prob._guess(float(d)) for d in deltas]
+    r = np.array([prob.residual(z) for z in zs])
+    ok = ~np.all(r == 10.0, axis=1)  # a fall: the constant penalty of every component
+    f = r[:, 3]
+    starts = []
+    for i in range(len(deltas) - 1):
+        if not (ok[i] and ok[i + 1]) or f[i] * f[i + 1] > 0.0:
+            continue
+        w = f[i] / (f[i] - f[i + 1]) if f[i] != f[i + 1] else 0.5
+        starts.append(zs[i] + w * (zs[i + 1] - zs[i]))
+    return starts
+
+
+def all_gaits(
+    params: Params,
+    *,
+    energy: float,
+    deltas: Sequence[float] | np.ndarray | None = None,
+    tol: float = 1e-10,
+    options: IntegratorOptions | None = None,
+    section: Section = "touchdown",
+    multipliers: bool = True,
+) -> GaitSet:
+    """Every periodic gait at total energy ``energy`` and the parameters' ``beta0``.
+
+    Parameters
+    ----------
+    params : Params
+        Model, with the touch-down angle ``beta0``.
+    energy : float
+        Total energy [MgL] (:func:`tslip.gait.section.total_energy`).
+    deltas : sequence of float, optional
+        Touch-down velocity angles to scan [rad], in (-pi/2, 0); default
+        :data:`DEFAULT_DELTAS`. Finer near a fold.
+    tol : float
+        Residual tolerance of each gait.
+    options : IntegratorOptions, optional
+        Default tolerance 1e-12 with DOP853.
+    section : {"touchdown", "apex"}
+        Section of the multipliers.
+    multipliers : bool
+        Compute each gait's Floquet multipliers.
+
+    Returns
+    -------
+    GaitSet
+
+    Examples
+    --------
+    >>> import tslip
+    >>> s = tslip.all_gaits(tslip.preset("slip"), energy=2.2)
+    >>> s.stability
+    ('asymptotic', 'unstable')
+    """
+    t0 = time.perf_counter()
+    prob = GaitProblem.from_params(params, options, fix="energy", energy=energy,
+                                   section=section)
+    d = DEFAULT_DELTAS if deltas is None else np.asarray(deltas, dtype=float).ravel()
+    if d.size < 2 or not np.all((d > -math.pi / 2) & (d < 0.0)):
+        raise ValueError("deltas must hold at least 2 angles in (-pi/2, 0) rad")
+    d = np.sort(d)[::-1]  # from 0 down
+    found: list[Gait] = []
+    for z in _brackets(prob, d):
+        g = find_gait(params, guess=z, tol=tol, options=options, fix="energy", energy=energy,
+                      section=section)
+        if not g.converged:
+            continue
+        zg = prob.encode(g)
+        if all(np.max(np.abs(zg - prob.encode(h))) > _SAME for h in found):
+            found.append(g)
+    found.sort(key=lambda g: -g.state.delta)
+    fl: list[Floquet | None] = []
+    for g in found:
+        if not multipliers:
+            fl.append(None)
+            continue
+        try:
+            fl.append(floquet(g, options=options, section=section))
+        except ValueError:
+            fl.append(None)
+    return GaitSet(params=params, energy=prob.energy, gaits=tuple(found), floquets=tuple(fl),
+                   section=section, deltas=d, seconds=time.perf_counter() - t0)
+
+
+@dataclass(frozen=True, eq=False)
+class StableRegion:
+    """The gaits of each cell of a two-parameter grid at fixed energy.
+
+    Arrays have shape ``(len(values[0]), len(values[1]))``: rows the first
+    parameter, columns the second.
+
+    Attributes
+    ----------
+    params : Params
+        Base parameters.
+    energy : float
+        Total energy held [MgL].
+    names : tuple of str
+        The two parameters (names of :func:`tslip.gait.set_param`).
+    values : tuple of ndarray
+        Their grid values.
+    n_gaits, n_stable : ndarray of int
+        Gaits found per cell, and how many of them are at least neutrally stable.
+    max_nontrivial : ndarray
+        The smallest largest-non-trivial multiplier among a cell's gaits (its
+        most stable gait), NaN without a gait.
+    seconds : float
+        Wall time [s].
+    """
+
+    params: Params
+    energy: float
+    names: tuple[str, str]
+    values: tuple[np.ndarray, np.ndarray]
+    n_gaits: np.ndarray
+    n_stable: np.ndarray
+    max_nontrivial: np.ndarray
+    seconds: float = field(default=math.nan, repr=False)
+
+    @property
+    def stable(self) -> np.ndarray:
+        """Cells with at least one stable gait."""
+        return self.n_stable > 0
+
+    def __repr__(self) -> str:
+        n = self.n_gaits.size
+        return (f"StableRegion({self.names[0]} x {self.names[1]}, {n} cells at energy "
+                f"{self.energy:.6g}: {int(self.stable.sum())} stable, "
+                f"{int((self.n_gaits == 0).sum())} without a gait)")
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per cell: the two parameters, ``n_gaits``, ``n_stable``, ``max_nontrivial``."""
+        import pandas as pd
+
+        a, b = np.meshgrid(self.values[0], self.values[1], indexing="ij")
+        df = pd.DataFrame({self.names[0]: a.ravel(), self.names[1]: b.ravel(),
+                           "n_gaits": self.n_gaits.ravel(), "n_stable": self.n_stable.ravel(),
+                           "max_nontrivial": self.max_nontrivial.ravel()})
+        units = {row.name: row.unit for row in PARAMETER_TABLE}
+        df.attrs["units"] = {n: units.get(n, "-") for n in self.names}
+        df.attrs["units"].update({"n_gaits": "-", "n_stable": "-", "max_nontrivial": "-"})
+        return df
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The region: no gait, unstable gaits only, a stable gait (:func:`plot_stable_region`)."""
+        from ..plotting.studies import plot_stable_region
+
+        return plot_stable_region(self, ax=ax)
+
+
+def stable_region(
+    params: Params,
+    grid: Mapping[str, Sequence[float] | np.ndarray],
+    *,
+    energy: float,
+    deltas: Sequence[float] | np.ndarray | None = None,
+    tol: float = 1e-10,
+    options: IntegratorOptions | None = None,
+    progress: Any = None,
+) -> StableRegion:
+    """Self-stable region over two parameters at fixed energy, every cell solved alone.
+
+    Parameters
+    ----------
+    params : Params
+        Base parameters (e.g. ``preset("slip")``).
+    grid : mapping of two parameter names to values
+        E.g. ``{"k": np.linspace(15, 35, 5), "beta0": np.linspace(1.15, 1.35, 9)}``;
+        names as :func:`tslip.gait.set_param` takes them.
+    energy : float
+        Total energy [MgL].
+    deltas, tol, options
+        As :func:`all_gaits`.
+    progress : callable, optional
+        ``progress(done, total)`` after each cell.
+
+    Returns
+    -------
+    StableRegion
+    """
+    if not isinstance(grid, Mapping) or len(grid) != 2:
+        raise ValueError("grid must map exactly two parameter names to values, e.g. "
+                         "{'k': [...], 'beta0': [...]}")
+    names = tuple(grid)
+    vals = tuple(np.asarray(grid[n], dtype=float).ravel() for n in names)
+    for n, v in zip(names, vals):
+        get_param(params, n)  # checks the name
+        if v.size == 0 or not np.all(np.isfinite(v)):
+            raise ValueError(f"grid[{n!r}] must be a non-empty sequence of finite numbers")
+    t0 = time.perf_counter()
+    shape = (vals[0].size, vals[1].size)
+    n_g = np.zeros(shape, dtype=int)
+    n_s = np.zeros(shape, dtype=int)
+    lam = np.full(shape, math.nan)
+    done = 0
+    for i, a in enumerate(vals[0]):
+        for j, b in enumerate(vals[1]):
+            p = set_param(set_param(params, names[0], float(a)), names[1], float(b))
+            s = all_gaits(p, energy=energy, deltas=deltas, tol=tol, options=options)
+            n_g[i, j] = len(s)
+            n_s[i, j] = len(s.stable)
+            m = s.max_nontrivial
+            if np.isfinite(m).any():
+                lam[i, j] = float(np.nanmin(m))
+            done += 1
+            if progress is not None:
+                progress(done, n_g.size)
+    return StableRegion(params=params, energy=float(energy), names=(names[0], names[1]),
+                        values=(vals[0], vals[1]), n_gaits=n_g, n_stable=n_s,
+                        max_nontrivial=lam, seconds=time.perf_counter() - t0)

@@ -1,0 +1,565 @@
+"""The periodic-gait search of Section 2.8 as a problem in its free variables.
+
+:class:`GaitProblem` states the search as pure functions of the free
+variables ``z`` (docs/conventions.md, "Poincare section and periodic
+gaits"): the residual and its exact Jacobian, the thesis's costs ``C1``
+(eq. 2.20) and ``C`` (eqs 2.21-2.22), bounds (eqs 2.23-2.24) and automatic
+starting guesses. The searches in :mod:`tslip.gait.fixed_point` see only
+these functions. Split from that module, which re-exports every name.
+
+What the search holds: the speed at the section (``fix="speed"``; the
+touch-down speed ``v0``, or the apex's forward speed) or the total energy
+(``fix="energy"``). At ``r = 0`` the undetermined pitch is held.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+
+from .._checks import check_number
+from ..model import _pack as pk
+from ..model.controllers import ConstantTorque, LocalVelocity
+from ..model.parameters import Params
+from ..model.state import TouchdownState
+from ..simulation import _packed
+from ..simulation.integrate import step_map
+from ..simulation.options import IntegratorOptions
+from ..simulation.result import Status
+
+if TYPE_CHECKING:
+    from .fixed_point import Gait
+
+__all__ = ["GaitProblem", "gait_residual", "nominal_energy", "C1_THRESHOLD", "C1_OFFSET",
+           "TIGHT", "Fix", "Section"]
+
+Fix = Literal["speed", "energy"]
+Section = Literal["touchdown", "apex"]
+
+#: ``epsilon`` of eq. 2.22: switch from ``C1`` to ``C2`` below this.
+C1_THRESHOLD = 1e-4
+#: Offset added to ``C1`` in eq. 2.22 so it exceeds ``C2`` for ``|lambda| < 5``.
+C1_OFFSET = 25.0
+
+#: Default options of gait search and Floquet multipliers, built (and checked) once:
+#: tolerance 1e-12 with DOP853.
+TIGHT = IntegratorOptions.tight("dop853")
+
+_FALL_PENALTY = 10.0
+_TWO_PI = 2.0 * math.pi
+
+
+# ---------------------------------------------------------------------------
+# the problem: pure functions of the free variables
+# ---------------------------------------------------------------------------
+
+
+def _unknown_names(params: Params) -> tuple[str, ...]:
+    """Free variables: ``(delta, phi, phid, alpha_r)`` and the controller reference.
+
+    At ``r = 0`` with a torque that does not depend on the pitch, ``phi`` is
+    undetermined (it does not enter the stride, or with the local reset only
+    as ``alpha_r - phi``): it is held at 0. Without any hip torque ``phid`` is
+    conserved and ``phi`` grows by ``phid T`` a stride, so a gait has
+    ``phid = 0``: held too. Left free, both drift along a continuation.
+    """
+    names = ["delta", "phi", "phid", "alpha_r"]
+    ctrl = params.controller
+    if isinstance(ctrl, LocalVelocity):
+        names.append("alphad_ref")
+    elif isinstance(ctrl, ConstantTorque) and (params.c_l > 0 or ctrl.c_h > 0):
+        names.append("tau_c")
+    a = ctrl.torque_coefficients()
+    if params.r == 0.0 and a[1] == 0.0:
+        names.remove("phi")
+        # a constant torque without damping is 0 at a gait (energy balance, decode)
+        torque_free = ("tau_c" not in names) if isinstance(ctrl, ConstantTorque) else not any(a)
+        if torque_free:
+            names.remove("phid")
+    return tuple(names)
+
+
+def _allowed_names() -> set[tuple[str, ...]]:
+    return {("delta", *mid, "alpha_r", *ext)
+            for mid in ((), ("phi",), ("phid",), ("phi", "phid"))
+            for ext in ((), ("alphad_ref",), ("tau_c",))}
+
+
+def nominal_energy(params: Params) -> float:
+    """Total energy [MgL] at touch-down at speed ``v0`` and angle ``beta0``, level trunk.
+
+    ``m v0^2 / 2 + m g (l0 sin beta0 - r)`` (eq. 2.9 with ``phi = phid = 0``):
+    the default of ``fix="energy"``.
+    """
+    p = params
+    return 0.5 * p.m * p.v0**2 + p.m * p.g * (p.l0 * math.sin(p.beta0) - p.r)
+
+
+def gait_residual(params: Params, state: TouchdownState,
+                  options: IntegratorOptions | None = None) -> tuple[np.ndarray, float, float]:
+    """Periodicity residual ``(beta, phi, phid, delta, v)`` of one stride.
+
+    Parameters
+    ----------
+    params : Params
+        Model, with the gait's ``beta0`` and ``v0``.
+    state : TouchdownState
+        Candidate touch-down state.
+    options : IntegratorOptions, optional
+        Integrator settings.
+
+    Returns
+    -------
+    residual : ndarray, shape (5,)
+        Next touch-down's ``(beta, phi, phid, delta, v)`` minus
+        ``(beta0, phi, phid, delta, v0)`` [rad, rad, rad g^1/2 L^-1/2, rad,
+        g^1/2 L^1/2]; after a fall a constant penalty vector (10 each).
+    stance_time, flight_time : float
+        Phase durations [g^-1/2 L^1/2] (NaN after a fall in that phase).
+    """
+    q = state.section()
+    res = step_map(params, q, h=0.0, options=options)
+    out = np.full(pk.NOUT, math.nan)
+    out[pk.OUT_TD : pk.OUT_TD + 5] = res.q
+    out[pk.OUT_TS], out[pk.OUT_TF] = res.stance_time, res.flight_time
+    return _section_residual(q, int(res.status), out, params, params.v0)
+
+
+def _section_residual(q: np.ndarray, status: int, out: np.ndarray,
+                      params: Params, v0: float) -> tuple[np.ndarray, float, float]:
+    """:func:`gait_residual` of the stride from section ``q`` that filled ``out``.
+
+    ``v0``: the touch-down speed the next touch-down must have (the search's).
+    """
+    ts, tf = float(out[pk.OUT_TS]), float(out[pk.OUT_TF])
+    if status != Status.OK:
+        return np.full(5, _FALL_PENALTY), ts, tf
+    b, ph, xd, yd, phd = out[pk.OUT_TD : pk.OUT_TD + 5].tolist()
+    r = np.array([
+        b - params.beta0,
+        ph - q[1],
+        phd - q[4],
+        math.atan2(yd, xd) - math.atan2(q[3], q[2]),
+        math.hypot(xd, yd) - v0,
+    ])
+    return r, ts, tf
+
+
+@dataclass(frozen=True, slots=True)
+class GaitProblem:
+    """The periodic-gait search of Section 2.8 as pure functions of ``z``.
+
+    ``z = (delta, phi, phid, alpha_r[, alphad_ref | tau_c])``: touch-down
+    velocity angle [rad], pitch [rad], pitch rate [rad g^1/2 L^-1/2], leg
+    reset angle [rad], and the controller reference hip rate
+    [rad g^1/2 L^-1/2] or constant torque [MgL].
+
+    At ``r = 0`` the undetermined pitch is held (``phi = 0``, and ``phid = 0``
+    without hip torque; :func:`_unknown_names`), so ``z`` is shorter.
+
+    Parameters
+    ----------
+    params : Params
+        Model with the gait's fixed ``v0`` and ``beta0``. ``alpha_r`` and the
+        controller reference are overwritten by ``z``; a constant-torque
+        controller without leg or hip damping gets ``tau_c = 0`` (energy
+        balance, Section 2.4).
+    options : IntegratorOptions
+        Integrator settings for every stride.
+    fix : {"speed", "energy"}
+        Hold the speed at the section (``v0``: the touch-down speed, or at the
+        apex the forward speed ``xd``, so ``|v| = v0 / cos(delta)``), or the
+        total energy ``energy`` (:func:`tslip.gait.section.total_energy`), from
+        which the touch-down speed follows with eq. 2.9's height.
+    section : {"touchdown", "apex"}
+        Where ``fix="speed"`` holds the speed. The residual is the touch-down
+        one either way: its zeros, the gaits, do not depend on the section.
+    energy : float
+        Total energy [MgL] held with ``fix="energy"``.
+
+    Examples
+    --------
+    >>> import tslip
+    >>> prob = GaitProblem.from_params(tslip.preset("table2.1"))
+    >>> prob.names
+    ('delta', 'phi', 'phid', 'alpha_r')
+    >>> g = tslip.find_gait(prob.params)
+    >>> bool(prob.c1(prob.encode(g)) < 1e-20)
+    True
+    """
+
+    params: Params
+    options: IntegratorOptions
+    names: tuple[str, ...] = ()
+    fix: Fix = "speed"
+    section: Section = "touchdown"
+    energy: float = math.nan
+    # packed once (validation happened when params and options were built):
+    # P with z's alpha_r and controller reference written in per evaluation
+    _P: np.ndarray = field(init=False, repr=False, compare=False)
+    _O: np.ndarray = field(init=False, repr=False, compare=False)
+    _ref_gain: float = field(init=False, repr=False, compare=False)
+    _idx: dict[str, int] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if not self.names:
+            object.__setattr__(self, "names", _unknown_names(self.params))
+        if tuple(self.names) not in _allowed_names():
+            raise ValueError("names must be ('delta', ['phi'], ['phid'], 'alpha_r') and at most "
+                             f"one of 'alphad_ref', 'tau_c', got {self.names}")
+        if self.fix not in ("speed", "energy"):
+            raise ValueError(f"fix must be 'speed' or 'energy', got {self.fix!r}")
+        if self.section not in ("touchdown", "apex"):
+            raise ValueError(f"section must be 'touchdown' or 'apex', got {self.section!r}")
+        if self.fix == "energy" and not math.isfinite(self.energy):
+            raise ValueError(f"energy [MgL] must be finite with fix='energy', got {self.energy!r}")
+        if self.fix == "energy":
+            p = self.params
+            e_min = p.m * p.g * (p.l0 * math.sin(p.beta0) - p.r)  # at rest, touching down
+            if not self.energy > e_min:
+                raise ValueError(f"energy must be in ({e_min:.6g}, inf) MgL (above the "
+                                 f"touch-down potential at beta0), got {self.energy!r}")
+        object.__setattr__(self, "_idx", {n: i for i, n in enumerate(self.names)})
+        # as pack_params(decode(z)[0]) but for alpha_r and the reference, which
+        # _stride writes in: tau = P[P_C0] + ..., P_C0 = Kd * alphad_ref (eq. 2.14)
+        # or tau_c (eq. 2.15; 0 without damping, as in decode)
+        P = pk.pack_params(self.params)
+        ctrl = self.params.controller
+        if isinstance(ctrl, ConstantTorque) and "tau_c" not in self.names:
+            P[pk.P_C0] = 0.0
+        object.__setattr__(self, "_P", P)
+        object.__setattr__(self, "_O", self.options.packed())
+        gain = getattr(ctrl, "Kd", 1.0) if "alphad_ref" in self.names else 1.0
+        object.__setattr__(self, "_ref_gain", float(gain))
+
+    @classmethod
+    def from_params(cls, params: Params, options: IntegratorOptions | None = None, *,
+                    fix: Fix = "speed", section: Section = "touchdown",
+                    energy: float | None = None) -> GaitProblem:
+        """Problem for ``params``.
+
+        Default options: tolerance 1e-12 with DOP853, which needs about a
+        third of dopri5's right-hand sides there (``IntegratorOptions.tight``).
+        ``fix="energy"`` holds ``energy``, by default :func:`nominal_energy`.
+        """
+        if fix == "speed" and energy is not None:
+            raise ValueError("energy is held only with fix='energy'")
+        e = math.nan
+        if fix == "energy":
+            e = nominal_energy(params) if energy is None else float(
+                check_number(energy, "energy", unit="MgL"))
+        return cls(params=params, options=options or TIGHT, fix=fix, section=section, energy=e)
+
+    @property
+    def size(self) -> int:
+        """Number of free variables."""
+        return len(self.names)
+
+    # -- the speed the section holds ---------------------------------------------
+    def speed(self, delta: float, phi: float = 0.0, phid: float = 0.0) -> float:
+        """Touch-down speed at velocity angle ``delta`` (NaN where no state exists).
+
+        ``v0``; ``v0 / cos(delta)`` for the apex's forward speed; from the
+        energy, ``sqrt(2 (E - m g (l0 sin beta0 - r cos phi) - J phid^2 / 2) / m)``.
+        """
+        p = self.params
+        if self.fix == "speed":
+            if self.section == "touchdown":
+                return p.v0
+            c = math.cos(delta)
+            return p.v0 / c if c > 0.0 else math.nan
+        kin = (self.energy - p.m * p.g * (p.l0 * math.sin(p.beta0) - p.r * math.cos(phi))
+               - 0.5 * p.J * phid * phid)
+        return math.sqrt(2.0 * kin / p.m) if kin > 0.0 else math.nan
+
+    def exists(self, z: Sequence[float] | np.ndarray) -> bool:
+        """Whether a touch-down state exists at ``z`` (the energy held can reach it)."""
+        try:
+            values = self._values(z)
+        except ValueError:
+            return False
+        return math.isfinite(self.speed(values["delta"], values["phi"], values["phid"]))
+
+    def _speed_gradient(self, delta: float, phi: float, phid: float, v: float
+                        ) -> dict[str, float]:
+        """``d speed / d(delta, phi, phid)`` (the names it depends on)."""
+        p = self.params
+        if self.fix == "speed":
+            return {} if self.section == "touchdown" else {"delta": v * math.tan(delta)}
+        return {"phi": -p.g * p.r * math.sin(phi) / v, "phid": -p.J * phid / (p.m * v)}
+
+    def _values(self, z: Sequence[float] | np.ndarray) -> dict[str, float]:
+        """``z`` by name, with the held pitch (0) filled in."""
+        if len(z) != self.size:
+            raise ValueError(f"guess must have {self.size} entries {list(self.names)}, "
+                             f"got {len(z)}")
+        zf = [float(v) for v in z]
+        if not all(map(math.isfinite, zf)):
+            raise ValueError(f"z must be finite, got {zf}")
+        values = {"phi": 0.0, "phid": 0.0}
+        values.update(zip(self.names, zf))
+        return values
+
+    # -- z <-> (params, state) ------------------------------------------------
+    def decode(self, z: Sequence[float] | np.ndarray) -> tuple[Params, TouchdownState]:
+        """Parameters and touch-down state for the free variables ``z``.
+
+        ``params.v0`` is the touch-down speed of ``z`` (:meth:`speed`).
+        """
+        values = self._values(z)
+        v = self.speed(values["delta"], values["phi"], values["phid"])
+        if not math.isfinite(v):
+            raise ValueError(f"no touch-down state at energy {self.energy:g} MgL with "
+                             f"{dict(values)}")
+        ctrl = self.params.controller
+        if "alphad_ref" in values and isinstance(ctrl, LocalVelocity):  # (the name implies it)
+            ctrl = dataclasses.replace(ctrl, alphad_ref=values["alphad_ref"])
+        if "tau_c" in values and isinstance(ctrl, ConstantTorque):
+            ctrl = dataclasses.replace(ctrl, tau_c=values["tau_c"])
+        elif isinstance(ctrl, ConstantTorque) and ctrl.tau_c != 0.0:
+            ctrl = dataclasses.replace(ctrl, tau_c=0.0)  # no damping: no torque
+        p = dataclasses.replace(self.params, alpha_r=values["alpha_r"], controller=ctrl, v0=v)
+        s = TouchdownState.from_velocity(
+            v=v, delta=values["delta"], beta=p.beta0, phi=values["phi"], phid=values["phid"]
+        )
+        return p, s
+
+    def encode(self, gait: Gait) -> np.ndarray:
+        """Free variables of a gait (a warm start for nearby parameters)."""
+        s, p = gait.state, gait.params
+        out = {"delta": s.delta, "phi": s.phi, "phid": s.phid, "alpha_r": p.alpha_r,
+               "alphad_ref": getattr(p.controller, "alphad_ref", math.nan),
+               "tau_c": getattr(p.controller, "tau_c", math.nan)}
+        z = np.array([out[n] for n in self.names], dtype=float)
+        if not np.all(np.isfinite(z)):
+            raise ValueError(f"the gait's controller has no {list(self.names)[-1]!r}")
+        return z
+
+    # -- costs ----------------------------------------------------------------
+    def _stride(self, z: Sequence[float] | np.ndarray, jacobian: bool = False,
+                ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray | None, float]:
+        """``P``, section ``q``, one stride at ``z`` on the packed arrays, and the speed.
+
+        Writes ``alpha_r`` and the controller reference of ``z`` into ``P``
+        exactly as :meth:`decode` followed by ``pack_params`` would. Where no
+        state exists at ``z`` (energy too low) the stride is a ``NONFINITE``.
+        """
+        values = self._values(z)
+        P = self._P.copy()
+        P[pk.P_ALPHA] = values["alpha_r"]
+        ref = self.names[-1] if self.names[-1] in ("alphad_ref", "tau_c") else None
+        if ref is not None:
+            P[pk.P_C0] = self._ref_gain * values[ref]
+        delta, phi, phid = values["delta"], values["phi"], values["phid"]
+        v = self.speed(delta, phi, phid)
+        q = np.array([self.params.beta0, phi, v * math.cos(delta), v * math.sin(delta), phid])
+        out = np.full(pk.NOUT, math.nan)
+        J = np.full((5, 5), math.nan) if jacobian else None
+        if not math.isfinite(v):
+            return P, q, int(Status.NONFINITE), out, J, v
+        if J is not None:
+            return P, q, _packed.stride_jacobian(P, self._O, q, 0.0, J, out), out, J, v
+        return P, q, _packed.stride_map(P, self._O, q, 0.0, out), out, None, v
+
+    def evaluate(self, z: Sequence[float] | np.ndarray) -> tuple[np.ndarray, float, float]:
+        """Residual, stance and flight time at ``z`` (see :func:`gait_residual`)."""
+        _, q, st, out, _, v = self._stride(z)
+        return _section_residual(q, st, out, self.params, v)
+
+    def residual_jacobian(self, z: Sequence[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Residual (5,) and its Jacobian ``dr/dz`` (5 x size) at ``z``.
+
+        The chain ``z -> q -> q' -> r``: ``dq'/dq`` exact from the variational
+        equations (:func:`tslip.step_jacobian`), ``dq'/d alpha_r`` exact from
+        the flight's touch-down time, ``dq'/d(alphad_ref | tau_c)`` by a
+        central difference (the reference acts in stance, outside the
+        variational equations). After a fall the Jacobian is NaN.
+        """
+        P, q, st, out, Jq, v = self._stride(z, jacobian=True)
+        r, _, _ = _section_residual(q, st, out, self.params, v)
+        n = self.size
+        if st != Status.OK or Jq is None or not np.all(np.isfinite(Jq)):
+            return r, np.full((5, n), math.nan)
+        values = self._values(z)
+        delta = values["delta"]
+        ix = self._idx
+        dv = {k: g for k, g in self._speed_gradient(delta, values["phi"], values["phid"],
+                                                     v).items() if k in ix}
+        cd, sd = math.cos(delta), math.sin(delta)
+        dq = np.zeros((5, n))  # dq/dz, q = (beta0, phi, v cos delta, v sin delta, phid)
+        dq[2, ix["delta"]], dq[3, ix["delta"]] = -v * sd, v * cd
+        for k, g in dv.items():  # the speed held by the section or the energy
+            dq[2, ix[k]] += cd * g
+            dq[3, ix[k]] += sd * g
+        if "phi" in ix:
+            dq[1, ix["phi"]] = 1.0
+        if "phid" in ix:
+            dq[4, ix["phid"]] = 1.0
+        dqn = Jq @ dq  # dq'/dz through the state
+        dqn[:, ix["alpha_r"]] += _packed.alpha_r_column(P, out)
+        if self.names[-1] in ("alphad_ref", "tau_c"):
+            kr = n - 1
+            ref = float(z[kr])
+            h = 1e-5 * max(1.0, abs(ref))
+            cols = []
+            for sgn in (1.0, -1.0):
+                zz = np.array(z, dtype=float)
+                zz[kr] = ref + sgn * h
+                _, _, s2, o2, _, _ = self._stride(zz)
+                if s2 != Status.OK:
+                    return r, np.full((5, n), math.nan)
+                cols.append(o2[pk.OUT_TD : pk.OUT_TD + 5].copy())
+            dqn[:, kr] += (cols[0] - cols[1]) / (2.0 * h)
+        # r = (beta', phi' - phi, phid' - phid, atan2(yd', xd') - delta, |v'| - v0)
+        _, _, xd, yd, _ = out[pk.OUT_TD : pk.OUT_TD + 5]
+        v2 = xd * xd + yd * yd
+        v = math.sqrt(v2)
+        D = np.zeros((5, 5))  # dr/dq'
+        D[0, 0] = D[1, 1] = D[2, 4] = 1.0
+        D[3, 2], D[3, 3] = -yd / v2, xd / v2
+        D[4, 2], D[4, 3] = xd / v, yd / v
+        Jr = D @ dqn
+        if "phi" in ix:
+            Jr[1, ix["phi"]] -= 1.0
+        if "phid" in ix:
+            Jr[2, ix["phid"]] -= 1.0
+        Jr[3, ix["delta"]] -= 1.0
+        for k, g in dv.items():
+            Jr[4, ix[k]] -= g
+        return r, Jr
+
+    def residual(self, z: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Periodicity residual (5,) at ``z``; the Newton search's function."""
+        return self.evaluate(z)[0]
+
+    def c1(self, z: Sequence[float] | np.ndarray) -> float:
+        """Eq. 2.20: squared periodicity residual ``|r(z)|^2`` [-]."""
+        r = self.residual(z)
+        return float(r @ r)
+
+    def c2(self, z: Sequence[float] | np.ndarray,
+           jacobian: Literal["fd", "exact"] = "fd") -> float:
+        """Eq. 2.21: largest squared non-trivial multiplier magnitude at ``z``.
+
+        The structural multipliers (the energy's; the decoupled pitch's at
+        ``r = 0``) are removed by :func:`~tslip.gait.stability.nontrivial_jacobian`.
+        NaN when a perturbed stride falls.
+        """
+        from .stability import map_jacobian, nontrivial_jacobian
+
+        p, s = self.decode(z)
+        q = s.section()
+        try:
+            A = map_jacobian(p, q, method=jacobian, options=self.options)
+        except ValueError:
+            return math.nan
+        if not np.all(np.isfinite(A)):
+            return math.nan
+        lam = np.linalg.eigvals(nontrivial_jacobian(p, q, A))
+        return float(np.max(np.abs(lam)) ** 2) if lam.size else 0.0
+
+    def cost(self, z: Sequence[float] | np.ndarray, *, eps: float = C1_THRESHOLD,
+             offset: float = C1_OFFSET, jacobian: Literal["fd", "exact"] = "fd") -> float:
+        """Eq. 2.22: ``C1 + offset`` if ``C1 > eps``, else ``C2``.
+
+        Where ``C2`` cannot be evaluated (a perturbed stride falls) the
+        candidate counts as not periodic, ``C1 + offset``.
+        """
+        c1 = self.c1(z)
+        if c1 > eps:
+            return c1 + offset
+        c2 = self.c2(z, jacobian)
+        return c2 if math.isfinite(c2) else c1 + offset
+
+    # -- bounds and starting guesses -------------------------------------------
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds of ``z`` (eqs 2.23-2.24).
+
+        ``delta`` in [-pi/2, 0] (landing while moving down), ``phi`` in
+        [-pi/2, pi/2], ``phid`` in [-10, 10] rad g^1/2 L^-1/2, ``alpha_r`` in
+        [-2 pi, 2 pi] (long flights retract the leg by more than pi),
+        ``alphad_ref`` in [0, 5 v0/l0 + 10] rad g^1/2 L^-1/2 (positive in
+        stance, docs/conventions.md; the nominal hip rate is about ``v0/l0``),
+        ``|tau_c| <= 10 + 2 (c_l + c_h) v0 / l0`` MgL (the torque balances the
+        dampers, about ``c_h v0 / l0`` at the hip). They span every gait found
+        over the thesis's parameter ranges (Sections 3.4-3.7) and keep CMA-ES
+        away from strides that cannot be integrated.
+        """
+        p = self.params
+        tau_max = 10.0 + 2.0 * (p.c_l + getattr(p.controller, "c_h", 0.0)) * p.v0 / p.l0
+        lo = {"delta": -math.pi / 2, "phi": -math.pi / 2, "phid": -10.0, "alpha_r": -_TWO_PI,
+              "alphad_ref": 0.0, "tau_c": -tau_max}
+        hi = {"delta": 0.0, "phi": math.pi / 2, "phid": 10.0, "alpha_r": _TWO_PI,
+              "alphad_ref": 5.0 * p.v0 / p.l0 + 10.0, "tau_c": tau_max}
+        return (np.array([lo[n] for n in self.names]), np.array([hi[n] for n in self.names]))
+
+    def scales(self) -> np.ndarray:
+        """Initial CMA-ES standard deviation of each free variable.
+
+        0.2 rad for ``delta`` and ``phi``, 0.5 for ``phid`` and ``alpha_r``,
+        ``0.5 max(1, v0/l0)`` for ``alphad_ref`` and ``0.2 (1 + (c_l + c_h)
+        v0/l0)`` for ``tau_c``: wide enough to leave the basin of a poor
+        starting guess (smaller steps often stalled at ``C1 ~ 1e-2``).
+        """
+        p = self.params
+        damping = (p.c_l + getattr(p.controller, "c_h", 0.0)) * p.v0 / p.l0
+        s = {"delta": 0.2, "phi": 0.2, "phid": 0.5, "alpha_r": 0.5,
+             "alphad_ref": 0.5 * max(1.0, p.v0 / p.l0), "tau_c": 0.2 * (1.0 + damping)}
+        return np.array([s[n] for n in self.names])
+
+    def guesses(self) -> Iterator[np.ndarray]:
+        """Automatic starting points, most likely first (lazily).
+
+        The first five are the original list (``delta`` from -0.05 to -0.4,
+        level trunk, ``alpha_r`` from the symmetric flight time of eq. 3.11
+        and the retraction of eq. 2.17). Then a scan: ``delta`` on a grid
+        from -0.005 to -1.2 with ``alpha_r`` offsets of +-0.15 rad and
+        controller references from an energy balance (x0.5, x1, x2), ranked
+        by ``C1`` after one stride each; candidates that fall are dropped.
+        """
+        first = (-0.05, -0.12, -0.25, -0.4, -0.02)
+        for d in first:
+            yield self._guess(d)
+        scored: list[tuple[float, int, np.ndarray]] = []
+        for d in (-0.005, -0.01, -0.02, -0.035, -0.05, -0.075, -0.1, -0.15, -0.2, -0.3, -0.4,
+                  -0.5, -0.65, -0.8, -1.0, -1.2):
+            for da in (0.0, -0.15, 0.15):
+                has_ref = self.names[-1] in ("alphad_ref", "tau_c")
+                for f in ((1.0, 0.5, 2.0) if has_ref else (1.0,)):
+                    if d in first and da == 0.0 and f == 1.0:
+                        continue  # already tried
+                    z = self._guess(d, f)
+                    z[self._idx["alpha_r"]] += da
+                    c1 = self.c1(z)
+                    if math.isfinite(c1) and c1 < 5 * _FALL_PENALTY**2:
+                        scored.append((c1, len(scored), z))
+        scored.sort(key=lambda t: (t[0], t[1]))
+        for _, _, z in scored:
+            yield z
+
+    def _guess(self, delta: float, factor: float = 1.0) -> np.ndarray:
+        p = self.params
+        v = self.speed(delta)
+        v = v if math.isfinite(v) else p.v0
+        tf = 2.0 * v * math.sin(-delta) / p.g  # eq. 3.11, symmetric stance
+        named = {"delta": delta, "phi": 0.0, "phid": 0.0,
+                 "alpha_r": p.beta0 - p.omega_r * tf}  # eq. 2.17 with phi = 0
+        z = [named[n] for n in self.names if n in named]
+        ts = 2.0 * p.l0 * (math.pi / 2 - p.beta0) / v  # eq. 3.10
+        if "alphad_ref" in self.names:
+            z.append(factor * (math.pi - 2 * p.beta0) / ts)
+        if "tau_c" in self.names:
+            # energy balance: tau_c * (pi - 2 beta0) = dissipated energy, with
+            # ldot(t) = ldot0 cos(pi t / ts) in the leg and alpha_dot = const
+            # at the hip
+            dalpha = max(math.pi - 2 * p.beta0, 0.1)
+            ldot0 = v * math.cos(p.beta0 + delta)
+            c_h = p.controller.c_h if isinstance(p.controller, ConstantTorque) else 0.0
+            loss = p.c_l * ldot0**2 * ts / 2 + c_h * dalpha**2 / ts
+            z.append(0.1 if loss == 0 else factor * loss / dalpha)
+        return np.array(z)
