@@ -50,6 +50,10 @@ def test_cli_simulate_search_report(tmp_path):
     r = runner.invoke(app, ["biped", "simulate", "-n", "2", "--out", str(tmp_path / "a.csv")])
     assert r.exit_code == 0, r.output
     assert "2 strides" in r.output and (tmp_path / "a.csv").exists()
+    from tslip import load
+
+    run = load(tmp_path / "a.csv")  # the table and its run record
+    assert type(run).__name__ == "Trajectory" and run.n_steps == 2
     r = runner.invoke(app, ["biped", "search", "--out", str(tmp_path / "g.json"),
                             "--max-iter", "1", "--no-multipliers", "-n", "3"])
     assert r.exit_code == 0, r.output

@@ -55,6 +55,13 @@ def test_continue_saves_branch_with_stability(tmp_path):
     stab = dict(zip(df["value"].round(3), df["stability"]))
     assert stab[-0.2] == "unstable" and stab[0.5] == "asymptotic" and stab[1.0] == "unstable"
     assert (tmp_path / "b.png").stat().st_size > 5000
+    # the run record beside the table: tslip.load gives the Branch back, table and all
+    import tslip
+
+    branch = tslip.load(out)
+    assert type(branch).__name__ == "Branch" and len(branch) == 13
+    assert list(branch.to_dataframe()["stability"]) == list(df["stability"])
+    assert json.loads(out.with_suffix(".json").read_text())["run"]["params"]["r"] == 0.3
 
 
 @pytest.mark.parametrize(

@@ -114,10 +114,8 @@ def simulate_cmd(
                 c.print(f"{name} leg, stride 1: thigh RMS error {te.thigh_rms:.2e} L, "
                         f"hip RMS error {te.hip_rms:.3f} rad")
         if out is not None:
-            from .._io import write_table
-
-            write_table(tr.to_dataframe(), out)
-            c.print(f"wrote {out}")
+            tr.save(out)  # the table, and its run record beside it (tslip.load reads both)
+            c.print(f"wrote {out} and {out.with_suffix('.json')}")
 
 
 def _gait_summary(p: BipedParams, z: np.ndarray, ev: np.ndarray | None,

@@ -16,7 +16,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from .._checks import check_fits, check_number, check_output
-from .._io import atomic_write, write_table
+from .._io import atomic_write
 from ..gait import analyse, continue_gait, find_gait, get_param, impulse_linearisation
 from ..gait import pitch_disturbance_response as pitch_response
 from ..gait.stride import friction_ratio
@@ -228,8 +228,8 @@ def continue_cmd(
                       + (f"stable in [{_fmt(stable.min())}, {_fmt(stable.max())}]"
                          if stable.size else "stable nowhere"))
         if out is not None:
-            write_table(df, out)
-            console.print(f"wrote {out} ({file_size(out)})")
+            branch.save(out)  # the table, and its run record beside it (tslip.load reads both)
+            console.print(f"wrote {out} ({file_size(out)}) and {out.with_suffix('.json')}")
         if plot is not None:
             from ..plotting import plot_branch
 
