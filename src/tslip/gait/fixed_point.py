@@ -492,7 +492,8 @@ class GaitProblem:
 
         The first five are the original list (``delta`` from -0.05 to -0.4,
         level trunk, ``alpha_r`` from the symmetric flight time of eq. 3.11
-        and the retraction of eq. 2.17). Then a scan: ``delta`` on a grid
+        and the retraction of eq. 2.17, over half that time with the apex
+        clock). Then a scan: ``delta`` on a grid
         from -0.005 to -1.2 with ``alpha_r`` offsets of +-0.15 rad and
         controller references from an energy balance (x0.5, x1, x2), ranked
         by ``C1`` after one stride each; candidates that fall are dropped.
@@ -519,7 +520,8 @@ class GaitProblem:
     def _guess(self, delta: float, factor: float = 1.0) -> np.ndarray:
         p = self.params
         tf = 2.0 * p.v0 * math.sin(-delta) / p.g  # eq. 3.11, symmetric stance
-        z = [delta, 0.0, 0.0, p.beta0 - p.omega_r * tf]  # eq. 2.17 with phi = 0
+        t_ret = tf / 2 if p.retraction == "apex" else tf  # a symmetric flight's apex: tf / 2
+        z = [delta, 0.0, 0.0, p.beta0 - p.omega_r * t_ret]  # eq. 2.17 with phi = 0
         ts = 2.0 * p.l0 * (math.pi / 2 - p.beta0) / p.v0  # eq. 3.10
         if "alphad_ref" in self.names:
             z.append(factor * (math.pi - 2 * p.beta0) / ts)
