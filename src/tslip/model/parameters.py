@@ -53,7 +53,7 @@ def _check_choice(name: str, value: object) -> None:
     """One-line ``ValueError`` naming the string field ``name`` and its allowed values."""
     allowed = _CHOICES[name]
     if not (isinstance(value, str) and value in allowed):
-        raise ValueError(f"{name} must be one of {', '.join(map(repr, allowed))}, got {value!r}")
+        raise ValueError(f"{name} must be {' or '.join(map(repr, allowed))}, got {value!r}")
 
 
 class ParameterInfo(NamedTuple):
