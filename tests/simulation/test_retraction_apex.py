@@ -127,6 +127,28 @@ def test_the_apex_kink_is_not_stepped_over():
         assert beta == pytest.approx(1.0 + 40.0 * (t_td - yd / p.g), abs=1e-9)
 
 
+@pytest.mark.parametrize("leg_reset", ["local", "global"])
+def test_random_flights_touch_down_as_brentq_finds(rng, leg_reset):
+    """Random lift-offs (pitch rates up to 6, retraction from -3 to 6, feet just above the
+    ground): the kernels' first touch-down is the brentq one, never a later crossing."""
+    compared = 0
+    for _ in range(60):
+        p = tslip.Params(r=rng.uniform(-0.3, 0.5), omega_r=rng.uniform(-3.0, 6.0),
+                         alpha_r=rng.uniform(0.6, 1.4), leg_reset=leg_reset, retraction="apex")
+        phi, phid = rng.uniform(-0.4, 0.4), rng.uniform(-6.0, 6.0)
+        beta = p.alpha_r - (phi if leg_reset == "local" else 0.0)
+        y = p.l0 * math.sin(beta) - p.r * math.cos(phi) + rng.uniform(5e-4, 0.05)
+        lo = np.array([0.0, y, rng.uniform(0.5, 5.0), rng.uniform(-1.0, 1.5), phi, phid])
+        P, res = pk.pack_params(p), np.empty(3)
+        if kn.find_touchdown(P, tslip.IntegratorOptions().packed(), lo, np.empty(0),
+                             np.zeros(1), res) != 0:
+            continue  # a fall (the hip lands first)
+        compared += 1
+        assert res[0] == pytest.approx(_touchdown_by_brentq(p, lo, "apex", 1.5 * res[0] + 0.01),
+                                       abs=1e-9)
+    assert compared > 40
+
+
 def test_recorded_flight_follows_the_rule():
     p = dataclasses.replace(_SLIP, retraction="apex")
     g = tslip.find_gait(p)
