@@ -287,6 +287,32 @@ def test_apex_clock_changes_slip_stability(beta0, omega_r, stable):
     assert largest[stable] < 0.95 and largest[other] > 1.2
 
 
+def test_apex_clock_stability_boundaries_are_twice_the_liftoff_ones():
+    """Preset slip: stable for omega_r in (-0.099, 0.316) with the lift-off clock, and in
+    exactly twice that interval from the apex (measured; at the lower end a multiplier
+    crosses +1, at the upper end -1).
+
+    With ``v0`` and ``beta0`` fixed both clocks have the same periodic orbit, with a
+    symmetric flight (rise time = fall time): a change that keeps the flight symmetric
+    changes the touch-down angle by ``omega_r dt_TD`` with the lift-off clock and by
+    ``omega_r dt_TD / 2`` with the apex clock. Measured: the boundaries scale by 2 to
+    1e-5 (also at beta0 = 1.25: 0.155 and 0.464 against 0.309 and 0.927), the multipliers
+    inside the interval do not (0.82 at ``omega_r`` = 0.25 with the lift-off clock, 0.93
+    at 0.5 from the apex).
+    """
+    base = tslip.preset("slip")
+
+    def largest(w, clock):
+        g = tslip.find_gait(dataclasses.replace(base, omega_r=w, retraction=clock))
+        assert g.converged, g.message
+        return floquet(g).max_nontrivial
+
+    for a, b in ((-0.3, -0.01), (0.1, 0.6)):
+        w = brentq(lambda v: largest(v, "liftoff") - 1.0, a, b, xtol=1e-9)
+        assert largest(2.0 * w, "apex") == pytest.approx(1.0, abs=1e-5)
+        assert largest(2.0 * w * 0.98, "apex") < 1.0 < largest(2.0 * w * 1.02, "apex")
+
+
 # -- the default clock is today's, bit for bit ---------------------------------------
 
 def test_default_liftoff_clock_is_bit_identical_to_main():
