@@ -62,7 +62,7 @@ def _kernel_touchdown(p, lo):
     return res[0], fs[6]
 
 
-#: (name, params, touch-down state for tslip.step) and hand-made lift-off states
+#: name -> (params, touch-down state): strides that touch down after, before and without an apex
 _T21 = dataclasses.replace(tslip.preset("table2.1"), alpha_r=0.92)
 _SLIP = dataclasses.replace(tslip.preset("slip"), omega_r=0.5, alpha_r=1.12)
 _STRIDES = {
