@@ -12,6 +12,11 @@ on a shared, noisy machine.
   the right-hand side is the package's own scalar stance function run as plain
   Python (``.py_func``), and the flight uses the same closed-form touch-down as
   the package, so the ratio isolates the stance integration.
+
+``--baseline REV`` also times the default stride (one-core ``run_batch`` and the
+``step_map`` loop) on revision ``REV`` and on this checkout, each in a
+subprocess, alternately for ``--rounds`` rounds, and prints then / now (a
+ratio above 1 means this checkout is faster).
 """
 
 from __future__ import annotations
@@ -68,13 +73,47 @@ def rate(fn, n: int, repeat: int = 3) -> float:
     return n / best
 
 
+_BASELINE_SETUP = """
+import numba, tslip
+numba.set_num_threads(1)
+g = tslip.find_gait(tslip.preset("table2.1"))
+p, s = g.params, g.state
+opts = tslip.IntegratorOptions(rtol={tol}, atol={tol})
+states, q = [s] * {rows}, s.section()
+"""
+_BASELINE_STMTS = {
+    "compiled, one core": "tslip.run_batch(p, states, {steps}, options=opts)",
+    "step_map Python loop": "for _ in range(5000): tslip.step_map(p, q, options=opts)",
+}
+
+
+def compare_with(rev: str, args: argparse.Namespace) -> None:
+    """The default stride on ``rev`` and on this checkout: best times and their ratio."""
+    from _baseline import run_at  # (benchmarks/ is on the path when run as a script)
+
+    setup = _BASELINE_SETUP.format(tol=args.tol, rows=args.rows)
+    print(f"default stride, revision {rev} vs this checkout, best of {args.rounds} x 3:")
+    for name, stmt in _BASELINE_STMTS.items():
+        stmt = stmt.format(steps=args.steps)
+        then = now = float("inf")
+        for _ in range(args.rounds):
+            then = min(then, run_at(rev, setup, stmt, repeat=3, clock="process_time"))
+            now = min(now, run_at(None, setup, stmt, repeat=3, clock="process_time"))
+        print(f"  {name:<22} then {then * 1e3:8.1f} ms  now {now * 1e3:8.1f} ms  "
+              f"then / now = {then / now:.3f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--tol", type=float, default=1e-8)
     ap.add_argument("--rows", type=int, default=200)
     ap.add_argument("--steps", type=int, default=100)
     ap.add_argument("--scipy-strides", type=int, default=50)
+    ap.add_argument("--baseline", metavar="REV", help="also compare with this git revision")
+    ap.add_argument("--rounds", type=int, default=3)
     args = ap.parse_args()
+    if args.baseline:
+        compare_with(args.baseline, args)
 
     gait = tslip.find_gait(tslip.preset("table2.1"))
     p, s = gait.params, gait.state

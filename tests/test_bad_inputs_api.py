@@ -71,6 +71,9 @@ CASES = [
     ("omega_r inf", lambda: Params(omega_r=-math.inf), "omega_r [rad g^1/2 L^-1/2] must be"),
     ("alpha_r str", lambda: Params(alpha_r="1"), "alpha_r [rad] must be a number"),
     ("leg_reset", lambda: Params(leg_reset="sideways"), "leg_reset must be 'local' or 'global'"),
+    ("retraction", lambda: Params(retraction="apogee"),
+     "retraction must be 'liftoff' or 'apex', got 'apogee'"),
+    ("retraction None", lambda: Params(retraction=None), "retraction must be 'liftoff' or 'apex'"),
     ("controller", lambda: Params(controller="passive"), "controller must be one of"),
     ("omega_r_bar nan", lambda: P.with_omega_r_bar(math.nan), "omega_r_bar [-] must be finite"),
     # Params.from_dict: the TOML / JSON path
@@ -90,6 +93,8 @@ CASES = [
      "omega_r_bar [-] must be a number"),
     ("from_dict leg_reset int", lambda: Params.from_dict({"leg_reset": 1}),
      "leg_reset must be 'local' or 'global'"),
+    ("from_dict retraction int", lambda: Params.from_dict({"retraction": 1}),
+     "retraction must be 'liftoff' or 'apex', got 1"),
     ("from_dict leg_reset bool", lambda: Params.from_dict({"leg_reset": True}),
      "leg_reset must be 'local' or 'global'"),
     ("controller gain bool", lambda: controller_from_dict({"type": "global_pd", "Kp": True}),

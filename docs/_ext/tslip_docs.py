@@ -109,6 +109,10 @@ def parameter_table() -> str:
     import dataclasses
 
     from tslip.model import Params
+    from tslip.model.parameters import LEG_RESETS, RETRACTIONS
+
+    def choices(values: tuple[str, ...]) -> str:
+        return ", ".join(f'`"{v}"`' for v in values)
 
     lines = ["| field | symbol | unit | default | range | meaning | source |",
              "| --- | --- | --- | --- | --- | --- | --- |"]
@@ -121,8 +125,12 @@ def parameter_table() -> str:
         lines.append(f"| `{f.name}` | {md['symbol']} | {md['unit']} | {f.default:g} "
                      f"| {lo}, {hi} | {_cell(md['description'])} | {md['source']} |")
     lines.append("| `controller` | | | `Passive()` | | stance hip controller | Section 2.4 |")
-    lines.append("| `leg_reset` | | | `\"local\"` | `\"local\"`, `\"global\"` "
+    defaults = {f.name: f.default for f in dataclasses.fields(Params)}
+    lines.append(f'| `leg_reset` | | | `"{defaults["leg_reset"]}"` | {choices(LEG_RESETS)} '
                  "| frame of `alpha_r` and `omega_r` | Sections 2.3.2, 7.6 |")
+    lines.append(f'| `retraction` | | | `"{defaults["retraction"]}"` | {choices(RETRACTIONS)} '
+                 "| start of the retraction clock: lift-off (eq. 2.17) or the flight apex "
+                 "(held at `alpha_r` until then) | Section 2.5 |")
     return "\n".join(lines) + "\n"
 
 

@@ -191,6 +191,14 @@ def test_preset_detail_and_unknown_name():
     assert bad.exit_code == 2 and bad.output.startswith("error: preset")
 
 
+def test_retraction_clock_from_the_command_line():
+    assert re.search(r"retraction\s+liftoff", ok("presets", "slip").stdout)
+    apex = tslip.find_gait(tslip.Params(retraction="apex"))
+    result = ok("simulate", "--steps", "2", "--set", "retraction=apex")
+    assert f"alpha_r = {apex.params.alpha_r:.6f}" in result.stdout
+    assert f"alpha_r = {tslip.find_gait(tslip.Params()).params.alpha_r:.6f}" not in result.stdout
+
+
 def test_demo_writes_all_outputs(tmp_path):
     out_dir = tmp_path / "demo"
     result = ok("demo", "--out-dir", out_dir, "--steps", "2")

@@ -314,3 +314,23 @@ def test_tslip_descent_with_a_turning_trunk():
     assert abs(foot) < 1e-12  # eq. 2.9
     np.testing.assert_allclose(touchdown_to_apex(p, td).as_array(), a.as_array(), atol=1e-12)
     assert total_energy(p, td) == pytest.approx(total_energy(p, a), abs=1e-12)
+
+
+@pytest.mark.parametrize("name", ["slip", "table6.1"])
+def test_apex_section_with_retraction_timed_from_the_apex(name):
+    """With ``retraction="apex"`` the apex is a section: the touch-down gait's apex is a
+    fixed point of the apex map (which starts its clock at that apex), the map's
+    touch-down is the gait's, and the apex multipliers are the touch-down ones
+    less the 0 of the rank-4 map (retraction from the apex forgets the lift-off)."""
+    p = tslip.preset(name)
+    p = dataclasses.replace(p, retraction="apex", omega_r=0.5 if name == "slip" else p.omega_r)
+    g = tslip.find_gait(p)
+    assert g.converged
+    a = touchdown_to_apex(g.params, g.state)
+    r = apex_map(g.params, a, options=TIGHT)
+    assert r.status == Status.OK
+    assert r.apex.section() == pytest.approx(a.section(), abs=1e-8)
+    assert r.touchdown.beta == pytest.approx(g.state.beta, abs=1e-10)
+    f_td, f_ap = tslip.floquet(g), tslip.floquet(g, section="apex")
+    assert f_ap.max_nontrivial == pytest.approx(f_td.max_nontrivial, abs=1e-8)
+    assert np.min(np.abs(f_td.multipliers)) < 1e-12  # the rank-4 touch-down map's 0

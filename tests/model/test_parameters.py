@@ -16,7 +16,8 @@ def test_table_matches_dataclass_fields_and_defaults():
         assert f.default == row.default
         assert f.metadata["unit"] == row.unit
         assert f.metadata["symbol"] == row.symbol
-    assert {r.name for r in PARAMETER_TABLE} == set(fields) - {"controller", "leg_reset"}
+    assert {r.name for r in PARAMETER_TABLE} == set(fields) - {"controller", "leg_reset",
+                                                                "retraction"}
 
 
 def test_defaults_are_table_2_1():
@@ -113,6 +114,27 @@ def test_from_dict_roundtrip_and_toml(tmp_path):
     bad.write_text("k = = 3")
     with pytest.raises(ValueError, match="not valid TOML"):
         Params.from_toml(bad)
+
+
+def test_retraction_clock_field(tmp_path):
+    from tslip.model.units import Scaling, from_si, to_si
+
+    assert Params().retraction == "liftoff"  # the thesis's clock (eq. 2.17)
+    p = Params(retraction="apex", k=30.0)
+    assert p.to_dict()["retraction"] == "apex"
+    assert Params.from_dict(p.to_dict()) == p
+    assert Params.from_dict({"retraction": "apex"}, base=tslip.preset("slip")).retraction == "apex"
+    f = tmp_path / "p.toml"
+    f.write_text('[params]\npreset = "table6.1"\nretraction = "apex"\n')
+    assert Params.from_toml(f) == dataclasses.replace(tslip.preset("table6.1"),
+                                                      retraction="apex")
+    s = Scaling(M=80.0, g=9.81, L=1.0)
+    si = to_si(p, s)
+    assert si["retraction"] == "apex" and from_si(si, s).retraction == "apex"
+    for bad in ("Apex", "touchdown", 0, None):
+        with pytest.raises(ValueError) as exc:
+            Params(retraction=bad)  # type: ignore[arg-type]
+        assert str(exc.value) == f"retraction must be 'liftoff' or 'apex', got {bad!r}"
 
 
 def test_touchdown_state_validation_and_section():

@@ -41,7 +41,7 @@ __all__ = [
 DATA_SUFFIXES = (".csv", ".parquet")
 
 _TABLE = {row.name: row for row in PARAMETER_TABLE}
-_STRING_KEYS = ("controller", "leg_reset")
+_STRING_KEYS = ("controller", "leg_reset", "retraction")
 
 # -- options shared by several commands --------------------------------------------
 
@@ -60,7 +60,8 @@ SetOpt = Annotated[
         "-s",
         metavar="KEY=VALUE",
         help="Override a parameter, e.g. k=30, omega_r_bar=0.2, controller=local_velocity, "
-        "controller.Kd=0.4, leg_reset=global. Repeatable; applied after --params.",
+        "controller.Kd=0.4, leg_reset=global, retraction=apex. Repeatable; applied after "
+        "--params.",
     ),
 ]
 ParamsOpt = Annotated[
@@ -196,7 +197,7 @@ def _parse_sets(items: list[str] | None, base: Params) -> dict[str, Any]:
         else:
             raise ValueError(
                 f"unknown parameter {key!r} in --set; allowed: {sorted(_TABLE)} plus "
-                "omega_r_bar, controller, controller.<gain>, leg_reset"
+                "omega_r_bar, controller, controller.<gain>, leg_reset, retraction"
             )
     if gains:
         if "controller" in out:

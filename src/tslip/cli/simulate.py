@@ -265,6 +265,7 @@ def _preset_matrix(names: list[str]) -> Table:
             ),
         )
     table.add_row("leg_reset", "", *(p.leg_reset for p in ps))
+    table.add_row("retraction", "", *(p.retraction for p in ps))
     return table
 
 
@@ -289,6 +290,8 @@ def _preset_detail(name: str) -> Table:
             f.metadata.get("description", ""),
         )
     table.add_row("leg_reset", p.leg_reset, "", "frame of the leg reset at lift-off")
+    table.add_row("retraction", p.retraction, "", "start of the retraction clock: lift-off "
+                  "or apex")
     return table
 
 

@@ -517,7 +517,8 @@ class GaitProblem:
 
         The first five are the original list (``delta`` from -0.05 to -0.4,
         level trunk, ``alpha_r`` from the symmetric flight time of eq. 3.11
-        and the retraction of eq. 2.17). Then a scan: ``delta`` on a grid
+        and the retraction of eq. 2.17, over half that time with the apex
+        clock). Then a scan: ``delta`` on a grid
         from -0.005 to -1.2 with ``alpha_r`` offsets of +-0.15 rad and
         controller references from an energy balance (x0.5, x1, x2), ranked
         by ``C1`` after one stride each; candidates that fall are dropped.
@@ -547,8 +548,9 @@ class GaitProblem:
         v = self.speed(delta)
         v = v if math.isfinite(v) else p.v0
         tf = 2.0 * v * math.sin(-delta) / p.g  # eq. 3.11, symmetric stance
+        t_ret = tf / 2 if p.retraction == "apex" else tf  # a symmetric flight's apex: tf / 2
         named = {"delta": delta, "phi": 0.0, "phid": 0.0,
-                 "alpha_r": p.beta0 - p.omega_r * tf}  # eq. 2.17 with phi = 0
+                 "alpha_r": p.beta0 - p.omega_r * t_ret}  # eq. 2.17 with phi = 0
         z = [named[n] for n in self.names if n in named]
         ts = 2.0 * p.l0 * (math.pi / 2 - p.beta0) / v  # eq. 3.10
         if "alphad_ref" in self.names:

@@ -357,9 +357,10 @@ def _run_flight_disturbed(params: Params, state: TouchdownState, kind: Kind, d: 
     fs = np.empty(10)
     if placement == "apex":
         t_a = min(max(lo[3], 0.0) / params.g, s0.flight_time)
-        kn.flight_state(P, lo, t_a, fs)
+        # the leg's retraction clock keeps running (the apex clock starts at t_a)
+        P[pk.P_ALPHA] += P[pk.P_OMEGA] * max(t_a - kn.retraction_start(P, lo[3]), 0.0)
+        kn.flight_state(P, lo, t_a, fs)  # (the CoM part does not depend on alpha_r)
         lo = fs[:6].copy()
-        P[pk.P_ALPHA] += P[pk.P_OMEGA] * t_a  # the leg's retraction clock keeps running
     tx, th = Terrain.flat(state.h).arrays()
     S = np.full((len(d), 7), np.nan)
     st0 = np.zeros(len(d), dtype=np.int64)

@@ -14,7 +14,8 @@ from .state import TouchdownState
 # -- parameter vector P ------------------------------------------------------
 P_M, P_J, P_R, P_K, P_L0, P_G, P_CL, P_OMEGA, P_ALPHA, P_GLOBAL, P_CTRL = range(11)
 P_C0 = 11  # tau = P[P_C0] + P[P_C0+1] phi + P[P_C0+2] betad + P[P_C0+3] phid
-NP = 15
+P_APEX = 15  # 1.0: the retraction clock starts at the flight apex (retraction="apex")
+NP = 16
 
 # -- integrator options O ----------------------------------------------------
 O_RTOL, O_ATOL, O_H0, O_MAXSTEPS, O_TMAX_STANCE, O_TMAX_FLIGHT, O_HMIN, O_METHOD = range(8)
@@ -89,6 +90,7 @@ def pack_params(p: Params) -> np.ndarray:
     out[P_M], out[P_J], out[P_R], out[P_K], out[P_L0], out[P_G] = p.m, p.J, p.r, p.k, p.l0, p.g
     out[P_CL], out[P_OMEGA], out[P_ALPHA] = p.c_l, p.omega_r, p.alpha_r
     out[P_GLOBAL] = 1.0 if p.leg_reset == "global" else 0.0
+    out[P_APEX] = 1.0 if p.retraction == "apex" else 0.0
     out[P_CTRL] = p.controller.code
     out[P_C0 : P_C0 + 4] = p.controller.torque_coefficients()
     return out

@@ -15,7 +15,7 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal, NamedTuple
+from typing import Any, Literal, NamedTuple, get_args
 
 from .._checks import check_fields, check_number
 from .._io import read_toml
@@ -35,10 +35,25 @@ __all__ = [
     "preset",
     "presets",
     "LegReset",
+    "Retraction",
+    "LEG_RESETS",
+    "RETRACTIONS",
     "read_params_file",
 ]
 
 LegReset = Literal["local", "global"]
+Retraction = Literal["liftoff", "apex"]
+#: The allowed values of the two string fields (their ``Literal`` types' arguments).
+LEG_RESETS: tuple[str, ...] = get_args(LegReset)
+RETRACTIONS: tuple[str, ...] = get_args(Retraction)
+_CHOICES: dict[str, tuple[str, ...]] = {"leg_reset": LEG_RESETS, "retraction": RETRACTIONS}
+
+
+def _check_choice(name: str, value: object) -> None:
+    """One-line ``ValueError`` naming the string field ``name`` and its allowed values."""
+    allowed = _CHOICES[name]
+    if not (isinstance(value, str) and value in allowed):
+        raise ValueError(f"{name} must be {' or '.join(map(repr, allowed))}, got {value!r}")
 
 
 class ParameterInfo(NamedTuple):
@@ -132,6 +147,14 @@ class Params:
         ``"local"`` (thesis): ``alpha_r`` and ``omega_r`` are relative to the
         trunk. ``"global"``: the classic SLIP reset, ``beta(t) = alpha_r +
         omega_r (t - t_LO)`` in the inertial frame (Section 7.6).
+    retraction : {"liftoff", "apex"}
+        When the retraction clock starts. ``"liftoff"`` (thesis, eq. 2.17):
+        ``alpha(t) = alpha_r + omega_r (t - t_LO)``. ``"apex"`` (Seyfarth et
+        al. 2003, the policy Section 2.5 cites): the leg is held at ``alpha_r``
+        from lift-off to the flight apex ``t_apex`` (``ydot = 0``) and then
+        retracts, ``alpha(t) = alpha_r + omega_r max(0, t - t_apex)``; a flight
+        that leaves the ground moving down has no apex, and its clock starts
+        at lift-off (``t_apex = t_LO``). docs/conventions.md, "Frames and angles".
 
     Examples
     --------
@@ -156,6 +179,7 @@ class Params:
     alpha_r: float = _f("alpha_r")
     controller: Controller = field(default_factory=Passive)
     leg_reset: LegReset = "local"
+    retraction: Retraction = "liftoff"
 
     def __post_init__(self) -> None:
         check_fields(self)  # every PARAMETER_TABLE row, by its field's metadata
@@ -164,8 +188,8 @@ class Params:
                 "controller must be one of Passive, GlobalPD, LocalVelocity, ConstantTorque, "
                 f"got {self.controller!r}"
             )
-        if self.leg_reset not in ("local", "global"):
-            raise ValueError(f"leg_reset must be 'local' or 'global', got {self.leg_reset!r}")
+        for name in _CHOICES:
+            _check_choice(name, getattr(self, name))
 
     # -- derived quantities (never stored) ---------------------------------
     @property
@@ -189,6 +213,7 @@ class Params:
         """Plain ``dict`` (TOML / JSON friendly), controller as a sub-table."""
         out: dict[str, Any] = {row.name: getattr(self, row.name) for row in PARAMETER_TABLE}
         out["leg_reset"] = self.leg_reset
+        out["retraction"] = self.retraction
         out["controller"] = self.controller.to_dict()
         return out
 
@@ -197,7 +222,8 @@ class Params:
         """Build from a dict of overrides on ``base`` (default: Table 2.1).
 
         Accepts the field names, ``omega_r_bar`` (eq. 2.18), ``preset`` (a
-        base preset name) and ``controller`` (a name or a table). Values are
+        base preset name), ``controller`` (a name or a table), ``leg_reset``
+        and ``retraction``. Values are
         typed strictly (see :func:`tslip._checks.check_number`); a ``preset``
         that differs from a given ``base``, or both ``omega_r`` and
         ``omega_r_bar``, is an error rather than a silent choice.
@@ -220,16 +246,15 @@ class Params:
         omega_r_bar = data.pop("omega_r_bar", None)
         if "controller" in data:
             changes["controller"] = controller_from_dict(data.pop("controller"))
-        if "leg_reset" in data:
-            leg_reset = data.pop("leg_reset")
-            if leg_reset not in ("local", "global"):
-                raise ValueError(f"leg_reset must be 'local' or 'global', got {leg_reset!r}")
-            changes["leg_reset"] = leg_reset
+        for name in _CHOICES:
+            if name in data:
+                _check_choice(name, data[name])
+                changes[name] = data.pop(name)
         for key, value in data.items():
             if key not in _TABLE:
                 raise ValueError(
                     f"unknown parameter {key!r}; allowed: {sorted(_TABLE)} "
-                    "plus omega_r_bar, controller, leg_reset, preset"
+                    "plus omega_r_bar, controller, leg_reset, retraction, preset"
                 )
             row = _TABLE[key]
             changes[key] = check_number(

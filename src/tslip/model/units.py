@@ -165,6 +165,7 @@ def to_si(params: Params, scaling: Scaling) -> dict[str, Any]:
         for k, v in ctrl.items()
     }
     out["leg_reset"] = params.leg_reset
+    out["retraction"] = params.retraction
     return out
 
 
@@ -193,7 +194,7 @@ def from_si(values: dict[str, Any], scaling: Scaling | None = None,
                 k: (scaling.to_dimensionless(v, _CONTROLLER_DIMS[k]) if k in _CONTROLLER_DIMS
                     else v) for k, v in ctrl.items()
             }
-        elif key == "leg_reset":
+        elif key in ("leg_reset", "retraction"):
             changes[key] = value
         elif key in dims:
             changes[key] = scaling.to_dimensionless(float(value), dims[key])

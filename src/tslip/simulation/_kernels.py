@@ -43,6 +43,7 @@ from ..model._pack import (
     OUT_TS,
     OUT_XF,
     P_ALPHA,
+    P_APEX,
     P_C0,
     P_CL,
     P_G,
@@ -457,11 +458,36 @@ def _record(P, rec, row, t, y):
 
 
 @njit(**_JIT)
-def flight_leg_angle(P, phi0, phid, t):
-    """Leg angle ``beta(t)`` in flight, ``t`` since lift-off, and its rate."""
+def retraction_start(P, yd0):
+    """Time after lift-off at which the retraction clock starts, for lift-off ``ydot = yd0``.
+
+    0 with ``retraction="liftoff"`` (eq. 2.17). With ``retraction="apex"`` the
+    apex ``yd0 / g`` of a flight that leaves the ground moving up, and 0 (the
+    clock starts at lift-off) for one that has no apex (``yd0 <= 0``).
+    """
+    if P[P_APEX] != 0.0 and yd0 > 0.0:
+        return yd0 / P[P_G]
+    return 0.0
+
+
+@njit(**_JIT)
+def flight_leg_angle(P, phi0, phid, t, ta):
+    """Leg angle ``beta(t)`` in flight, ``t`` since lift-off, and its rate.
+
+    The hip angle is ``alpha_r + omega_r max(0, t - ta)`` with ``ta`` from
+    :func:`retraction_start` (held at ``alpha_r`` until then); ``beta = alpha -
+    phi(t)`` for the local reset, ``beta = alpha`` for the global one. The rate
+    is the one from ``t`` on (retracting at ``t = ta``).
+    """
+    if t >= ta:
+        s = t - ta
+        w = P[P_OMEGA]
+    else:
+        s = 0.0
+        w = 0.0
     if P[P_GLOBAL] != 0.0:
-        return P[P_ALPHA] + P[P_OMEGA] * t, P[P_OMEGA]
-    return P[P_ALPHA] + P[P_OMEGA] * t - (phi0 + phid * t), P[P_OMEGA] - phid
+        return P[P_ALPHA] + P[P_OMEGA] * s, w
+    return P[P_ALPHA] + P[P_OMEGA] * s - (phi0 + phid * t), w - phid
 
 
 @njit(**_JIT)
@@ -476,7 +502,7 @@ def flight_state(P, lo, t, out):
     x = lo[0] + lo[2] * t
     y = lo[1] + lo[3] * t - 0.5 * g * t * t
     ph = lo[4] + lo[5] * t
-    b, _ = flight_leg_angle(P, lo[4], lo[5], t)
+    b, _ = flight_leg_angle(P, lo[4], lo[5], t, retraction_start(P, lo[3]))
     hip_x = x - r * math.sin(ph)
     hip_y = y + r * math.cos(ph)
     out[0] = x
@@ -492,13 +518,13 @@ def flight_state(P, lo, t, out):
 
 
 @njit(**_JIT)
-def _flight_heights(P, lo, t):
-    """Foot and hip height, their rates and the foot x-position at ``t``."""
+def _flight_heights(P, lo, t, ta):
+    """Foot and hip height, their rates and the foot x-position at ``t`` (clock from ``ta``)."""
     g = P[P_G]
     r = P[P_R]
     l0 = P[P_L0]
     ph = lo[4] + lo[5] * t
-    b, bd = flight_leg_angle(P, lo[4], lo[5], t)
+    b, bd = flight_leg_angle(P, lo[4], lo[5], t, ta)
     y = lo[1] + lo[3] * t - 0.5 * g * t * t
     yd = lo[3] - g * t
     hip_y = y + r * math.cos(ph)
@@ -533,7 +559,9 @@ def find_touchdown(P, O, lo, tx, th, res):
     downward crossing is never missed; near the root the step is Newton-like.
     The foot must first be above the ground (a reset foot that starts below
     it has to rise, docs/conventions.md). Terrain: heights ``th[k]`` between
-    breakpoints ``tx`` (``len(th) == len(tx) + 1``).
+    breakpoints ``tx`` (``len(th) == len(tx) + 1``). With the apex clock the
+    leg rate jumps at the apex, so ``K`` bounds both rates and no step
+    crosses the apex.
 
     ``res`` receives ``(t_td, ground_h, clearance_at_reset)``.
     """
@@ -542,13 +570,16 @@ def find_touchdown(P, O, lo, tx, th, res):
     l0 = P[P_L0]
     phid = lo[5]
     bd = P[P_OMEGA] if P[P_GLOBAL] != 0.0 else P[P_OMEGA] - phid
+    ta = retraction_start(P, lo[3])
+    if ta > 0.0:  # before the apex the held leg turns with the trunk (local) or not at all
+        bd = max(abs(bd), abs(0.0 if P[P_GLOBAL] != 0.0 else phid))
     Kf = g + r * phid * phid + l0 * bd * bd + 1e-300
     Kh = g + r * phid * phid + 1e-300
     vx = abs(lo[2]) + r * abs(phid) + l0 * abs(bd) + 1e-300
     t_max = O[O_TMAX_FLIGHT]
     tol = 1e-13
     t = 0.0
-    foot_y, foot_yd, hip_y, hip_yd, foot_x = _flight_heights(P, lo, t)
+    foot_y, foot_yd, hip_y, hip_yd, foot_x = _flight_heights(P, lo, t, ta)
     k = _segment(tx, foot_x)
     res[1] = th[k]
     res[2] = foot_y - th[k]
@@ -587,8 +618,10 @@ def find_touchdown(P, O, lo, tx, th, res):
             if k < tx.shape[0]:
                 dist = min(dist, tx[k] - foot_x)
             dt = min(dt, max(dist / vx, 1e-12))
+        if t < ta:  # stop at the apex: the foot's rate jumps there
+            dt = min(dt, ta - t)
         t += dt
-        foot_y, foot_yd, hip_y, hip_yd, foot_x = _flight_heights(P, lo, t)
+        foot_y, foot_yd, hip_y, hip_yd, foot_x = _flight_heights(P, lo, t, ta)
         knew = _segment(tx, foot_x)
         if knew != k:
             k = knew
@@ -841,7 +874,7 @@ def _flight_row(P, t_lo, i, lo, tau, fs, row):
     row[TR_L] = l0
     row[TR_BETA] = fs[6]
     row[TR_LD] = 0.0
-    row[TR_BETAD] = P[P_OMEGA] if P[P_GLOBAL] != 0.0 else P[P_OMEGA] - fs[5]
+    row[TR_BETAD] = flight_leg_angle(P, lo[4], lo[5], tau, retraction_start(P, lo[3]))[1]
     row[TR_ALPHA] = fs[6] + fs[4]
     row[TR_FOOTX] = fs[7]
     row[TR_FOOTY] = fs[8]

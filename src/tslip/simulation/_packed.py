@@ -90,7 +90,9 @@ def alpha_r_column(P: np.ndarray, out: np.ndarray) -> np.ndarray:
     """``dq'/d alpha_r`` of a completed stride (5,), from its ``out`` vector.
 
     ``alpha_r`` only moves the swing leg in flight (eq. 2.17): the leg angle
-    ``beta(t) = alpha_r + omega_r t [- phi(t)]`` and so the touch-down time
+    ``beta(t) = alpha_r + omega_r (t - t_apex)^+ [- phi(t)]`` (``t_apex = 0``
+    for the lift-off clock, :func:`._kernels.retraction_start`; ``alpha_r``
+    shifts the whole flight's angle alike) and so the touch-down time
     ``t_TD``, a root of the foot height ``f(t) = y_hip(t) - l0 sin beta(t) - H``.
     With ``df/d alpha_r = -l0 cos beta`` the implicit derivative is
     ``dt_TD/d alpha_r = l0 cos beta / f'(t_TD)``, and ``q' = (beta(t),
@@ -101,7 +103,7 @@ def alpha_r_column(P: np.ndarray, out: np.ndarray) -> np.ndarray:
     tf = out[pk.OUT_TF]
     phi0, yd0, phid0 = out[pk.OUT_LO + 4], out[pk.OUT_LO + 3], out[pk.OUT_LO + 5]
     b = out[pk.OUT_TD]  # beta(t_TD)
-    bdot = P[pk.P_OMEGA] if P[pk.P_GLOBAL] != 0.0 else P[pk.P_OMEGA] - phid0
+    _, bdot = kn.flight_leg_angle(P, phi0, phid0, tf, kn.retraction_start(P, yd0))
     ph = phi0 + phid0 * tf
     dfdt = yd0 - g * tf - r * math.sin(ph) * phid0 - l0 * math.cos(b) * bdot
     dt = l0 * math.cos(b) / dfdt

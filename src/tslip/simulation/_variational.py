@@ -12,7 +12,11 @@ chain; each link is differentiated exactly:
    ``dy_LO = Phi - f (grad F_y . Phi) / (grad F_y . f)``;
 4. lift-off -> CoM flight state, analytic;
 5. the closed-form flight, with the touch-down time's implicit derivative
-   ``dt_TD = -(df/dlo) / (df/dt)`` for the foot height ``f``.
+   ``dt_TD = -(df/dlo) / (df/dt)`` for the foot height ``f``; with the apex
+   retraction clock (``retraction="apex"``) the touch-down leg angle also
+   depends on the lift-off ``ydot`` through the apex time ``t_apex = ydot / g``,
+   ``d beta / d ydot = -omega_r / g`` when the leg retracts at touch-down (0 when
+   it touches down still held, and for a flight without apex).
 
 ``Df`` comes from differentiating ``M qdd = R`` (eq. 2.3, ``R = Q - C``):
 ``d qdd = M^-1 (dR - dM qdd)``, with the closed-form ``M^-1`` of
@@ -40,6 +44,7 @@ from ..model._pack import (
     P_K,
     P_L0,
     P_M,
+    P_OMEGA,
     P_R,
     ST_OK,
 )
@@ -49,6 +54,7 @@ from ._kernels import (
     NSTATE,
     flight_leg_angle,
     hip_torque,
+    retraction_start,
     rhs,
     stance_accel,
     stance_initial,
@@ -253,15 +259,20 @@ def stride_jacobian(P, O, td, tx, th, Jq, out):
     phi0 = out[OUT_LO + 4]
     phid0 = out[OUT_LO + 5]
     yd0 = out[OUT_LO + 3]
-    bt, bdot = flight_leg_angle(P, phi0, phid0, tf)
+    ta = retraction_start(P, yd0)
+    bt, bdot = flight_leg_angle(P, phi0, phid0, tf, ta)
     pht = phi0 + phid0 * tf
     local = P[P_GLOBAL] == 0.0
     dbdphi = -1.0 if local else 0.0
     dbdphid = -tf if local else 0.0
+    # apex clock: beta = alpha_r + omega_r (t - yd0 / g) [- phi(t)] once retracting
+    dbdyd = -P[P_OMEGA] / g if (ta > 0.0 and tf >= ta) else 0.0
     spt, cbt = math.sin(pht), math.cos(bt)
     # partials of f with respect to lo = (y, xd, yd, phi, phid) and t
     df = np.array([1.0, 0.0, tf, -r * spt - l0 * cbt * dbdphi,
                    -r * spt * tf - l0 * cbt * dbdphid])
+    if dbdyd != 0.0:
+        df[2] -= l0 * cbt * dbdyd
     dfdt = yd0 - g * tf - r * spt * phid0 - l0 * cbt * bdot
     dttd = np.zeros(5)
     for j in range(5):
@@ -272,6 +283,8 @@ def stride_jacobian(P, O, td, tx, th, Jq, out):
     # q' = (beta(t), phi(t), xd, yd - g t, phid)
     for j in range(5):
         Jq[0, j] = dbdphi * G[3, j] + dbdphid * G[4, j] + bdot * dttd[j]
+        if dbdyd != 0.0:
+            Jq[0, j] += dbdyd * G[2, j]
         Jq[1, j] = G[3, j] + tf * G[4, j] + phid0 * dttd[j]
         Jq[2, j] = G[1, j]
         Jq[3, j] = G[2, j] - g * dttd[j]
