@@ -18,6 +18,7 @@ from tslip import gait as tg
 from tslip._results import Result
 
 P = tslip.preset("table6.1")
+SLIP = tslip.preset("slip")
 
 
 @pytest.fixture(scope="module")
@@ -55,6 +56,9 @@ def _objects(gait) -> dict[str, object]:
         "StepDownResponse": tg.step_down_response(gait, -0.05, n_steps=4),
         "VelocityAngleCase": tg.velocity_angle_effect(gait, (0.02,))[0],
         "GaitReport": tg.analyse(gait.params, gait=gait, n_steps=5),
+        "GaitSet": tslip.all_gaits(SLIP, energy=2.2),
+        "StableRegion": tslip.stable_region(SLIP, {"beta0": [1.17, 1.19], "k": [25.0, 27.0]},
+                                            energy=2.2),
     }
 
 
@@ -106,9 +110,10 @@ NAMES = ["Trajectory", "Trajectory, a fall", "StepResult", "BatchStep", "BatchRu
          "Floquet", "RobustnessResult", "RobustnessLimit", "Impulse", "ImpulseLinearisation",
          "PitchResponse", "Branch", "StrideProperties", "FrictionCheck", "HeightChangeResult",
          "StepDownResponse", "VelocityAngleCase", "StudyResult", "SyntheticRun", "StepData",
-         "StepAverage", "FitResult", "TrackResult", "GaitReport"]
+         "StepAverage", "FitResult", "TrackResult", "GaitReport", "GaitSet", "StableRegion"]
 #: Classes without a figure of their own.
-NO_PLOT = {"BatchStep", "RobustnessLimit", "StrideProperties", "SyntheticRun", "TrackResult"}
+NO_PLOT = {"BatchStep", "RobustnessLimit", "StrideProperties", "SyntheticRun", "TrackResult",
+           "GaitSet"}
 
 
 @pytest.mark.parametrize("name", NAMES)

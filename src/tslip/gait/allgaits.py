@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._results import Result
 from ..model.parameters import PARAMETER_TABLE, Params
 from ..simulation.options import IntegratorOptions
 from .continuation import get_param, set_param
@@ -54,7 +55,7 @@ _SAME = 1e-7  # two solutions with delta and alpha_r this close are one gait
 
 
 @dataclass(frozen=True, eq=False)
-class GaitSet:
+class GaitSet(Result):
     """The periodic gaits found at one energy and one set of parameters.
 
     Attributes
@@ -220,7 +221,7 @@ def all_gaits(
 
 
 @dataclass(frozen=True, eq=False)
-class StableRegion:
+class StableRegion(Result):
     """The gaits of each cell of a two-parameter grid at fixed energy.
 
     Arrays have shape ``(len(values[0]), len(values[1]))``: rows the first
