@@ -33,7 +33,7 @@ from .._checks import check_fields
 from .._renamed import accepts_n_strides, module_getattr, warn_renamed
 from .._results import Result, frame, with_units
 from ..model._pack import METHODS
-from ..simulation.result import Status
+from ..simulation.result import Outcome, Status
 from . import _kernels as kn
 from . import _pack as pk
 from ._legacy import SIMULATE_ALIASES
@@ -404,7 +404,7 @@ def simulate(
 
 
 @dataclass(frozen=True, slots=True, repr=False)
-class StepResult(Result):
+class StepResult(Result, Outcome):
     """One stride of the biped (right touch-down to the next), as :func:`step` returns it.
 
     The biped's counterpart of :class:`tslip.StepResult` (both are
@@ -439,20 +439,6 @@ class StepResult(Result):
         row.update(zip(CONTACT_FIELDS, np.asarray(self.contact).tolist()))
         return frame([row], BIPED_UNITS)
 
-    @property
-    def fell(self) -> bool:
-        """True if the runner fell in this stride."""
-        return self.status.fell
-
-    @property
-    def ok(self) -> bool:
-        """True if the stride ended in a right touch-down."""
-        return self.status == Status.OK
-
-    @property
-    def reason(self) -> str:
-        """Why the stride ended as it did."""
-        return self.status.reason
 
 
 _NO_REC = np.empty((0, pk.NREC))

@@ -25,7 +25,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "Status", "LiftoffState", "StepResult", "StepList", "Trajectory", "Event", "EventList",
-    "IntegrationError",
+    "IntegrationError", "Outcome",
 ]
 
 
@@ -131,8 +131,30 @@ class LiftoffState:
         return cls(*map(float, out[pk.OUT_LO : pk.OUT_LO + 10]))
 
 
+class Outcome:
+    """``fell``, ``ok`` and ``reason`` of a stride with a ``status`` (both models' StepResult)."""
+
+    __slots__ = ()
+    status: Status
+
+    @property
+    def fell(self) -> bool:
+        """True if the runner fell in this stride."""
+        return self.status.fell
+
+    @property
+    def ok(self) -> bool:
+        """True if the stride ended in its touch-down (the biped's: the right foot's)."""
+        return self.status == Status.OK
+
+    @property
+    def reason(self) -> str:
+        """Why the stride ended as it did."""
+        return self.status.reason
+
+
 @dataclass(frozen=True, slots=True)
-class StepResult(Result):
+class StepResult(Result, Outcome):
     """One stride: touch-down, stance, lift-off, flight, next touch-down.
 
     Attributes
@@ -216,20 +238,6 @@ class StepResult(Result):
             params=params,
         )
 
-    @property
-    def fell(self) -> bool:
-        """True if the runner fell in this stride."""
-        return self.status.fell
-
-    @property
-    def ok(self) -> bool:
-        """True if the stride ended in a touch-down."""
-        return self.status == Status.OK
-
-    @property
-    def reason(self) -> str:
-        """Why the stride ended as it did."""
-        return self.status.reason
 
     @property
     def impulse(self) -> tuple[float, float]:
