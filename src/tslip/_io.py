@@ -84,16 +84,28 @@ def read_toml(path: str | Path, what: str) -> dict:
         raise ValueError(f"{what} {str(path)!r} is not valid TOML: {exc}") from None
 
 
-def git_hash() -> str | None:
-    """The source checkout's commit, if the package runs from one."""
-    import subprocess
+#: Seconds a :func:`git_hash` answer is reused (``tslip reproduce`` records it for each of
+#: its studies; each ``git`` call costs tens of milliseconds).
+GIT_HASH_SECONDS = 60.0
+_git_cache: list[Any] = []  # [monotonic time, answer] of the last git call
 
+
+def git_hash() -> str | None:
+    """The source checkout's commit, if the package runs from one (asked at most once a minute)."""
+    import subprocess
+    import time
+
+    now = time.monotonic()
+    if _git_cache and now - _git_cache[0] < GIT_HASH_SECONDS:
+        return _git_cache[1]
     try:
         out = subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent,
                              capture_output=True, text=True, timeout=5)
+        answer = out.stdout.strip() or None if out.returncode == 0 else None
     except (OSError, subprocess.SubprocessError):
-        return None
-    return out.stdout.strip() or None if out.returncode == 0 else None
+        answer = None
+    _git_cache[:] = [now, answer]
+    return answer
 
 
 def write_mp4(

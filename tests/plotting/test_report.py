@@ -282,3 +282,25 @@ def test_reproduce_cli_prints_each_verdict_and_the_count_per_verdict(page, tmp_p
         assert row.rstrip().endswith(c.verdict.value)
     for v in Verdict:
         assert f"{v.value}: {sum(c.verdict is v for c in claims)}" in r.output
+
+
+def test_figures_are_tasks_ready_when_their_data_arrive_and_drawn_alike_in_workers(data):
+    """``tslip reproduce`` draws each figure on the worker pool once its data are in; the
+    PNGs equal those drawn here, byte for byte."""
+    from tslip.sweeps._schedule import run_tasks
+
+    plots = report.ReportPlots()
+    assert set(plots.inputs) == set(report._plots(data))  # every figure is a task
+    assert plots.ready({}) == []
+    grids = report.figure_inputs()["4.10"]
+    assert len(grids) == 4
+    partial = {k: data[k] for k in grids[:-1]}
+    assert plots.ready(partial) == []  # Figure 4.10 waits for its last grid
+    tasks = plots.ready({"E": data["E"], **partial})
+    assert sorted(t.key[1] for t in tasks) == ["E.2", "E.3", "E.4"]
+    tasks += plots.ready(data)
+    assert sorted(t.key[1] for t in tasks) == sorted(plots.inputs)  # each once
+    assert plots.ready(data) == [] and plots.cost == 0
+    run_tasks(tasks, lambda task, result: plots.done(task, result) or [], workers=2)
+    direct = {k: report.figure_png(make()) for k, make in report._plots(data).items()}
+    assert plots.images == direct

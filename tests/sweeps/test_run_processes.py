@@ -196,3 +196,21 @@ def test_wait_blocks_until_the_holder_releases(tmp_path, caplog):
         t.join(timeout=30)
     assert got.is_set()
     assert f"pid {os.getpid()}" in caplog.records[0].getMessage()
+
+
+def test_ctrl_c_during_the_final_wait_stops_the_workers():
+    """Leaving the block starts a wait for the workers (one still busy here, as a slow
+    starter would be); a Ctrl-C during it stops them instead of leaving them running."""
+    import threading
+
+    from tslip.sweeps._pool import process_pool
+
+    ctrl_c = threading.Timer(3.0, os.kill, (os.getpid(), signal.SIGINT))
+    t0 = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        with process_pool(2) as pool:
+            pool.submit(time.sleep, 120)
+            workers = list(pool._processes.values())
+            ctrl_c.start()
+    assert time.monotonic() - t0 < 60  # not waited for
+    assert workers and not any(w.is_alive() for w in workers)

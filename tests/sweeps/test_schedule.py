@@ -146,7 +146,9 @@ def test_parallel_reproduction_equals_serial_bit_for_bit(serial_tiny, tmp_path):
     from tslip.sweeps.reproduce import run_all
 
     timing: dict = {}
-    data, claims, _ = run_all(tmp_path, resolution="tiny", workers=2, timing=timing)
+    info: dict = {}
+    data, claims, _ = run_all(tmp_path, resolution="tiny", workers=2, timing=timing, info=info)
+    assert info == {"workers": 2}  # named in the report's header
     _same(serial_tiny[0], data)
     assert _claims(serial_tiny[1]) == _claims(claims)
     # every line solved once, every point computed once and cached

@@ -24,7 +24,8 @@ from .. import __version__
 from .._io import atomic_write, write_json
 from ..sweeps.claims import Verdict
 
-__all__ = ["reproduce", "write_report", "figure_png", "render_ready", "SECTIONS"]
+__all__ = ["PLOT_SECONDS", "SECTIONS", "ReportPlots", "compute", "figure_inputs", "figure_png",
+           "plot_task", "render_ready", "reproduce", "write_report"]
 
 
 def figure_png(fig: Figure, dpi: int = 80) -> str:
@@ -34,7 +35,35 @@ def figure_png(fig: Figure, dpi: int = 80) -> str:
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
+#: Controller studies of Figures 4.24-4.25: legend label -> study name.
+_CONTROLLERS = {"passive": "mass_offset", "global PD": "controller_global_pd",
+                "local velocity": "controller_local_velocity",
+                "constant torque": "controller_constant_torque"}
+#: The studies drawn as a multipliers figure and a robustness figure: (figures, study).
+_STUDY_PAIRS = ((("4.8", "4.9"), "velocity"), (("4.12", "4.13"), "leg_damping"),
+                (("4.14", "4.15"), "hip_damping"), (("4.16", "4.17"), "mass_offset"),
+                (("4.18", "4.19"), "stiffness"), (("4.20", "4.21"), "touchdown_angle"),
+                (("4.22", "4.23"), "retraction"))
+_STRIDE_STUDIES = ("stride_v0", "stride_k", "stride_beta0")
+
+
+def figure_inputs() -> dict[str, tuple[str, ...]]:
+    """The data keys each report figure is drawn from (:func:`_plots`), by figure."""
+    from ..sweeps.catalogue import GRID_SPEEDS
+
+    inputs: dict[str, tuple[str, ...]] = {
+        k: (k,) for k in ("4.1", "4.2", "4.3", "6.2", "4.4", "4.5", "4.7", "C.1")}
+    inputs.update(dict.fromkeys(("E.2", "E.3", "E.4"), ("E",)))
+    inputs["4.10"] = tuple(f"grid_v{v:g}" for v in GRID_SPEEDS)
+    inputs["4.11"] = _STRIDE_STUDIES
+    inputs["4.24"] = inputs["4.25"] = tuple(_CONTROLLERS.values())
+    for figs, name in _STUDY_PAIRS:
+        inputs.update(dict.fromkeys(figs, (name,)))
+    return inputs
+
+
 def _plots(data: Mapping[str, Any]) -> dict[str, Callable[[], Figure]]:
+    """Each report figure's plot, from ``data`` (its keys: :func:`figure_inputs`)."""
     from ..sweeps.catalogue import GRID_SPEEDS
     from . import biped as b
     from . import gait as g
@@ -60,9 +89,7 @@ def _plots(data: Mapping[str, Any]) -> dict[str, Callable[[], Figure]]:
         axes[0].set_ylabel("Δv [g^1/2 L^1/2]")
         return fig
 
-    ctrl = {"passive": "mass_offset", "global PD": "controller_global_pd",
-            "local velocity": "controller_local_velocity",
-            "constant torque": "controller_constant_torque"}
+    ctrl = _CONTROLLERS
     plots: dict[str, Callable[[], Figure]] = {
         "4.1": lambda: g.plot_impulse_linearisation(data["4.1"]),
         "4.2": lambda: g.plot_pitch_impulse(data["4.2"]),
@@ -77,15 +104,11 @@ def _plots(data: Mapping[str, Any]) -> dict[str, Callable[[], Figure]]:
         "E.3": lambda: b.plot_foot_path(data["E"]["e2"]["run"], stride=0),
         "E.4": lambda: b.plot_metacentric(data["E"]["converged"]["metacentric"]),
         "4.10": lambda: s.plot_stable_grid({v: data[f"grid_v{v:g}"] for v in GRID_SPEEDS}),
-        "4.11": lambda: s.plot_stride_times({n: data[n] for n in
-                                             ("stride_v0", "stride_k", "stride_beta0")}),
+        "4.11": lambda: s.plot_stride_times({n: data[n] for n in _STRIDE_STUDIES}),
         "4.24": lambda: s.plot_controllers_multipliers({k: data[v] for k, v in ctrl.items()}),
         "4.25": lambda: s.plot_controllers_robustness({k: data[v] for k, v in ctrl.items()}),
     }
-    for figs, name in ((("4.8", "4.9"), "velocity"), (("4.12", "4.13"), "leg_damping"),
-                       (("4.14", "4.15"), "hip_damping"), (("4.16", "4.17"), "mass_offset"),
-                       (("4.18", "4.19"), "stiffness"), (("4.20", "4.21"), "touchdown_angle"),
-                       (("4.22", "4.23"), "retraction")):
+    for figs, name in _STUDY_PAIRS:
         p = pair(name)
         plots[figs[0]], plots[figs[1]] = p["eig"], p["rob"]
     return plots
@@ -286,6 +309,61 @@ def _global_pd_note(data: Mapping[str, Any]) -> str:
             "near-periodic gait.</p>")
 
 
+#: Estimated CPU seconds to draw one report figure (:class:`ReportPlots`).
+PLOT_SECONDS = 0.5
+
+
+def plot_task(fkey: str, inputs: Mapping[str, Any], tick: Any = None) -> str | None:
+    """Figure ``fkey`` as a PNG data URI, from its inputs (a task, in a worker).
+
+    None if the plot fails: :func:`write_report` draws it again here and
+    reports the error in the page.
+    """
+    try:
+        return figure_png(_plots(inputs)[fkey]())
+    except Exception:  # noqa: BLE001 - reported by write_report
+        return None
+
+
+class ReportPlots:
+    """The report's figures as tasks of ``tslip reproduce``'s scheduler.
+
+    Passed to :func:`tslip.sweeps.reproduce.run_all` as ``extra``: each
+    figure is a task (:func:`plot_task`) made ready as soon as the data it is
+    drawn from (:func:`figure_inputs`) have arrived, so the figures are drawn
+    on the worker pool while the rest is computed; ``images`` collects them.
+    """
+
+    #: What :func:`plot_task` imports (for the workers to import once).
+    modules = (__name__, "tslip.plotting.biped", "tslip.plotting.gait", "tslip.plotting.studies")
+
+    def __init__(self) -> None:
+        self.inputs = figure_inputs()
+        self.images: dict[str, str] = {}
+        self.sent: set[str] = set()
+
+    @property
+    def cost(self) -> float:
+        """Estimated seconds of the figures not yet sent."""
+        return PLOT_SECONDS * (len(self.inputs) - len(self.sent))
+
+    def ready(self, data: Mapping[str, Any]) -> list[Any]:
+        """Tasks for the figures whose data ``data`` now holds (each figure once)."""
+        from ..sweeps._schedule import Task
+
+        out = []
+        for fkey, keys in self.inputs.items():
+            if fkey not in self.sent and all(k in data for k in keys):
+                self.sent.add(fkey)
+                out.append(Task(("plot", fkey), plot_task,
+                                (fkey, {k: data[k] for k in keys}), PLOT_SECONDS))
+        return out
+
+    def done(self, task: Any, result: str | None) -> None:
+        if result is not None:
+            self.images[task.key[1]] = result
+
+
 def render_ready(data: Mapping[str, Any], images: dict[str, str]) -> None:
     """Add to ``images`` every figure whose data ``data`` holds (for plotting as data arrive)."""
     for fkey, make in _plots(data).items():
@@ -365,23 +443,38 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
     return path
 
 
+def compute(out_dir: str | Path, *, quick: bool = False, resolution: str | None = None,
+            workers: int | None = None, scheduler: str | None = None,
+            progress: Callable[[str, str, float], None] | None = None,
+            timing: dict[Any, tuple[float, float, Any]] | None = None,
+            ) -> tuple[dict[str, Any], list[Any], float, dict[str, str], int]:
+    """:func:`tslip.sweeps.reproduce.run_all` with the report's figures drawn as its tasks.
+
+    Returns the data, the claims, the seconds, the figures (PNG data URIs by
+    key, for :func:`write_report`) and the worker processes used.
+    """
+    from ..sweeps.reproduce import run_all
+
+    plots = ReportPlots()
+    info: dict[str, Any] = {}
+    data, claims, seconds = run_all(out_dir, quick=quick, resolution=resolution,
+                                    workers=workers, scheduler=scheduler, progress=progress,
+                                    timing=timing, extra=plots, info=info)
+    return data, claims, seconds, plots.images, int(info["workers"])
+
+
 def reproduce(out_dir: str | Path, *, quick: bool = False, workers: int | None = None,
               scheduler: str | None = None,
               progress: Callable[[str, str, float], None] | None = None) -> Path:
     """Run every thesis study and figure and write ``out_dir/index.html``.
 
-    See :func:`tslip.sweeps.reproduce.run_all` for the parameters. Returns
-    the report's path.
+    See :func:`tslip.sweeps.reproduce.run_all` for the parameters; the
+    figures are drawn on the same worker pool as the studies
+    (:class:`ReportPlots`), and the page names the worker count used.
+    Returns the report's path.
     """
-    import os
-
-    from ..sweeps.reproduce import run_all
-
-    images: dict[str, str] = {}  # plotted as the data arrive, while the rest is computed
-    data, claims, seconds = run_all(out_dir, quick=quick, workers=workers,
-                                    scheduler=scheduler, progress=progress,
-                                    on_result=lambda d: render_ready(d, images))
-    n = workers if workers is not None else (os.cpu_count() or 1)
+    data, claims, seconds, images, n = compute(out_dir, quick=quick, workers=workers,
+                                               scheduler=scheduler, progress=progress)
     path = write_report(Path(out_dir) / "index.html", data, claims, quick=quick,
                         seconds=seconds, workers=n, images=images)
     if progress:

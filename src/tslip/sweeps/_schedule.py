@@ -122,7 +122,7 @@ def _timed(fn: Callable[..., Any], args: tuple[Any, ...],
 def run_tasks(tasks: Iterable[Task], on_done: OnDone, workers: int = 1,
               tick: Callable[[int], None] | None = None,
               timing: dict[Hashable, tuple[float, float, Hashable]] | None = None,
-              scheduler: str | None = None) -> None:
+              scheduler: str | None = None, preload: Iterable[str] = ()) -> None:
     """Run ``tasks`` and every task their results make ready; see the module docstring.
 
     ``workers``: 1 runs each task here; more starts that many processes.
@@ -131,6 +131,9 @@ def run_tasks(tasks: Iterable[Task], on_done: OnDone, workers: int = 1,
     task, ``parent`` the key of the task whose result made it ready (or None).
     ``scheduler``: address of a Dask cluster to run the tasks on instead
     (``workers`` is then ignored; the tasks cannot report progress).
+    ``preload``: modules of tasks made ready later, for the workers to import
+    once (:func:`tslip.sweeps._pool.process_pool`); the first tasks' modules
+    are imported anyway.
     """
     order = itertools.count()
     ready: list[tuple[float, int, Task]] = []
@@ -159,9 +162,10 @@ def run_tasks(tasks: Iterable[Task], on_done: OnDone, workers: int = 1,
         return
     if not ready:
         return
+    modules = dict.fromkeys([*(t.fn.__module__ for _, _, t in ready), *preload])
     queue = _pool.progress_queue()
     try:
-        with _pool.process_pool(workers, queue) as pool:
+        with _pool.process_pool(workers, queue, preload=modules) as pool:
             running: dict[cf.Future, Task] = {}
             while ready or running:
                 while ready and len(running) <= workers:

@@ -35,10 +35,10 @@ import itertools
 import math
 import pickle
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from contextlib import ExitStack
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -50,7 +50,7 @@ from ..gait.robustness import robustness
 from ..model.controllers import LocalVelocity
 from ..model.parameters import preset
 from ..simulation.options import IntegratorOptions
-from . import catalogue
+from . import _pool, catalogue
 from ._lock import folder_lock
 from ._schedule import Task, choose_workers, run_tasks
 from .claims import ClaimResult, evaluate
@@ -78,6 +78,27 @@ APPENDIX_E_SETTINGS: dict[str, dict[str, Any]] = {
 
 #: ``progress(stage, name, seconds)`` after each study or figure.
 Progress = Callable[[str, str, float], None]
+
+
+class Extra(Protocol):
+    """More tasks on the results as they arrive (the report's figures,
+    :class:`tslip.plotting.report.ReportPlots`), run on the same pool.
+
+    ``ready(data so far)`` returns the tasks the data now allow (keys not
+    starting with a study's name or ``"figure"``), ``done(task, result)``
+    takes each result here, ``cost`` estimates the seconds not yet sent and
+    ``modules`` names the modules its tasks use (for the workers to import once).
+    """
+
+    @property
+    def cost(self) -> float: ...
+
+    @property
+    def modules(self) -> tuple[str, ...]: ...
+
+    def ready(self, data: Mapping[str, Any]) -> list[Task]: ...
+
+    def done(self, task: Task, result: Any) -> None: ...
 
 
 #: Table 6.1's pitch-rate limit variants (:func:`pitch_rate_variants`): label ->
@@ -351,6 +372,7 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
             resolution: str | None = None,
             timing: dict[Any, tuple[float, float, Any]] | None = None,
             on_result: Callable[[dict[str, Any]], None] | None = None,
+            extra: Extra | None = None, info: dict[str, Any] | None = None,
             ) -> tuple[dict[str, Any], list[ClaimResult], float]:
     """Run every thesis study and figure; return the data, the claims and the seconds.
 
@@ -380,7 +402,12 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
         Filled with each task's CPU and wall seconds (see :func:`run_catalogue`).
     on_result : callable, optional
         ``on_result(data)`` here after each study and figure, with the data so
-        far (e.g. to plot while the rest is computed).
+        far.
+    extra : Extra, optional
+        More tasks on the data as they arrive, on the same pool (the report's
+        figures: :class:`tslip.plotting.report.ReportPlots`).
+    info : dict, optional
+        Filled with ``"workers"``: the worker processes used.
 
     Returns
     -------
@@ -395,7 +422,7 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     results = run_catalogue(out, res, workers=workers, scheduler=scheduler, progress=progress,
-                            timing=timing, on_result=on_result)
+                            timing=timing, on_result=on_result, extra=extra, info=info)
     order = [*catalogue.STUDIES, *_figure_jobs(res), "table6.1", "E"]
     data: dict[str, Any] = {**{k: results[k] for k in order},
                             "quick": res != "full", "resolution": res}
@@ -406,18 +433,25 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
                   workers: int | None = None, scheduler: str | None = None,
                   progress: Progress | None = None,
                   timing: dict[Any, tuple[float, float, Any]] | None = None,
-                  on_result: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
+                  on_result: Callable[[dict[str, Any]], None] | None = None,
+                  extra: Extra | None = None,
+                  info: dict[str, Any] | None = None) -> dict[str, Any]:
     """Every study and single-gait figure as tasks of one scheduler; results by key.
 
     Each study folder is locked (:func:`tslip.sweeps._lock.folder_lock`)
     for the run. ``timing`` receives each task's CPU and wall seconds and
     the task that made it ready (:func:`tslip.sweeps._schedule.run_tasks`);
-    ``on_result(data so far)`` is called after each study and figure.
+    ``on_result(data so far)`` is called after each study and figure, and
+    ``extra``'s tasks (:class:`Extra`) run as the data they need arrive;
+    ``info["workers"]`` is set to the worker count used.
     """
     res = catalogue.resolution_name(resolution)
     out = Path(out_dir)
     specs = catalogue.studies(res)
     results: dict[str, Any] = {}
+    preload = ["tslip.sweeps.run", __name__, *(extra.modules if extra is not None else ())]
+    if scheduler is None and workers != 1:  # likely parallel: the workers' imports start now
+        _pool.prestart(preload)
     with ExitStack() as locks:
         jobs: dict[str, StudyJob] = {}
         for name, spec in specs.items():
@@ -425,13 +459,27 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
             locks.enter_context(folder_lock(folder))
             jobs[name] = StudyJob(spec, folder, writes=scheduler is None)
 
+        follow: list[Task] = []  # extra's tasks made ready by the last arrival
+
         def arrived() -> None:
-            if on_result is not None:
-                on_result({**results, **figures.data})
+            if on_result is not None or extra is not None:
+                data = {**results, **figures.data}
+                if on_result is not None:
+                    on_result(data)
+                if extra is not None:
+                    follow.extend(extra.ready(data))
+
+        def followers() -> list[Task]:
+            out = follow[:]
+            follow.clear()
+            return out
 
         figures = _Figures(res, out, progress, arrived)
         cost = sum(j.cost for j in jobs.values()) + figures.cost
+        cost += extra.cost if extra is not None else 0.0
         n = 1 if scheduler is not None else choose_workers(cost, workers)
+        if info is not None:
+            info["workers"] = n
         t0 = time.perf_counter()
 
         def study_done(name: str) -> None:
@@ -443,15 +491,18 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
         def on_done(task: Task, result: Any) -> list[Task]:
             owner = task.key[0]
             if owner == "figure":
-                return figures.on_done(task, result)
+                return figures.on_done(task, result) + followers()
+            if owner not in jobs and extra is not None:
+                extra.done(task, result)
+                return []
             new = jobs[owner].on_done(task, result)
             if jobs[owner].finished:
                 study_done(owner)
-            return new
+            return new + followers()
 
         for name in [n for n, j in jobs.items() if j.finished]:
             study_done(name)
         arrived()  # what was cached
-        tasks = [t for j in jobs.values() for t in j.start()] + figures.tasks
-        run_tasks(tasks, on_done, n, timing=timing, scheduler=scheduler)
+        tasks = [t for j in jobs.values() for t in j.start()] + figures.tasks + followers()
+        run_tasks(tasks, on_done, n, timing=timing, scheduler=scheduler, preload=preload)
     return {**results, **figures.data}
