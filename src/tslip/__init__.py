@@ -7,7 +7,7 @@ The public names below are imported on first use (PEP 562), so ``import
 tslip`` loads neither numba's kernels nor pandas or scipy.
 """
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 from typing import TYPE_CHECKING  # noqa: E402
 
