@@ -33,7 +33,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._results import Result
-from ..model.parameters import PARAMETER_TABLE, Params
+from ..model.parameters import Params
+from ..model.units import COLUMN_UNITS, param_unit
 from ..simulation.options import IntegratorOptions
 from .continuation import get_param, set_param
 from .fixed_point import Gait, find_gait
@@ -127,10 +128,8 @@ class GaitSet(Result):
         cols = ["delta", "v", "apex_y", "alpha_r", "stance_time", "flight_time", "energy",
                 "max_nontrivial", "stability", "residual"]
         df = pd.DataFrame(rows, columns=cols)
-        df.attrs["units"] = {"delta": "rad", "v": "g^1/2 L^1/2", "apex_y": "L", "alpha_r": "rad",
-                             "stance_time": "g^-1/2 L^1/2", "flight_time": "g^-1/2 L^1/2",
-                             "energy": "MgL", "max_nontrivial": "-", "stability": "-",
-                             "residual": "-"}
+        df.attrs["units"] = {c: COLUMN_UNITS.get(c, "-") for c in cols}
+        df.attrs["units"]["apex_y"] = COLUMN_UNITS["y"]
         return df
 
 
@@ -274,8 +273,7 @@ class StableRegion(Result):
         df = pd.DataFrame({self.names[0]: a.ravel(), self.names[1]: b.ravel(),
                            "n_gaits": self.n_gaits.ravel(), "n_stable": self.n_stable.ravel(),
                            "max_nontrivial": self.max_nontrivial.ravel()})
-        units = {row.name: row.unit for row in PARAMETER_TABLE}
-        df.attrs["units"] = {n: units.get(n, "-") for n in self.names}
+        df.attrs["units"] = {n: param_unit(n) or "-" for n in self.names}
         df.attrs["units"].update({"n_gaits": "-", "n_stable": "-", "max_nontrivial": "-"})
         return df
 

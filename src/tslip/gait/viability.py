@@ -38,7 +38,8 @@ import numpy as np
 from .._checks import check_number
 from .._results import Result, with_units
 from ..model import _pack as pk
-from ..model.parameters import PARAMETER_TABLE, Params
+from ..model.parameters import Params
+from ..model.units import COLUMN_UNITS, param_unit
 from ..simulation.integrate import run_batch
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status
@@ -59,12 +60,11 @@ __all__ = ["StateActionMap", "Viability", "Basin", "state_action_map", "viabilit
 STATE_NAMES = ("y", "phi", "phid")
 
 #: Units of the apex-section variables a grid can span.
-SECTION_UNITS = {"y": "L", "xd": "g^1/2 L^1/2", "phi": "rad", "phid": "rad g^1/2 L^-1/2"}
-_PARAM_UNITS = {row.name: row.unit for row in PARAMETER_TABLE}
+SECTION_UNITS = {n: COLUMN_UNITS[n] for n in ("y", "xd", "phi", "phid")}
 
 
 def _unit(name: str) -> str:
-    return SECTION_UNITS.get(name, _PARAM_UNITS.get(name, "-"))
+    return SECTION_UNITS.get(name) or param_unit(name) or "-"
 
 
 def _short(axes: Sequence[np.ndarray], names: Sequence[str]) -> str:
