@@ -14,6 +14,7 @@ import pytest
 
 import tslip
 from _result_checks import check_frozen, check_plot, check_repr, check_round_trip, check_units
+from experiment._truth import truth_tracks
 from tslip import gait as tg
 from tslip._results import Result
 
@@ -64,7 +65,6 @@ def _objects(gait) -> dict[str, object]:
 
 def _study_and_experiment(gait) -> dict[str, object]:
     """A two-point study, and the video pipeline on a short synthetic run."""
-    import pandas as pd
 
     from tslip.experiment.fit import FitResult, fit_scores, model_curves, stride_table
     from tslip.experiment.render import camera_frames
@@ -78,12 +78,7 @@ def _study_and_experiment(gait) -> dict[str, object]:
                                 analyses=("floquet", "stride")), workers=1)
     cam = Camera(width=512, height=408, fps=500.0)
     run = synthesize(gait.params, gait.state, 1.6, camera=cam)
-    tru = run.truth
-    tracks = pd.DataFrame({"frame": tru["frame"], "t": tru["t"], "body_q": 1, "foot1_q": 1,
-                           "foot2_q": 1})
-    for m, src in (("front", "front"), ("rear", "rear"), ("foot1", "near"), ("foot2", "hind")):
-        tracks[f"{m}_x_m"] = tru[f"{src}_x_m"]
-        tracks[f"{m}_y_m"] = tru[f"{src}_y_m"]
+    tracks = truth_tracks(run)
     data = process_tracks(tracks, cam.fps, run.geometry, options=ProcessOptions(near="foot1"))
     avg = average_steps(data.samples, data.steps)
     curves, ts, tf, _ = model_curves(gait.params, avg.tau)

@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 import tslip
+from experiment._truth import truth_tracks
 from tslip.experiment.fit import fit_scores, model_curves
 from tslip.experiment.signals import (
     SIGNALS,
@@ -79,12 +80,7 @@ def recording():  # noqa: ANN201
     """Step data from the exact marker positions of a 1.6 s synthetic run (4 near steps)."""
     g = tslip.find_gait(tslip.preset("table6.1"))
     run = synthesize(g.params, g.state, 1.6, camera=CAM)
-    tru = run.truth
-    tracks = pd.DataFrame({"frame": tru["frame"], "t": tru["t"], "body_q": 1, "foot1_q": 1,
-                           "foot2_q": 1})
-    for m, src in (("front", "front"), ("rear", "rear"), ("foot1", "near"), ("foot2", "hind")):
-        tracks[f"{m}_x_m"] = tru[f"{src}_x_m"]
-        tracks[f"{m}_y_m"] = tru[f"{src}_y_m"]
+    tracks = truth_tracks(run)
     data = process_tracks(tracks, CAM.fps, run.geometry, options=ProcessOptions(near="foot1"))
     return g, run, data
 
