@@ -179,10 +179,10 @@ def apex_section_ok(params: Params) -> bool:
     """Whether the touch-down leg angle follows from the apex state (the apex is a section).
 
     True without retraction (``omega_r = 0``) or with retraction timed from
-    the apex (``retraction="apex"``, where the parameters have it); a
-    retraction clock running from lift-off needs the time since lift-off.
+    the apex (``retraction="apex"``); a retraction clock running from
+    lift-off needs the time since lift-off.
     """
-    return params.omega_r == 0.0 or getattr(params, "retraction", "liftoff") == "apex"
+    return params.omega_r == 0.0 or params.retraction == "apex"
 
 
 def _check_section(params: Params) -> None:
