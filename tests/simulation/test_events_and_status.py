@@ -157,3 +157,42 @@ def test_negative_fy_from_the_hip_torque_with_the_leg_shortening_keeps_the_stanc
     assert r.stance[0, 4] < 0.0  # ld at touch-down: the spring compresses
     assert r.ok and r.stance_time > 0.3
     assert r.grf[:, 2].max() > 1.0 and r.grf[-1, 2] == pytest.approx(0.0, abs=1e-6)
+
+
+def test_collapsing_leg_is_a_hip_ground_fall():
+    """A soft leg landing fast collapses to zero length with the hip still above the foot
+    by ``l sin(beta) > 0`` all the way: the polar stance equations are singular at ``l = 0``
+    and event 1 never crosses. The stance must end as the hip reaching the ground
+    (eq. 2.11) when ``l`` reaches ``L_COLLAPSE l0``, at the time an independent Cartesian
+    model (tests/simulation/test_reference.py, no singularity there) puts it; before the
+    collapse event it ground on to ``max_steps`` (MAX_STEPS after 100,000 steps).
+    """
+    from tslip.simulation._kernels import L_COLLAPSE
+
+    from .test_reference import _com_from_touchdown, leg_state, stance_rhs
+
+    p = dataclasses.replace(tslip.preset("table2.1-local-velocity"), k=5.0)
+    td = tslip.TouchdownState.from_velocity(v=5.0, delta=-1.0, beta=1.08)
+    tight = tslip.IntegratorOptions.tight()
+    r = tslip.step(p, td, options=tight)
+    assert r.status == Status.FALL_HIP_GROUND
+    assert r.liftoff.l == pytest.approx(L_COLLAPSE * p.l0, rel=1e-9)
+    assert r.n_integrator_steps < 5000
+
+    from scipy.integrate import solve_ivp
+
+    y0, xf = _com_from_touchdown(p, td)
+    s0 = np.array([td.x, y0, td.phi, td.xd, td.yd, td.phid])
+
+    def collapse(t, s):
+        return leg_state(p, s, xf, td.h).l - L_COLLAPSE * p.l0
+
+    collapse.terminal, collapse.direction = True, -1.0
+    sol = solve_ivp(lambda t, s: stance_rhs(p, s, xf, td.h), (0.0, 1.0), s0, method="DOP853",
+                    rtol=1e-12, atol=1e-12, events=collapse)
+    assert sol.t_events[0].size == 1, "the reference leg does not collapse"
+    assert r.stance_time == pytest.approx(sol.t_events[0][0], abs=1e-8)
+    lift = leg_state(p, sol.y_events[0][0], xf, td.h)
+    assert lift.l * math.sin(lift.beta) < L_COLLAPSE * p.l0  # the hip is at the ground
+    # it never lifts off on the way: F_y stays positive up to the collapse
+    assert all(leg_state(p, s, xf, td.h).Fy > 0 for s in sol.y.T)

@@ -186,12 +186,23 @@ def com_velocity(P, y):
                          y[3], y[4], y[5])
 
 
+NEVENTS = 4  # event_values
+#: Leg length, as a fraction of ``l0``, at which a stance ends as the hip reaching the
+#: ground (eq. 2.11, ``Status.FALL_HIP_GROUND``): a leg compressed that far has put the
+#: hip on its foot. Without it such a stance ground on at ever smaller steps until
+#: ``IntegratorOptions.max_steps`` (100,000 steps, about 0.1 s of CPU a stride).
+L_COLLAPSE = 1e-3
+
+
 @njit(**_JIT)
 def event_values(P, y, gv):
     """Stance event functions; each event fires on a crossing from > 0 to <= 0.
 
     0: lift-off, ``F_y`` (eq. 2.8); 1: hip height above the foot
-    ``l sin(beta)`` (eq. 2.11); 2: ``xdot_m`` (eq. 2.10).
+    ``l sin(beta)`` (eq. 2.11); 2: ``xdot_m`` (eq. 2.10); 3: the leg
+    collapsing, ``l - L_COLLAPSE l0``: the hip reaching the foot, on the
+    ground, which event 1 cannot see (it only approaches zero as ``l -> 0``,
+    where the polar equations are singular, ``betad ~ 1/l^2``).
     """
     l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
     sb = math.sin(b)
@@ -201,6 +212,7 @@ def event_values(P, y, gv):
     gv[0] = fl * sb + tau / l * cb  # F_y, eq. 2.6
     gv[1] = l * sb
     gv[2] = -ld * cb + l * sb * bd + P[P_R] * math.cos(ph) * phd  # xdot_m, eq. A.5
+    gv[3] = l - L_COLLAPSE * P[P_L0]
 
 
 # ---------------------------------------------------------------------------
@@ -292,9 +304,9 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
     y = np.empty(NSTATE)
     ynew = np.empty(NSTATE)
     ytmp = np.empty(NSTATE)
-    gv_old = np.empty(3)
-    gv_new = np.empty(3)
-    gv_tmp = np.empty(3)
+    gv_old = np.empty(NEVENTS)
+    gv_new = np.empty(NEVENTS)
+    gv_tmp = np.empty(NEVENTS)
     for i in range(NSTATE):
         y[i] = y0[i]
     nrec_max = rec.shape[0]
@@ -361,8 +373,8 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
         have_dense = False
         # falls first: lift-off wins only if strictly earlier (F_y = F_l sin(beta)
         # and the hip height l sin(beta) vanish together when beta reaches 0)
-        for j in range(3):
-            ev = (1, 2, 0)[j]
+        for j in range(NEVENTS):
+            ev = (1, 3, 2, 0)[j]
             if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
                 if not have_dense:
                     dense_output(P, method, y, ynew, h, K, R, ytmp)
@@ -397,7 +409,7 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
                 y[i] = ynew[i]
             if first_ev == 0:
                 status = ST_OK
-            elif first_ev == 1:
+            elif first_ev == 1 or first_ev == 3:
                 status = ST_FALL_HIP_GROUND
             else:
                 status = ST_FALL_BACKWARD
@@ -407,7 +419,7 @@ def integrate_stance(P, O, y0, yout, rec, rec_dt, stats):
             for i in range(NSTATE):
                 y[i] = ynew[i]
                 K[0, i] = K[ns, i]  # FSAL
-            for i in range(3):
+            for i in range(NEVENTS):
                 gv_old[i] = gv_new[i]
             fac = _rk.step_factor(method, err, 10.0)
             if last_rejected:
