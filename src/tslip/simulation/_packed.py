@@ -117,11 +117,6 @@ def run(P: np.ndarray, O: np.ndarray, td: np.ndarray, n_steps: int,  # noqa: E74
     Stops at the first stride that does not end in a touch-down. Returns
     ``(status, strides completed)``, as one row of :func:`tslip.run_batch`.
     """
-    out = np.empty(pk.NOUT)
-    td = td.copy()
-    for i in range(n_steps):
-        st = int(kn.stride(P, O, td, tx, th, _NO_REC, 0.0, out))
-        if st != pk.ST_OK:
-            return st, i
-        td[:] = out[pk.OUT_TD : pk.OUT_TD + pk.NTD]
-    return pk.ST_OK, n_steps
+    hist = np.empty((n_steps + 1, pk.NTD))
+    st, done, _ = kn.run_row(P, O, td, n_steps, tx, th, hist)  # the strides in compiled code
+    return int(st), int(done)
