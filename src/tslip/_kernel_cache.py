@@ -30,8 +30,9 @@ _ROOT = Path(__file__).parent
 #: Package files whose code is compiled into the kernels (njit functions and
 #: the layout constants they read).
 SOURCES: tuple[str, ...] = (
-    "model/_pack.py", "simulation/_rk.py", "simulation/_kernels.py", "simulation/_variational.py",
-    "biped/_pack.py", "biped/_kernels.py",
+    "model/_pack.py", "simulation/_rk.py", "simulation/_stance.py", "simulation/_flight.py",
+    "simulation/_stepper.py", "simulation/_stride.py", "simulation/_record.py",
+    "simulation/_kernels.py", "simulation/_variational.py", "biped/_pack.py", "biped/_kernels.py",
 )
 
 

@@ -30,7 +30,7 @@ from . import _kernels as kn
 __all__ = ["touchdown", "stride_map", "stride_jacobian", "alpha_r_column", "run"]
 
 _TX = np.empty(0)  # flat ground: no terrain breakpoints
-_NO_REC = np.empty((0, pk.NREC))  # kn.stride records nothing into it
+_NO_REC = np.empty((0, pk.NREC))  # the stride kernels record nothing into it
 
 
 def touchdown(q: np.ndarray, h: float = 0.0) -> np.ndarray:
@@ -48,7 +48,7 @@ def stride_map(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E
     The next section is ``out[OUT_TD:OUT_TD + 5]``; as :func:`tslip.step_map`.
     """
     th = np.array([h])
-    return int(kn.stride(P, O, touchdown(q, h), _TX, th, _NO_REC, 0.0, out))
+    return int(kn.STRIDE[int(O[pk.O_METHOD])](P, O, touchdown(q, h), _TX, th, _NO_REC, 0.0, out))
 
 
 #: The last exact Jacobians, keyed by their exact inputs (P, O, q, h): gait search
@@ -119,8 +119,9 @@ def run(P: np.ndarray, O: np.ndarray, td: np.ndarray, n_steps: int,  # noqa: E74
     """
     out = np.empty(pk.NOUT)
     td = td.copy()
+    stride = kn.STRIDE[int(O[pk.O_METHOD])]
     for i in range(n_steps):
-        st = int(kn.stride(P, O, td, tx, th, _NO_REC, 0.0, out))
+        st = int(stride(P, O, td, tx, th, _NO_REC, 0.0, out))
         if st != pk.ST_OK:
             return st, i
         td[:] = out[pk.OUT_TD : pk.OUT_TD + pk.NTD]
