@@ -19,6 +19,7 @@ code for the other (``tests/simulation/test_kernel_variants.py``).
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 from numba import njit
 
@@ -53,8 +54,8 @@ class ByMethod:
     def __init__(self, kernels: tuple) -> None:
         self.kernels = kernels
 
-    def __call__(self, *args: object) -> object:
-        return self.kernels[int(args[1][O_METHOD])](*args)  # type: ignore[index]
+    def __call__(self, *args: Any) -> Any:
+        return self.kernels[int(args[1][O_METHOD])](*args)
 
     @property
     def signatures(self) -> list:

@@ -164,68 +164,28 @@ def _make_integrate_stance(method: int, record: bool) -> Callable:
         n_rej = 0
         last_rejected = False
         done = False
+        # a step that finds an event is followed by one exact step to the event time
+        # (the next pass of the loop), for a full-order event state
+        to_event = False
+        first_ev = -1
+        h_ev = 0.0
         while not done:
-            if n_acc + n_rej >= max_steps:
-                status = ST_ERR_MAX_STEPS
-                break
-            if t >= t_max:
-                status = ST_ERR_STANCE_TIMEOUT
-                break
-            if h < h_min:
-                status = ST_ERR_STEP_UNDERFLOW
-                break
-            rk_step(P, method, y, h, K, ytmp, ynew)
-            err = _rk.error_norm(method, NSTATE, y, ynew, h, K, rtol, atol)
-            if not math.isfinite(err):
-                # a NaN/inf stage: shrink hard, give up below h_min
-                h *= 0.1
-                n_rej += 1
-                last_rejected = True
-                continue
-            if err > 1.0:
-                h *= _rk.step_factor(method, err, 10.0)
-                n_rej += 1
-                last_rejected = True
-                continue
-            # accepted step: look for events
-            n_acc += 1
-            event_values(P, ynew, gv_new)
-            first_ev = -1
-            theta_ev = 2.0
-            have_dense = False
-            # falls first: lift-off wins only if strictly earlier (F_y = F_l sin(beta)
-            # and the hip height l sin(beta) vanish together when beta reaches 0)
-            for j in range(NEVENTS):
-                ev = (1, 3, 2, 0)[j]
-                if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
-                    if not have_dense:
-                        dense_output(P, method, y, ynew, h, K, R, ytmp)
-                        have_dense = True
-                    th = event_root(P, method, R, ev, gv_old[ev], gv_new[ev], ytmp, gv_tmp, st)
-                    if th < theta_ev - 1e-9:
-                        theta_ev = th
-                        first_ev = ev
-            if record and rec_dt > 0.0 and nrec_max > 0:
-                if not have_dense:
-                    dense_output(P, method, y, ynew, h, K, R, ytmp)
-                    have_dense = True
-                t_stop = t + h * min(theta_ev, 1.0)
-                while t_next_rec <= t_stop:
-                    if nrec >= nrec_max:
-                        overflow = 1.0
-                        break
-                    _rk.dense_eval_inline(method, R, (t_next_rec - t) / h, ytmp)
-                    record_row(P, rec, nrec, t_next_rec, ytmp)
-                    nrec += 1
-                    t_next_rec += rec_dt
-            if first_ev >= 0:
-                # exact step to the event time for a full-order event state
-                h_ev = theta_ev * h
-                if h_ev > 0.0:
-                    rk_step(P, method, y, h_ev, K, ytmp, ynew)
-                else:
-                    for i in range(NSTATE):
-                        ynew[i] = y[i]
+            if not to_event:
+                if n_acc + n_rej >= max_steps:
+                    status = ST_ERR_MAX_STEPS
+                    break
+                if t >= t_max:
+                    status = ST_ERR_STANCE_TIMEOUT
+                    break
+                if h < h_min:
+                    status = ST_ERR_STEP_UNDERFLOW
+                    break
+            if not to_event or h_ev > 0.0:
+                rk_step(P, method, y, h_ev if to_event else h, K, ytmp, ynew)
+            else:
+                for i in range(NSTATE):
+                    ynew[i] = y[i]
+            if to_event:
                 t += h_ev
                 for i in range(NSTATE):
                     y[i] = ynew[i]
@@ -237,6 +197,54 @@ def _make_integrate_stance(method: int, record: bool) -> Callable:
                     status = ST_FALL_BACKWARD
                 done = True
             else:
+                err = _rk.error_norm(method, NSTATE, y, ynew, h, K, rtol, atol)
+                if not math.isfinite(err):
+                    # a NaN/inf stage: shrink hard, give up below h_min
+                    h *= 0.1
+                    n_rej += 1
+                    last_rejected = True
+                    continue
+                if err > 1.0:
+                    h *= _rk.step_factor(method, err, 10.0)
+                    n_rej += 1
+                    last_rejected = True
+                    continue
+                # accepted step: look for events, on the dense output (also the grid samples')
+                n_acc += 1
+                event_values(P, ynew, gv_new)
+                dense = False
+                if record and rec_dt > 0.0 and nrec_max > 0:
+                    dense = True
+                for ev in range(NEVENTS):
+                    if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
+                        dense = True
+                if dense:
+                    dense_output(P, method, y, ynew, h, K, R, ytmp)
+                theta_ev = 2.0
+                # falls first: lift-off wins only if strictly earlier (F_y = F_l sin(beta)
+                # and the hip height l sin(beta) vanish together when beta reaches 0)
+                for j in range(NEVENTS):
+                    ev = (1, 3, 2, 0)[j]
+                    if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
+                        th = event_root(P, method, R, ev, gv_old[ev], gv_new[ev], ytmp, gv_tmp,
+                                        st)
+                        if th < theta_ev - 1e-9:
+                            theta_ev = th
+                            first_ev = ev
+                if record and rec_dt > 0.0 and nrec_max > 0:
+                    t_stop = t + h * min(theta_ev, 1.0)
+                    while t_next_rec <= t_stop:
+                        if nrec >= nrec_max:
+                            overflow = 1.0
+                            break
+                        _rk.dense_eval_inline(method, R, (t_next_rec - t) / h, ytmp)
+                        record_row(P, rec, nrec, t_next_rec, ytmp)
+                        nrec += 1
+                        t_next_rec += rec_dt
+                if first_ev >= 0:
+                    h_ev = theta_ev * h
+                    to_event = True
+                    continue
                 t += h
                 for i in range(NSTATE):
                     y[i] = ynew[i]
