@@ -13,14 +13,14 @@ import subprocess
 import sys
 
 from tslip.simulation import _kernels as kn
-from tslip.simulation import _record, _stepper, _stride, _variational
+from tslip.simulation import _record, _stride, _variational
 
 #: every per-method kernel tuple, by where it lives
 _TUPLES = {
     "stride": _stride.STRIDE, "stride_rec": _stride.STRIDE_REC, "run_row": _stride.RUN_ROW,
     "run_batch": _stride.RUN_BATCH, "run_batch_serial": _stride.RUN_BATCH_SERIAL,
     "stride_batch": _stride.STRIDE_BATCH, "stride_batch_serial": _stride.STRIDE_BATCH_SERIAL,
-    "stance": _stepper.INTEGRATE_STANCE, "stance_rec": _stepper.INTEGRATE_STANCE_REC,
+    "stance_rec": _stride.STANCE_REC,
     "record_run": _record.RECORD_RUN, "jacobian": _variational.STRIDE_JACOBIAN,
 }
 

@@ -46,10 +46,10 @@ from ._stance import (
     stance_accel,
     stance_initial,
 )
-from ._stepper import INTEGRATE_STANCE, INTEGRATE_STANCE_REC
 from ._stride import (
     RUN_BATCH,
     RUN_BATCH_SERIAL,
+    STANCE_REC,
     STRIDE,
     STRIDE_BATCH,
     STRIDE_BATCH_SERIAL,
@@ -57,7 +57,7 @@ from ._stride import (
 )
 
 __all__ = [
-    "INTEGRATE_STANCE", "INTEGRATE_STANCE_REC", "L_COLLAPSE", "NEVENTS", "NSTATE", "RECORD_RUN",
+    "L_COLLAPSE", "NEVENTS", "NSTATE", "RECORD_RUN",
     "STRIDE", "STRIDE_REC", "com_velocity",
     "event_values", "find_touchdown", "flight_leg_angle", "flight_samples", "flight_state",
     "grf", "hip_torque", "integrate_stance", "record_run", "retraction_start", "rhs",
@@ -71,14 +71,28 @@ def stride(P: np.ndarray, O: np.ndarray, td: np.ndarray, tx: np.ndarray,  # noqa
     """One stride from the touch-down state ``td`` (7); fills ``out``, returns the status.
 
     The stance is recorded into ``rec`` if it has rows (see
-    :func:`._stepper._make_integrate_stance`): ``STRIDE_REC[method]``, else ``STRIDE[method]``.
+    :func:`._stride._make_stride`): ``STRIDE_REC[method]``, else ``STRIDE[method]``.
     """
     kernels = STRIDE_REC if rec.shape[0] > 0 else STRIDE
     return kernels[int(O[O_METHOD])](P, O, td, tx, th, rec, rec_dt, out)
 
 
-#: ``(P, O, y0, yout, rec, rec_dt, stats) -> status``: the stance alone, recorded into ``rec``
-integrate_stance = ByMethod(INTEGRATE_STANCE_REC)
+_NO_TERRAIN = np.empty(0)
+
+
+def integrate_stance(P: np.ndarray, O: np.ndarray, y0: np.ndarray,  # noqa: E741
+                     yout: np.ndarray, rec: np.ndarray, rec_dt: float, stats: np.ndarray) -> int:
+    """The stance alone from the stance state ``y0``, recorded into ``rec`` (``STANCE_REC``).
+
+    ``yout`` receives the final state, ``stats`` ``[t_end, n_accepted, n_rejected,
+    n_recorded, overflow]``; returns the status (see :func:`._stride._make_stride`).
+    """
+    out = np.empty(NSTATE + 5)
+    status = STANCE_REC[int(O[O_METHOD])](P, O, y0, _NO_TERRAIN, _NO_TERRAIN, rec, rec_dt, out)
+    yout[:] = out[:NSTATE]
+    stats[:] = out[NSTATE:]
+    return int(status)
+
 record_run = ByMethod(RECORD_RUN)
 run_batch = ByMethod(RUN_BATCH)
 run_batch_serial = ByMethod(RUN_BATCH_SERIAL)

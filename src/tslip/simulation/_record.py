@@ -153,7 +153,7 @@ def _make_record_run(method: int) -> Callable:
 
         Starts from the touch-down state ``td`` (7) at time ``pos[1]`` and writes
         from row ``pos[0]`` of ``data`` (rows x NTRAJ, columns ``TR_*``): each
-        stance on the grid of :func:`._stepper.integrate_stance` (touch-down and lift-off
+        stance on the grid of :func:`._stride._make_stride` (touch-down and lift-off
         rows included), each flight in closed form at ``dt, 2 dt, ...`` after
         lift-off, and the touch-down instant closing the last stride if ``close``
         (otherwise the next stride's first row is that instant). ``tloc`` gets each
