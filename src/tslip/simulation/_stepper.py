@@ -12,7 +12,7 @@ from numba import njit
 
 from .._kernel_cache import check as _check_cache
 from . import _rk
-from ._rk import _INLINE
+from ._rk import _INLINE, _JIT
 from ._stance import NSTATE, event_values, grf, rhs
 
 
@@ -64,9 +64,12 @@ def event_root(P, method, R, ev, g_lo, g_hi, ytmp, gv, st):
     return st[1]  # the earliest theta known to be at or past the crossing
 
 
-@njit(**_INLINE)
+@njit(**_JIT)
 def record_row(P, rec, row, t, y):
-    """Stance record row ``row``: ``t, y, F_x, F_y, tau``."""
+    """Stance record row ``row``: ``t, y, F_x, F_y, tau``.
+
+    Compiled on its own, not inlined: a recording stride writes rows from four places.
+    """
     rec[row, 0] = t
     for i in range(NSTATE):
         rec[row, 1 + i] = y[i]
