@@ -31,7 +31,8 @@ _ROOT = Path(__file__).parent
 #: the layout constants they read).
 SOURCES: tuple[str, ...] = (
     "model/_pack.py", "simulation/_rk.py", "simulation/_kernels.py", "simulation/_variational.py",
-    "biped/_pack.py", "biped/_kernels.py",
+    "biped/_pack.py", "biped/_jit.py", "biped/_tmt.py", "biped/_control.py", "biped/_contact.py",
+    "biped/_rhs.py", "biped/_events.py", "biped/_stride.py", "biped/_kernels.py", "_nrt.py",
 )
 
 
