@@ -69,15 +69,17 @@ def references_branch(P, rho, swing):
     thf = P[P_THF]
     lt0 = P[P_LT0]
     lts = P[P_LTS]
-    if not swing:
-        w = math.pi / d
-        a = w * rho
-        return (lt0, 0.0, thf + 0.5 * ths * (1.0 - math.cos(a)), w * 0.5 * ths * math.sin(a) / T)
+    w = math.pi / d
     e = 1.0 / (1.0 - d)
     u = (2.0 * rho - 1.0 - d) * e
-    a = math.pi * (rho - d) * e
+    a = math.pi * (rho - d) * e if swing else w * rho
+    # one place for both branches: the compiler evaluates the pair as one sincos
+    ca = math.cos(a)
+    sa = math.sin(a)
+    if not swing:
+        return (lt0, 0.0, thf + 0.5 * ths * (1.0 - ca), w * 0.5 * ths * sa / T)
     return (lts * u * u + (lt0 - lts), 4.0 * lts * e * u / T,
-            thf + 0.5 * ths * (math.cos(a) + 1.0), -math.pi * e * 0.5 * ths * math.sin(a) / T)
+            thf + 0.5 * ths * (ca + 1.0), -math.pi * e * 0.5 * ths * sa / T)
 
 
 @njit(**FAST)

@@ -10,9 +10,11 @@ with their own options.
 
 from __future__ import annotations
 
+from typing import Any
+
 from .._nrt import without_nrt
 
-JIT = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
+JIT: dict[str, Any] = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
 FAST = without_nrt(**JIT)
 INLINE = dict(FAST, inline="always")
 

@@ -19,7 +19,8 @@ compiled without numba's reference counting (:mod:`tslip._nrt`), so
 :func:`run` allocates every work array and passes it in; the loop is
 compiled once per Runge-Kutta pair (:func:`_integrate_dopri5`,
 :func:`_integrate_dop853`), only for the pair a run uses, so that the
-tableau is a constant; the switching functions at the end of a step read the
+tableau is a constant, with the right-hand side inlined into its stage
+loop; the switching functions at the end of a step read the
 sines and cosines the right-hand side has just computed there.
 """
 
@@ -79,18 +80,22 @@ from ._pack import (
     ST_OK,
     ST_TEND,
 )
-from ._rhs import make_workspace, rhs
+from ._rhs import make_workspace, rhs, rhs_inline
 
 
 @njit(**INLINE)
 def rk_step(P, method, t, y, h, K, ytmp, ynew, cs, ctl, ws, aux):
-    """One step from ``(t, y)`` with ``K[0] = f(t, y)``; ``K[ns] = f(ynew)``."""
+    """One step from ``(t, y)`` with ``K[0] = f(t, y)``; ``K[ns] = f(ynew)``.
+
+    The stages and the FSAL evaluation share one call of the right-hand side,
+    inlined (no call overhead, one copy of its code).
+    """
     ns = _rk.n_stages(method)
-    for s in range(1, ns):
-        _rk.stage_state(method, N, y, h, K, s, ytmp)
-        rhs(P, t + _rk.stage_c(method, s) * h, ytmp, cs, ctl, False, K[s], ws, aux)
-    _rk.stage_state(method, N, y, h, K, ns, ynew)
-    rhs(P, t + h, ynew, cs, ctl, False, K[ns], ws, aux)
+    for s in range(1, ns + 1):
+        ys = ynew if s == ns else ytmp
+        _rk.stage_state(method, N, y, h, K, s, ys)
+        ts = t + h if s == ns else t + _rk.stage_c(method, s) * h
+        rhs_inline(P, ts, ys, cs, ctl, False, K[s], ws, aux)
 
 
 @njit(**INLINE)
