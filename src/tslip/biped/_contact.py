@@ -38,7 +38,7 @@ def foot_state(P, y, leg):
                            math.cos(gam))
 
 
-@njit(**INLINE)
+@njit(**FAST)
 def foot_state_of(P, y, leg, trig):
     """:func:`foot_state` with the sines and cosines ``trig`` of :func:`._tmt.tmt_blocks`."""
     return foot_state_trig(P, y, leg, trig[0], trig[1], trig[2 + 2 * leg], trig[3 + 2 * leg])
@@ -57,7 +57,7 @@ def contact_force(P, y, cs, leg, clamp):
     return contact_law(P, foot_state(P, y, leg), cs, leg, clamp)
 
 
-@njit(**INLINE)
+@njit(**FAST)
 def contact_force_trig(P, y, cs, leg, clamp, trig):
     """:func:`contact_force` with the sines and cosines ``trig`` of the state."""
     if P[P_CONTACT] == 0.0 or cs[CS_ON_R + leg] == 0.0:

@@ -135,7 +135,7 @@ def ctl_switch(ctl, leg):
 NRC = 7
 
 
-@njit(**INLINE)
+@njit(**FAST)
 def references_at(P, t, ctl, leg, rc):
     """References of a leg at time ``t`` in controller state ``ctl``, cached in ``rc``.
 

@@ -15,7 +15,7 @@ from numba import njit
 
 from .._kernel_cache import check as _check_cache
 from ._contact import foot_state, foot_state_of
-from ._jit import FAST, INLINE
+from ._jit import FAST
 from ._pack import (
     CS_ON_R,
     CS_ZR,
@@ -30,7 +30,7 @@ from ._pack import (
 )
 
 
-@njit(**INLINE)
+@njit(**FAST)
 def state_trig(y, trig):
     """``sin, cos`` of ``theta_b`` and of both leg angles of ``y``, as
     :func:`._tmt.tmt_blocks` leaves them in its ``trig``."""
@@ -43,8 +43,9 @@ def state_trig(y, trig):
         trig[3 + 2 * j] = math.cos(gam)
 
 
-@njit(**INLINE)
+@njit(**FAST)
 def _contact_g(P, cs, leg, z, zd):
+    """:func:`event_value` of a foot at height ``z``, vertical speed ``zd``."""
     if cs[CS_ON_R + leg] == 0.0:
         return z
     zt = cs[CS_ZR + 2 * leg]
@@ -61,14 +62,14 @@ def event_value(P, y, cs, leg):
     return _contact_g(P, cs, leg, z, zd)
 
 
-@njit(**INLINE)
+@njit(**FAST)
 def event_value_trig(P, y, cs, leg, trig):
     """:func:`event_value` given the sines and cosines ``trig`` of ``y``."""
     x, z, xd, zd = foot_state_of(P, y, leg, trig)
     return _contact_g(P, cs, leg, z, zd)
 
 
-@njit(**INLINE)
+@njit(**FAST)
 def fall_check_trig(P, y, cb):
     """:func:`fall_check` given ``cb = cos(theta_b)``."""
     if y[1] + P[P_R1] * cb <= 0.0:
@@ -88,7 +89,7 @@ def fall_check(P, y):
     return fall_check_trig(P, y, math.cos(y[2]))
 
 
-@njit(**INLINE)
+@njit(**FAST)
 def fall_value_trig(P, y, cb):
     """:func:`fall_value` given ``cb = cos(theta_b)``."""
     g = y[1] + P[P_R1] * cb
@@ -121,7 +122,7 @@ K_CTL = 2
 K_FALL = 4
 
 
-@njit(**INLINE)
+@njit(**FAST)
 def event_g(P, k, t, y, cs, tsw, trig):
     """Switching function ``k`` at ``(t, y)``: contact (0, 1), controller (2, 3),
     fall (4); ``trig`` the sines and cosines of ``y`` (:func:`state_trig`)."""

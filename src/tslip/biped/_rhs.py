@@ -13,14 +13,22 @@ from numba import njit
 from .._kernel_cache import check as _check_cache
 from ._contact import contact_law, foot_state_trig
 from ._control import NRC, actuation
-from ._jit import FAST, INLINE, JIT
+from ._jit import FAST, JIT
 from ._pack import CS_ON_R, P_CONTACT, P_R1
 from ._tmt import NBLK, block_solve, tmt_blocks
 
 
-@njit(**INLINE)
-def rhs_inline(P, t, y, cs, ctl, clamp, out, ws, aux):
-    """:func:`rhs`, inlined into the integrator's stage loop."""
+@njit(**FAST)
+def rhs(P, t, y, cs, ctl, clamp, out, ws, aux):
+    """State derivative of ``y = (q, qd)`` (eq. E.22); forces go to ``aux`` (10).
+
+    ``clamp``: see :func:`._contact.contact_force` (the integrator steps
+    unclamped). ``ws`` is a workspace of :func:`make_workspace`; it also keeps
+    the sines and cosines of ``y`` (``ws[5]``, see :func:`._tmt.tmt_blocks`)
+    and caches the controller references (``ws[6]``, see
+    :func:`._control.references_at`), so one workspace serves one parameter
+    vector ``P``.
+    """
     blk, h, qdd, S, Nw, trig, rc = ws
     tmt_blocks(P, y[:9], y[9:], blk, h, trig)
     r1 = P[P_R1]
@@ -58,20 +66,6 @@ def rhs_inline(P, t, y, cs, ctl, clamp, out, ws, aux):
     for a in range(9):
         out[a] = y[9 + a]
         out[9 + a] = qdd[a] if ok else math.nan
-
-
-@njit(**FAST)
-def rhs(P, t, y, cs, ctl, clamp, out, ws, aux):
-    """State derivative of ``y = (q, qd)`` (eq. E.22); forces go to ``aux`` (10).
-
-    ``clamp``: see :func:`._contact.contact_force` (the integrator steps
-    unclamped). ``ws`` is a workspace of :func:`make_workspace`; it also keeps
-    the sines and cosines of ``y`` (``ws[5]``, see :func:`._tmt.tmt_blocks`)
-    and caches the controller references (``ws[6]``, see
-    :func:`._control.references_at`), so one workspace serves one parameter
-    vector ``P``.
-    """
-    rhs_inline(P, t, y, cs, ctl, clamp, out, ws, aux)
 
 
 def make_workspace():
