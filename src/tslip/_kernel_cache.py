@@ -27,10 +27,13 @@ __all__ = ["SOURCES", "sources_hash", "check"]
 
 _ROOT = Path(__file__).parent
 
-#: Package files whose code is compiled into the kernels (njit functions and
-#: the layout constants they read).
+#: Package files whose code is compiled into the kernels (njit functions, the
+#: layout constants they read, and the naming of the per-method copies); a test
+#: checks that every module defining or feeding a kernel is listed.
 SOURCES: tuple[str, ...] = (
-    "model/_pack.py", "simulation/_rk.py", "simulation/_kernels.py", "simulation/_variational.py",
+    "model/_pack.py", "simulation/_rk.py", "simulation/_specialise.py", "simulation/_stance.py",
+    "simulation/_flight.py", "simulation/_stepper.py", "simulation/_stride.py",
+    "simulation/_record.py", "simulation/_kernels.py", "simulation/_variational.py",
     "biped/_pack.py", "biped/_jit.py", "biped/_tmt.py", "biped/_control.py", "biped/_contact.py",
     "biped/_rhs.py", "biped/_events.py", "biped/_stride.py", "biped/_kernels.py", "_nrt.py",
 )

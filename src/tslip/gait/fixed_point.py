@@ -303,11 +303,18 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
                 return z, err
             errp = float(np.max(np.abs(rp)))
             return (z + dz, errp) if errp < err else (z, err)
+        # The full step, usually taken, is tried with its Jacobian; a shortened
+        # one with the residual alone (a stride, not a variational stride), its
+        # Jacobian computed once it is accepted. The iterates are the same either way.
         t = 1.0
+        Jn = None
         while True:
             zn = z + t * dz
             try:
-                rn, Jn = fj(zn)
+                if t == 1.0:
+                    rn, Jn = fj(zn)
+                else:
+                    rn, Jn = residual(zn), None
                 nn = float(np.linalg.norm(rn))
             except ValueError:
                 nn = math.inf
@@ -316,6 +323,11 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
             t *= 0.5
             if t < _NEWTON_MIN_STEP:
                 return z, err
+        if Jn is None:
+            try:
+                rn, Jn = fj(zn)
+            except ValueError:
+                return None, math.inf
         z, r, J, nrm = zn, rn, Jn, nn
     return None, math.inf  # not reached
 

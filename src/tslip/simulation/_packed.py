@@ -26,11 +26,12 @@ import numpy as np
 
 from ..model import _pack as pk
 from . import _kernels as kn
+from ._stride import RUN_ROW
 
 __all__ = ["touchdown", "stride_map", "stride_jacobian", "alpha_r_column", "run"]
 
 _TX = np.empty(0)  # flat ground: no terrain breakpoints
-_NO_REC = np.empty((0, pk.NREC))  # kn.stride records nothing into it
+_NO_REC = np.empty((0, pk.NREC))  # the stride kernels record nothing into it
 
 
 def touchdown(q: np.ndarray, h: float = 0.0) -> np.ndarray:
@@ -48,7 +49,7 @@ def stride_map(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E
     The next section is ``out[OUT_TD:OUT_TD + 5]``; as :func:`tslip.step_map`.
     """
     th = np.array([h])
-    return int(kn.stride(P, O, touchdown(q, h), _TX, th, _NO_REC, 0.0, out))
+    return int(kn.STRIDE[int(O[pk.O_METHOD])](P, O, touchdown(q, h), _TX, th, _NO_REC, 0.0, out))
 
 
 #: The last exact Jacobians, keyed by their exact inputs (P, O, q, h): gait search
@@ -117,11 +118,7 @@ def run(P: np.ndarray, O: np.ndarray, td: np.ndarray, n_steps: int,  # noqa: E74
     Stops at the first stride that does not end in a touch-down. Returns
     ``(status, strides completed)``, as one row of :func:`tslip.run_batch`.
     """
-    out = np.empty(pk.NOUT)
-    td = td.copy()
-    for i in range(n_steps):
-        st = int(kn.stride(P, O, td, tx, th, _NO_REC, 0.0, out))
-        if st != pk.ST_OK:
-            return st, i
-        td[:] = out[pk.OUT_TD : pk.OUT_TD + pk.NTD]
-    return pk.ST_OK, n_steps
+    hist = np.empty((n_steps + 1, pk.NTD))
+    run_row = RUN_ROW[int(O[pk.O_METHOD])]  # the strides in compiled code
+    st, done, _ = run_row(P, O, td, n_steps, tx, th, hist)
+    return int(st), int(done)

@@ -287,7 +287,7 @@ def step_factor(method, err, fac_max):
     return min(fac_max, max(0.2, 0.9 * err ** ERR_EXP[method]))
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def initial_probe(y, f0, rtol, atol, out):
     """First half of the starting step (Hairer, Norsett & Wanner, II.4).
 
@@ -309,7 +309,7 @@ def initial_probe(y, f0, rtol, atol, out):
     return h0, d1
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def initial_step(method, y, f0, f1, h0, d1, rtol, atol):
     """Starting step from the probe ``f1 = f(y + h0 f0)``: ``(0.01 / |f'|)^(1/p)``."""
     n = y.shape[0]
@@ -418,6 +418,23 @@ def root_update(st, c, fc, tol):
         st[4] = 1.0
     return st[1] - st[0] < tol
 
+
+# ---------------------------------------------------------------------------
+# The same routines inlined: the TSLIP's stride kernels call these twins, so a
+# stride compiles as one function (each separately compiled callee costs a
+# compile and a re-optimisation in every caller); the biped calls the ones above
+# ---------------------------------------------------------------------------
+
+
+def _inlined(kernel):
+    return njit(**_INLINE)(getattr(kernel, "py_func", kernel))  # no py_func without the JIT
+
+
+dense_coeffs_inline = _inlined(dense_coeffs)
+dense_eval_inline = _inlined(dense_eval)
+root_start_inline = _inlined(root_start)
+root_guess_inline = _inlined(root_guess)
+root_update_inline = _inlined(root_update)
 
 # numba does not notice when a kernel called from another file changes; drop
 # cached kernels compiled against other sources (see tslip._kernel_cache).

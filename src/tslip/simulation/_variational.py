@@ -20,12 +20,17 @@ chain; each link is differentiated exactly:
 
 ``Df`` comes from differentiating ``M qdd = R`` (eq. 2.3, ``R = Q - C``):
 ``d qdd = M^-1 (dR - dM qdd)``, with the closed-form ``M^-1`` of
-:func:`._kernels.stance_accel`.
+:func:`._stance.stance_accel`.
+
+One kernel per integrator method (:func:`._stride.specialise`), which inlines
+the recorded stride (:func:`._stride._make_stride`); :func:`_aug_rhs` compiles
+on its own, the other helpers are ``inline="always"``.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from numba import njit
@@ -33,7 +38,6 @@ from numba import njit
 from .._kernel_cache import check as _check_cache
 from ..model._pack import (
     NREC,
-    O_METHOD,
     OUT_LO,
     OUT_TF,
     P_C0,
@@ -49,20 +53,14 @@ from ..model._pack import (
     ST_OK,
 )
 from . import _rk
-from ._kernels import (
-    _JIT,
-    NSTATE,
-    flight_leg_angle,
-    hip_torque,
-    retraction_start,
-    rhs,
-    stance_accel,
-    stance_initial,
-    stride,
-)
+from ._flight import flight_leg_angle, retraction_start
+from ._rk import _INLINE, _JIT
+from ._specialise import ByMethod, specialise
+from ._stance import NSTATE, hip_torque, rhs, stance_accel, stance_initial
+from ._stride import stride_of
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def _solve_m(P, l, sa, ca, v1, v2, v3):
     """``M^-1 v`` in closed form (Schur complement on the phi row is ``J``)."""
     r = P[P_R]
@@ -70,7 +68,7 @@ def _solve_m(P, l, sa, ca, v1, v2, v3):
     return v1 / P[P_M] + r * ca * x3, v2 / (P[P_M] * l * l) - r * sa / l * x3, x3
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def rhs_jacobian(P, y, Jf):
     """Jacobian ``Df`` (6 x 6) of the stance right-hand side at ``y``."""
     m = P[P_M]
@@ -120,7 +118,7 @@ def rhs_jacobian(P, y, Jf):
         P, l, sa, ca, -2.0 * m * r * phd * sa, a3 - 2.0 * m * r * l * phd * ca, a3)
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def fy_gradient(P, y, gr):
     """Gradient of ``F_y`` (eq. 2.6) with respect to the stance state."""
     l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
@@ -152,7 +150,7 @@ def _aug_rhs(P, z, out, Jf):
             out[NSTATE + i * NSTATE + c] = acc
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def _sens_step(P, method, z, h, K, ztmp, Jf):
     """One step of ``(y, Phi)`` (in place) with the Runge-Kutta pair of the stride.
 
@@ -171,128 +169,134 @@ def _sens_step(P, method, z, h, K, ztmp, Jf):
         z[i] = ztmp[i]
 
 
-@njit(**_JIT)
-def stride_jacobian(P, O, td, tx, th, Jq, out):
-    """Next touch-down state and its exact Jacobian ``Jq = dq'/dq`` (5 x 5).
+def _make_stride_jacobian(method: int) -> Callable:
+    def stride_jacobian(P, O, td, tx, th, Jq, out):
+        """Next touch-down state and its exact Jacobian ``Jq = dq'/dq`` (5 x 5).
 
-    Returns the stride status; ``out`` is filled as by :func:`._kernels.stride`.
-    """
-    rec = np.empty((4096, NREC))
-    status = stride(P, O, td, tx, th, rec, 0.0, out)
-    if status != ST_OK or out[26] != 0.0:  # OUT_RECOVF
-        for i in range(5):
-            for j in range(5):
-                Jq[i, j] = math.nan
-        return status
-    nrec = int(out[25])  # OUT_NREC
-    l0 = P[P_L0]
-    r = P[P_R]
-    g = P[P_G]
-    # 1. dy0/dq (6 x 5), q = (beta, phi, xd, yd, phid)
-    y = np.empty(NSTATE)
-    stance_initial(P, td, y)
-    b, ph, xd, yd, phd = td[0], td[1], td[2], td[3], td[4]
-    sb, cb = math.sin(b), math.cos(b)
-    sp, cp = math.sin(ph), math.cos(ph)
-    u = xd - r * cp * phd
-    w = yd - r * sp * phd
-    du = np.array([0.0, r * sp * phd, 1.0, 0.0, -r * cp])
-    dw = np.array([0.0, -r * cp * phd, 0.0, 1.0, -r * sp])
-    D0 = np.zeros((NSTATE, 5))
-    D0[1, 0] = 1.0
-    D0[2, 1] = 1.0
-    D0[5, 4] = 1.0
-    for j in range(5):
-        D0[3, j] = -cb * du[j] + sb * dw[j]
-        D0[4, j] = (sb * du[j] + cb * dw[j]) / l0
-    D0[3, 0] += u * sb + w * cb
-    D0[4, 0] += (u * cb - w * sb) / l0
-    # 2. replay the accepted steps with sensitivities
-    method = int(O[O_METHOD])
-    z = np.zeros(NAUG)
-    for i in range(NSTATE):
-        z[i] = y[i]
-        z[NSTATE + i * NSTATE + i] = 1.0
-    K = np.empty((_rk.NK, NAUG))
-    ztmp = np.empty(NAUG)
-    Jf = np.empty((NSTATE, NSTATE))
-    for k in range(1, nrec):
-        h = rec[k, 0] - rec[k - 1, 0]
-        if h > 0.0:
-            _sens_step(P, method, z, h, K, ztmp, Jf)
-    for i in range(NSTATE):
-        y[i] = z[i]
-    Phi = z[NSTATE:].copy().reshape((NSTATE, NSTATE))
-    # 3. saltation at lift-off: dt_LO = -(grad Fy . Phi) / (grad Fy . f)
-    f = np.empty(NSTATE)
-    rhs(P, y, f)
-    gr = np.empty(NSTATE)
-    fy_gradient(P, y, gr)
-    gf = 0.0
-    for i in range(NSTATE):
-        gf += gr[i] * f[i]
-    S = Phi @ D0  # dy_LO/dq before the event correction
-    dtlo = np.zeros(5)
-    for j in range(5):
-        acc = 0.0
-        for i in range(NSTATE):
-            acc += gr[i] * S[i, j]
-        dtlo[j] = -acc / gf
-    for i in range(NSTATE):
+        Returns the stride status; ``out`` is filled as by :func:`._stride._make_stride`.
+        """
+        rec = np.empty((4096, NREC))
+        status = stride_of(method, True, P, O, td, tx, th, rec, 0.0, out)
+        if status != ST_OK or out[26] != 0.0:  # OUT_RECOVF
+            for i in range(5):
+                for j in range(5):
+                    Jq[i, j] = math.nan
+            return status
+        nrec = int(out[25])  # OUT_NREC
+        l0 = P[P_L0]
+        r = P[P_R]
+        g = P[P_G]
+        # 1. dy0/dq (6 x 5), q = (beta, phi, xd, yd, phid)
+        y = np.empty(NSTATE)
+        stance_initial(P, td, y)
+        b, ph, xd, yd, phd = td[0], td[1], td[2], td[3], td[4]
+        sb, cb = math.sin(b), math.cos(b)
+        sp, cp = math.sin(ph), math.cos(ph)
+        u = xd - r * cp * phd
+        w = yd - r * sp * phd
+        du = np.array([0.0, r * sp * phd, 1.0, 0.0, -r * cp])
+        dw = np.array([0.0, -r * cp * phd, 0.0, 1.0, -r * sp])
+        D0 = np.zeros((NSTATE, 5))
+        D0[1, 0] = 1.0
+        D0[2, 1] = 1.0
+        D0[5, 4] = 1.0
         for j in range(5):
-            S[i, j] += f[i] * dtlo[j]
-    # 4. lift-off CoM state lo = (y_m, xd, yd, phi, phid) and its Jacobian (5 x 6)
-    l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
-    sb, cb = math.sin(b), math.cos(b)
-    sp, cp = math.sin(ph), math.cos(ph)
-    L = np.zeros((5, NSTATE))
-    L[0, 0], L[0, 1], L[0, 2] = sb, l * cb, r * sp
-    L[1, 0], L[1, 1], L[1, 2] = sb * bd, ld * sb + l * cb * bd, -r * sp * phd
-    L[1, 3], L[1, 4], L[1, 5] = -cb, l * sb, r * cp
-    L[2, 0], L[2, 1], L[2, 2] = cb * bd, ld * cb - l * sb * bd, r * cp * phd
-    L[2, 3], L[2, 4], L[2, 5] = sb, l * cb, r * sp
-    L[3, 2] = 1.0
-    L[4, 5] = 1.0
-    G = L @ S  # d lo / dq
-    # 5. flight: foot height f(t) = y + yd t - g t^2/2 + r cos(phi(t)) - l0 sin(beta(t)) - H
-    tf = out[OUT_TF]
-    phi0 = out[OUT_LO + 4]
-    phid0 = out[OUT_LO + 5]
-    yd0 = out[OUT_LO + 3]
-    ta = retraction_start(P, yd0)
-    bt, bdot = flight_leg_angle(P, phi0, phid0, tf, ta)
-    pht = phi0 + phid0 * tf
-    local = P[P_GLOBAL] == 0.0
-    dbdphi = -1.0 if local else 0.0
-    dbdphid = -tf if local else 0.0
-    # apex clock: beta = alpha_r + omega_r (t - yd0 / g) [- phi(t)] once retracting
-    dbdyd = -P[P_OMEGA] / g if (ta > 0.0 and tf >= ta) else 0.0
-    spt, cbt = math.sin(pht), math.cos(bt)
-    # partials of f with respect to lo = (y, xd, yd, phi, phid) and t
-    df = np.array([1.0, 0.0, tf, -r * spt - l0 * cbt * dbdphi,
-                   -r * spt * tf - l0 * cbt * dbdphid])
-    if dbdyd != 0.0:
-        df[2] -= l0 * cbt * dbdyd
-    dfdt = yd0 - g * tf - r * spt * phid0 - l0 * cbt * bdot
-    dttd = np.zeros(5)
-    for j in range(5):
-        acc = 0.0
-        for i in range(5):
-            acc += df[i] * G[i, j]
-        dttd[j] = -acc / dfdt
-    # q' = (beta(t), phi(t), xd, yd - g t, phid)
-    for j in range(5):
-        Jq[0, j] = dbdphi * G[3, j] + dbdphid * G[4, j] + bdot * dttd[j]
+            D0[3, j] = -cb * du[j] + sb * dw[j]
+            D0[4, j] = (sb * du[j] + cb * dw[j]) / l0
+        D0[3, 0] += u * sb + w * cb
+        D0[4, 0] += (u * cb - w * sb) / l0
+        # 2. replay the accepted steps with sensitivities
+        z = np.zeros(NAUG)
+        for i in range(NSTATE):
+            z[i] = y[i]
+            z[NSTATE + i * NSTATE + i] = 1.0
+        K = np.empty((_rk.NK, NAUG))
+        ztmp = np.empty(NAUG)
+        Jf = np.empty((NSTATE, NSTATE))
+        for k in range(1, nrec):
+            h = rec[k, 0] - rec[k - 1, 0]
+            if h > 0.0:
+                _sens_step(P, method, z, h, K, ztmp, Jf)
+        for i in range(NSTATE):
+            y[i] = z[i]
+        Phi = z[NSTATE:].copy().reshape((NSTATE, NSTATE))
+        # 3. saltation at lift-off: dt_LO = -(grad Fy . Phi) / (grad Fy . f)
+        f = np.empty(NSTATE)
+        rhs(P, y, f)
+        gr = np.empty(NSTATE)
+        fy_gradient(P, y, gr)
+        gf = 0.0
+        for i in range(NSTATE):
+            gf += gr[i] * f[i]
+        S = Phi @ D0  # dy_LO/dq before the event correction
+        dtlo = np.zeros(5)
+        for j in range(5):
+            acc = 0.0
+            for i in range(NSTATE):
+                acc += gr[i] * S[i, j]
+            dtlo[j] = -acc / gf
+        for i in range(NSTATE):
+            for j in range(5):
+                S[i, j] += f[i] * dtlo[j]
+        # 4. lift-off CoM state lo = (y_m, xd, yd, phi, phid) and its Jacobian (5 x 6)
+        l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
+        sb, cb = math.sin(b), math.cos(b)
+        sp, cp = math.sin(ph), math.cos(ph)
+        L = np.zeros((5, NSTATE))
+        L[0, 0], L[0, 1], L[0, 2] = sb, l * cb, r * sp
+        L[1, 0], L[1, 1], L[1, 2] = sb * bd, ld * sb + l * cb * bd, -r * sp * phd
+        L[1, 3], L[1, 4], L[1, 5] = -cb, l * sb, r * cp
+        L[2, 0], L[2, 1], L[2, 2] = cb * bd, ld * cb - l * sb * bd, r * cp * phd
+        L[2, 3], L[2, 4], L[2, 5] = sb, l * cb, r * sp
+        L[3, 2] = 1.0
+        L[4, 5] = 1.0
+        G = L @ S  # d lo / dq
+        # 5. flight: foot height f(t) = y + yd t - g t^2/2 + r cos(phi(t)) - l0 sin(beta(t)) - H
+        tf = out[OUT_TF]
+        phi0 = out[OUT_LO + 4]
+        phid0 = out[OUT_LO + 5]
+        yd0 = out[OUT_LO + 3]
+        ta = retraction_start(P, yd0)
+        bt, bdot = flight_leg_angle(P, phi0, phid0, tf, ta)
+        pht = phi0 + phid0 * tf
+        local = P[P_GLOBAL] == 0.0
+        dbdphi = -1.0 if local else 0.0
+        dbdphid = -tf if local else 0.0
+        # apex clock: beta = alpha_r + omega_r (t - yd0 / g) [- phi(t)] once retracting
+        dbdyd = -P[P_OMEGA] / g if (ta > 0.0 and tf >= ta) else 0.0
+        spt, cbt = math.sin(pht), math.cos(bt)
+        # partials of f with respect to lo = (y, xd, yd, phi, phid) and t
+        df = np.array([1.0, 0.0, tf, -r * spt - l0 * cbt * dbdphi,
+                       -r * spt * tf - l0 * cbt * dbdphid])
         if dbdyd != 0.0:
-            Jq[0, j] += dbdyd * G[2, j]
-        Jq[1, j] = G[3, j] + tf * G[4, j] + phid0 * dttd[j]
-        Jq[2, j] = G[1, j]
-        Jq[3, j] = G[2, j] - g * dttd[j]
-        Jq[4, j] = G[4, j]
-    return status
+            df[2] -= l0 * cbt * dbdyd
+        dfdt = yd0 - g * tf - r * spt * phid0 - l0 * cbt * bdot
+        dttd = np.zeros(5)
+        for j in range(5):
+            acc = 0.0
+            for i in range(5):
+                acc += df[i] * G[i, j]
+            dttd[j] = -acc / dfdt
+        # q' = (beta(t), phi(t), xd, yd - g t, phid)
+        for j in range(5):
+            Jq[0, j] = dbdphi * G[3, j] + dbdphid * G[4, j] + bdot * dttd[j]
+            if dbdyd != 0.0:
+                Jq[0, j] += dbdyd * G[2, j]
+            Jq[1, j] = G[3, j] + tf * G[4, j] + phid0 * dttd[j]
+            Jq[2, j] = G[1, j]
+            Jq[3, j] = G[2, j] - g * dttd[j]
+            Jq[4, j] = G[4, j]
+        return status
+
+    return stride_jacobian
+
+
+#: ``(P, O, td, tx, th, Jq, out) -> status`` by method, and called as one by ``O``'s method.
+STRIDE_JACOBIAN = specialise(_make_stride_jacobian, "stride_jacobian")
+stride_jacobian = ByMethod(STRIDE_JACOBIAN)
 
 
 # numba does not notice when a kernel called from another file changes; drop
 # cached kernels compiled against other sources (see tslip._kernel_cache).
-_check_cache(stride_jacobian, __file__)
+_check_cache(_aug_rhs, __file__)
 

@@ -54,8 +54,9 @@ __all__ = [
 
 _FLAT = Terrain.flat(0.0)
 _REC_ROWS = 4096
-#: ``rec`` of a stride that records nothing: the map calls ``kn.stride`` itself, as
-#: every caller does (a wrapper kernel would be one more level to compile)
+#: ``rec`` of a stride that records nothing: the map calls the method's stride kernel
+#: ``kn.STRIDE[method]`` itself, as every caller does (a wrapper kernel would be one
+#: more level to compile)
 _NO_REC = np.empty((0, pk.NREC))
 
 
@@ -235,7 +236,8 @@ def step_map(
     out = np.empty(pk.NOUT)
     tx, th = _FLAT.arrays()
     th = th + h
-    status = Status(int(kn.stride(P, _options(options), td, tx, th, _NO_REC, 0.0, out)))
+    O = _options(options)
+    status = Status(int(kn.STRIDE[int(O[pk.O_METHOD])](P, O, td, tx, th, _NO_REC, 0.0, out)))
     return MapResult(
         out[pk.OUT_TD : pk.OUT_TD + 5].copy(), float(out[pk.OUT_TS]), float(out[pk.OUT_TF]),
         status,

@@ -105,10 +105,15 @@ class _Seed:
     controller reference).
     """
 
-    def __init__(self, params: Any, z: dict[str, float]) -> None:
-        self.params = params
+    def __init__(self, decode: Callable[[], Any], z: dict[str, float]) -> None:
+        self._decode = decode
         self.z = z
         self.state = SimpleNamespace(**z)  # encode() reads gait.state.delta, phi, phid
+
+    @functools.cached_property
+    def params(self) -> Any:
+        """Decoded when first read: only the natural continuation's predictor reads it."""
+        return self._decode()
 
 
 def seeds_from_records(records: Sequence[dict[str, Any] | None],
@@ -146,9 +151,11 @@ class _Line:
         return self.spec.params_at({**self.assignment, self.inner: float(self.values[i])})
 
     def seed(self, i: int, rec: dict[str, Any]) -> _Seed:
-        prob = GaitProblem.from_params(self.point_params(i))
-        params, _ = prob.decode([rec[n] for n in prob.names])
-        return _Seed(params, {n: _num(rec.get(n)) for n in UNKNOWNS})
+        def decode() -> Any:
+            prob = GaitProblem.from_params(self.point_params(i))
+            return prob.decode([rec[n] for n in prob.names])[0]
+
+        return _Seed(decode, {n: _num(rec.get(n)) for n in UNKNOWNS})
 
     def attempt(self, i: int, solve: Callable[[], tuple[Gait, str]],
                 keep_failure: bool) -> _Seed | None:

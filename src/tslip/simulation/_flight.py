@@ -1,0 +1,218 @@
+"""Compiled flight in closed form: the swing leg, the flight state, the next touch-down.
+
+Private (see :mod:`._kernels`). Flight is ballistic (eq. 2.7) with the leg reset
+of eq. 2.17 (signs in docs/conventions.md); only the touch-down time needs a
+search (:func:`find_touchdown`, which compiles on its own; the other functions
+are ``inline="always"``, copied into the kernels that call them).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from .._kernel_cache import check as _check_cache
+from ..model._pack import (
+    O_TMAX_FLIGHT,
+    P_ALPHA,
+    P_APEX,
+    P_G,
+    P_GLOBAL,
+    P_L0,
+    P_OMEGA,
+    P_R,
+    ST_ERR_FLIGHT_TIMEOUT,
+    ST_FALL_NO_TOUCHDOWN,
+    ST_FALL_TRIP,
+    ST_OK,
+)
+from ._rk import _INLINE, _JIT
+
+
+@njit(**_INLINE)
+def retraction_start(P, yd0):
+    """Time after lift-off at which the retraction clock starts, for lift-off ``ydot = yd0``.
+
+    0 with ``retraction="liftoff"`` (eq. 2.17). With ``retraction="apex"`` the
+    apex ``yd0 / g`` of a flight that leaves the ground moving up, and 0 (the
+    clock starts at lift-off) for one that has no apex (``yd0 <= 0``).
+    """
+    if P[P_APEX] != 0.0 and yd0 > 0.0:
+        return yd0 / P[P_G]
+    return 0.0
+
+
+@njit(**_INLINE)
+def flight_leg_angle(P, phi0, phid, t, ta):
+    """Leg angle ``beta(t)`` in flight, ``t`` since lift-off, and its rate.
+
+    The hip angle is ``alpha_r + omega_r max(0, t - ta)`` with ``ta`` from
+    :func:`retraction_start` (held at ``alpha_r`` until then); ``beta = alpha -
+    phi(t)`` for the local reset, ``beta = alpha`` for the global one. The rate
+    is the one from ``t`` on (retracting at ``t = ta``).
+    """
+    if t >= ta:
+        s = t - ta
+        w = P[P_OMEGA]
+    else:
+        s = 0.0
+        w = 0.0
+    if P[P_GLOBAL] != 0.0:
+        return P[P_ALPHA] + P[P_OMEGA] * s, w
+    return P[P_ALPHA] + P[P_OMEGA] * s - (phi0 + phid * t), w - phid
+
+
+@njit(**_INLINE)
+def flight_state(P, lo, t, out):
+    """Flight state ``t`` after lift-off from ``lo = (x, y, xd, yd, phi, phid)``.
+
+    Writes ``(x, y, xd, yd, phi, phid, beta, foot_x, foot_y, hip_y)`` to ``out``.
+    """
+    g = P[P_G]
+    r = P[P_R]
+    l0 = P[P_L0]
+    x = lo[0] + lo[2] * t
+    y = lo[1] + lo[3] * t - 0.5 * g * t * t
+    ph = lo[4] + lo[5] * t
+    b, _ = flight_leg_angle(P, lo[4], lo[5], t, retraction_start(P, lo[3]))
+    hip_x = x - r * math.sin(ph)
+    hip_y = y + r * math.cos(ph)
+    out[0] = x
+    out[1] = y
+    out[2] = lo[2]
+    out[3] = lo[3] - g * t
+    out[4] = ph
+    out[5] = lo[5]
+    out[6] = b
+    out[7] = hip_x + l0 * math.cos(b)
+    out[8] = hip_y - l0 * math.sin(b)
+    out[9] = hip_y
+
+
+@njit(**_INLINE)
+def _flight_heights(P, lo, t, ta):
+    """Foot and hip height, their rates and the foot x-position at ``t`` (clock from ``ta``)."""
+    g = P[P_G]
+    r = P[P_R]
+    l0 = P[P_L0]
+    ph = lo[4] + lo[5] * t
+    b, bd = flight_leg_angle(P, lo[4], lo[5], t, ta)
+    y = lo[1] + lo[3] * t - 0.5 * g * t * t
+    yd = lo[3] - g * t
+    hip_y = y + r * math.cos(ph)
+    hip_yd = yd - r * math.sin(ph) * lo[5]
+    foot_y = hip_y - l0 * math.sin(b)
+    foot_yd = hip_yd - l0 * math.cos(b) * bd
+    foot_x = lo[0] + lo[2] * t - r * math.sin(ph) + l0 * math.cos(b)
+    return foot_y, foot_yd, hip_y, hip_yd, foot_x
+
+
+@njit(**_INLINE)
+def _segment(tx, x):
+    """Index of the terrain segment holding ``x`` (breakpoints ``tx`` sorted)."""
+    k = 0
+    while k < tx.shape[0] and x >= tx[k]:
+        k += 1
+    return k
+
+
+@njit(**_INLINE)
+def _safe_dt(f, fd, K):
+    """Time ``f`` (> 0) surely stays positive given ``|f''| <= K`` and rate ``fd``."""
+    return (fd + math.sqrt(fd * fd + 2.0 * K * f)) / K
+
+
+@njit(**_JIT)
+def find_touchdown(P, O, lo, tx, th, res):
+    """First touch-down after lift-off, by certified safe steps.
+
+    With ``|f''| <= K`` bounding the foot (and hip) height's second
+    derivative, a step of ``_safe_dt`` cannot skip a zero, so the first
+    downward crossing is never missed; near the root the step is Newton-like.
+    The foot must first be above the ground (a reset foot that starts below
+    it has to rise, docs/conventions.md). Terrain: heights ``th[k]`` between
+    breakpoints ``tx`` (``len(th) == len(tx) + 1``). With the apex clock the
+    leg rate jumps at the apex, so ``K`` bounds both rates and no step
+    crosses the apex.
+
+    ``res`` receives ``(t_td, ground_h, clearance_at_reset)``.
+    """
+    g = P[P_G]
+    r = abs(P[P_R])
+    l0 = P[P_L0]
+    phid = lo[5]
+    bd = P[P_OMEGA] if P[P_GLOBAL] != 0.0 else P[P_OMEGA] - phid
+    ta = retraction_start(P, lo[3])
+    if ta > 0.0:  # before the apex the held leg turns with the trunk (local) or not at all
+        bd = max(abs(bd), abs(0.0 if P[P_GLOBAL] != 0.0 else phid))
+    Kf = g + r * phid * phid + l0 * bd * bd + 1e-300
+    Kh = g + r * phid * phid + 1e-300
+    vx = abs(lo[2]) + r * abs(phid) + l0 * abs(bd) + 1e-300
+    t_max = O[O_TMAX_FLIGHT]
+    tol = 1e-13
+    t = 0.0
+    foot_y, foot_yd, hip_y, hip_yd, foot_x = _flight_heights(P, lo, t, ta)
+    k = _segment(tx, foot_x)
+    res[1] = th[k]
+    res[2] = foot_y - th[k]
+    armed = foot_y - th[k] > 0.0
+    for _ in range(100000):
+        if t > t_max:
+            res[0] = t
+            return ST_ERR_FLIGHT_TIMEOUT
+        H = th[k]
+        hh = hip_y - H
+        if hh <= tol:  # the safe steps approach the hip's contact without crossing it
+            res[0] = t
+            res[1] = H
+            return ST_FALL_NO_TOUCHDOWN
+        f = foot_y - H
+        if armed:
+            # a downward crossing: just after arming the foot is at the ground but rising
+            if f <= tol and foot_yd <= 0.0:
+                res[0] = t
+                res[1] = H
+                return ST_OK
+            dt = _safe_dt(f, foot_yd, Kf)
+        else:
+            if f > 0.0:
+                armed = True
+                continue
+            # wait for the foot to rise above the ground: -f must reach 0
+            dt = _safe_dt(max(-f, 1e-300), -foot_yd, Kf)
+            dt = max(dt, 1e-12)
+        dt = min(dt, _safe_dt(hh, hip_yd, Kh))
+        # do not step across a terrain breakpoint unnoticed
+        if tx.shape[0] > 0:
+            dist = math.inf
+            if k > 0:
+                dist = foot_x - tx[k - 1]
+            if k < tx.shape[0]:
+                dist = min(dist, tx[k] - foot_x)
+            dt = min(dt, max(dist / vx, 1e-12))
+        if t < ta:  # stop at the apex: the foot's rate jumps there
+            dt = min(dt, ta - t)
+        t += dt
+        foot_y, foot_yd, hip_y, hip_yd, foot_x = _flight_heights(P, lo, t, ta)
+        knew = _segment(tx, foot_x)
+        if knew != k:
+            k = knew
+            if armed and foot_y - th[k] <= 0.0:
+                res[0] = t
+                res[1] = th[k]
+                return ST_FALL_TRIP
+    res[0] = t
+    return ST_ERR_FLIGHT_TIMEOUT
+
+
+@njit(**_JIT)
+def flight_samples(P, lo, ts, out):
+    """:func:`flight_state` at each time in ``ts``; ``out`` has shape (n, 10)."""
+    for i in range(ts.shape[0]):
+        flight_state(P, lo, ts[i], out[i])
+
+
+# numba does not notice when a kernel called from another file changes; drop
+# cached kernels compiled against other sources (see tslip._kernel_cache).
+_check_cache(find_touchdown, __file__)

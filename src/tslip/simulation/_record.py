@@ -1,0 +1,239 @@
+"""Compiled recorded runs (``tslip.simulate``): strides sampled into trajectory rows.
+
+Private (see :mod:`._kernels`). :data:`RECORD_RUN` holds one kernel per
+integrator method (:func:`._stride.specialise`); the row builders are
+``inline="always"``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+from numba import njit
+
+from .._kernel_cache import check as _check_cache
+from ..model._pack import (
+    NOUT,
+    NREC,
+    NTD,
+    OUT_LO,
+    OUT_NREC,
+    OUT_RECOVF,
+    OUT_TD,
+    OUT_TF,
+    OUT_TS,
+    OUT_XF,
+    P_G,
+    P_J,
+    P_K,
+    P_L0,
+    P_M,
+    P_R,
+    RI_LOFY,
+    RI_NSTANCE,
+    RI_ROW0,
+    RI_ROW1,
+    RI_STATUS,
+    RI_T0,
+    RI_TDY,
+    RUN_FULL,
+    ST_OK,
+    TR_ALPHA,
+    TR_BETA,
+    TR_BETAD,
+    TR_ENERGY,
+    TR_FOOTX,
+    TR_FOOTY,
+    TR_FX,
+    TR_FY,
+    TR_HIPX,
+    TR_HIPY,
+    TR_L,
+    TR_LD,
+    TR_PHI,
+    TR_PHID,
+    TR_STANCE,
+    TR_STEP,
+    TR_T,
+    TR_TAU,
+    TR_X,
+    TR_XD,
+    TR_Y,
+    TR_YD,
+)
+from ._flight import flight_leg_angle, flight_state, retraction_start
+from ._rk import _INLINE
+from ._specialise import specialise
+from ._stance import _com_velocity
+from ._stride import stride_of
+
+
+@njit(**_INLINE)
+def _energy(P, y, xd, yd, phid, l):
+    """Total mechanical energy: kinetic + gravity + leg spring [MgL]."""
+    return (0.5 * P[P_M] * (xd * xd + yd * yd) + 0.5 * P[P_J] * phid * phid
+            + P[P_M] * P[P_G] * y + 0.5 * P[P_K] * (P[P_L0] - l) * (P[P_L0] - l))
+
+
+@njit(**_INLINE)
+def _stance_row(P, t0, i, xf, h, r, row):
+    """Trajectory row from the stance record row ``r`` (eq. A.3-A.5: CoM, hip from the leg)."""
+    rp = P[P_R]
+    l, b, ph, ld, bd, phd = r[1], r[2], r[3], r[4], r[5], r[6]
+    sb = math.sin(b)
+    cb = math.cos(b)
+    sp = math.sin(ph)
+    cp = math.cos(ph)
+    y = h + l * sb - rp * cp
+    xd, yd = _com_velocity(rp, l, sb, cb, sp, cp, ld, bd, phd)
+    row[TR_T] = t0 + r[0]
+    row[TR_STEP] = i
+    row[TR_STANCE] = 1.0
+    row[TR_X] = xf - l * cb + rp * sp
+    row[TR_Y] = y
+    row[TR_XD] = xd
+    row[TR_YD] = yd
+    row[TR_PHI] = ph
+    row[TR_PHID] = phd
+    row[TR_L] = l
+    row[TR_BETA] = b
+    row[TR_LD] = ld
+    row[TR_BETAD] = bd
+    row[TR_ALPHA] = b + ph
+    row[TR_FOOTX] = xf
+    row[TR_FOOTY] = h
+    row[TR_HIPX] = xf - l * cb
+    row[TR_HIPY] = h + l * sb
+    row[TR_FX] = r[7]
+    row[TR_FY] = r[8]
+    row[TR_TAU] = r[9]
+    row[TR_ENERGY] = _energy(P, y, xd, yd, phd, l)
+
+
+@njit(**_INLINE)
+def _flight_row(P, t_lo, i, lo, tau, fs, row):
+    """Trajectory row ``tau`` after lift-off at ``t_lo`` (closed-form flight, eq. 2.7)."""
+    flight_state(P, lo, tau, fs)
+    l0 = P[P_L0]
+    row[TR_T] = t_lo + tau
+    row[TR_STEP] = i
+    row[TR_STANCE] = 0.0
+    for j in range(6):  # x, y, xd, yd, phi, phid
+        row[TR_X + j] = fs[j]
+    row[TR_L] = l0
+    row[TR_BETA] = fs[6]
+    row[TR_LD] = 0.0
+    row[TR_BETAD] = flight_leg_angle(P, lo[4], lo[5], tau, retraction_start(P, lo[3]))[1]
+    row[TR_ALPHA] = fs[6] + fs[4]
+    row[TR_FOOTX] = fs[7]
+    row[TR_FOOTY] = fs[8]
+    row[TR_HIPX] = fs[0] - P[P_R] * math.sin(fs[4])
+    row[TR_HIPY] = fs[9]
+    row[TR_FX] = 0.0
+    row[TR_FY] = 0.0
+    row[TR_TAU] = 0.0
+    row[TR_ENERGY] = _energy(P, fs[1], fs[2], fs[3], fs[5], l0)
+
+
+@njit(**_INLINE)
+def n_flight_samples(tf, dt, final):
+    """Flight samples of a stride: ``dt, 2 dt, ...`` strictly before ``tf`` (those within
+    1e-9 of it dropped: the next touch-down row follows), plus ``tf`` itself if ``final``."""
+    n = max(0, int(math.ceil((tf - dt) / dt))) if tf > dt else 0
+    if n > 0 and tf - (dt + (n - 1) * dt) < 1e-9:
+        n -= 1
+    return n + 1 if final else n
+
+
+def _make_record_run(method: int) -> Callable:
+    def record_run(P, O, td, tx, th, first, last, close, dt, data, tloc, starts, outs, info, pos):
+        """Strides ``first .. last - 1`` of a run, sampled every ``dt`` into trajectory rows.
+
+        Starts from the touch-down state ``td`` (7) at time ``pos[1]`` and writes
+        from row ``pos[0]`` of ``data`` (rows x NTRAJ, columns ``TR_*``): each
+        stance on the grid of :func:`._stride._make_stride` (touch-down and lift-off
+        rows included), each flight in closed form at ``dt, 2 dt, ...`` after
+        lift-off, and the touch-down instant closing the last stride if ``close``
+        (otherwise the next stride's first row is that instant). ``tloc`` gets each
+        stance row's time since its touch-down. Stride ``s`` fills ``starts[s]``
+        (its touch-down state), ``outs[s]`` (:func:`._stride._make_stride`'s output) and
+        ``info[s]`` (``RI_*``).
+
+        Returns the status of the last stride run (it stops at the first that is
+        not OK), or ``RUN_FULL`` if the next stride's rows would not fit; then
+        ``td``, ``pos = (row, t0, stride)`` say where to resume with more rows.
+        """
+        rec = np.empty((64, NREC))
+        out = np.empty(NOUT)
+        lo = np.empty(6)
+        fs = np.empty(10)
+        row = int(pos[0])
+        t0 = pos[1]
+        nmax = data.shape[0]
+        status = ST_OK
+        for s in range(first, last):
+            pos[0] = row
+            pos[1] = t0
+            pos[2] = s
+            while True:
+                status = stride_of(method, True, P, O, td, tx, th, rec, dt, out)
+                if out[OUT_RECOVF] == 0.0:
+                    break
+                rec = np.empty((4 * rec.shape[0], NREC))
+            nrec = int(out[OUT_NREC])
+            ts = out[OUT_TS]
+            tf = out[OUT_TF]
+            final = status != ST_OK or (close and s == last - 1)
+            nfl = n_flight_samples(tf, dt, final) if tf > 0.0 else 0
+            if row + nrec + nfl > nmax:
+                return RUN_FULL
+            xf = out[OUT_XF]
+            h = td[6]
+            for k in range(nrec):
+                _stance_row(P, t0, s, xf, h, rec[k], data[row + k])
+                tloc[row + k] = rec[k, 0]
+            t_lo = t0 + ts
+            for j in range(6):
+                lo[j] = out[OUT_LO + j]
+            for k in range(nfl):
+                tau = dt + k * dt
+                if final and k == nfl - 1:
+                    tau = tf
+                _flight_row(P, t_lo, s, lo, tau, fs, data[row + nrec + k])
+            for j in range(NTD):
+                starts[s, j] = td[j]
+            for j in range(NOUT):
+                outs[s, j] = out[j]
+            inf = info[s]
+            inf[RI_T0] = t0
+            inf[RI_ROW0] = row
+            inf[RI_NSTANCE] = nrec
+            inf[RI_ROW1] = row + nrec + nfl
+            inf[RI_STATUS] = status
+            inf[RI_TDY] = h + P[P_L0] * math.sin(td[0]) - P[P_R] * math.cos(td[1])
+            inf[RI_LOFY] = (lo[1] + P[P_R] * math.cos(lo[4])) - out[OUT_LO + 6] * math.sin(
+                out[OUT_LO + 7])
+            row += nrec + nfl
+            pos[0] = row
+            pos[2] = s + 1
+            if status != ST_OK:
+                break
+            t0 = t_lo + tf
+            pos[1] = t0
+            for j in range(NTD):
+                td[j] = out[OUT_TD + j]
+        return status
+
+    return record_run
+
+
+#: ``(P, O, td, tx, th, first, last, close, dt, data, tloc, starts, outs, info, pos)
+#: -> status`` by method (:func:`_make_record_run`).
+RECORD_RUN = specialise(_make_record_run, "record_run")
+
+
+# numba does not notice when a kernel called from another file changes; drop
+# cached kernels compiled against other sources (see tslip._kernel_cache).
+_check_cache(_stance_row, __file__)

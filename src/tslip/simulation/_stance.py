@@ -1,0 +1,154 @@
+"""Compiled stance dynamics: equations of motion, ground force, events, touch-down state.
+
+Private (see :mod:`._kernels`). The readable reference for the equations is
+:mod:`tslip.model.dynamics`; the tests check that both agree.
+
+Only :func:`rhs` and :func:`event_values` compile on their own: every stride
+kernel calls them from several places. The other functions are ``inline="always"``
+(numba copies them into the kernel that calls them, so a stride compiles as a few
+functions, not dozens); each still runs on its own when called from Python.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from .._kernel_cache import check as _check_cache
+from ..model._pack import P_C0, P_CL, P_G, P_J, P_K, P_L0, P_M, P_R
+from ._rk import _INLINE, _JIT
+
+#: Stance state ``y = (l, beta, phi, ld, betad, phid)``.
+NSTATE = 6
+
+
+@njit(**_INLINE)
+def hip_torque(P, phi, betad, phid):
+    """Hip torque of the stance controller (eqs 2.12-2.16), linear in the state.
+
+    ``tau = a0 + a1 phi + a2 betad + a3 phid`` with the coefficients from
+    ``Controller.torque_coefficients``.
+    """
+    return P[P_C0] + P[P_C0 + 1] * phi + P[P_C0 + 2] * betad + P[P_C0 + 3] * phid
+
+
+@njit(**_INLINE)
+def stance_accel(P, y):
+    """Generalised accelerations and forces in stance.
+
+    Solves ``M qdd = Q - C`` (eq. 2.3) for ``q = (l, beta, phi)``. The Schur
+    complement of the mass matrix (eq. 2.4) on the phi row is exactly ``J``,
+    so the 3x3 solve is closed form.
+
+    Returns ``(ldd, betadd, phidd, F_l, tau)``.
+    """
+    m = P[P_M]
+    r = P[P_R]
+    g = P[P_G]
+    l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
+    sb = math.sin(b)
+    cb = math.cos(b)
+    sp = math.sin(ph)
+    cp = math.cos(ph)
+    sa = sb * cp + cb * sp  # sin(beta + phi)
+    ca = cb * cp - sb * sp  # cos(beta + phi)
+    tau = hip_torque(P, ph, bd, phd)
+    fl = P[P_K] * (P[P_L0] - l) - P[P_CL] * ld  # eq. 2.1
+    # R = Q - C (eq. A.11, A.13)
+    r1 = -m * g * sb + fl - (m * r * phd * phd * sa - m * l * bd * bd)
+    r2 = tau - m * g * l * cb - (m * r * l * phd * phd * ca + 2.0 * m * l * bd * ld)
+    r3 = tau - m * g * r * sp - (m * r * l * bd * bd * ca + 2.0 * m * r * bd * ld * sa)
+    phdd = (r3 + r * ca * r1 - r * sa * r2 / l) / P[P_J]
+    ldd = r1 / m + r * ca * phdd
+    bdd = r2 / (m * l * l) - r * sa / l * phdd
+    return ldd, bdd, phdd, fl, tau
+
+
+@njit(**_JIT)
+def rhs(P, y, out):
+    """Stance state derivative for ``y = (l, beta, phi, ld, betad, phid)``."""
+    ldd, bdd, phdd, _, _ = stance_accel(P, y)
+    out[0] = y[3]
+    out[1] = y[4]
+    out[2] = y[5]
+    out[3] = ldd
+    out[4] = bdd
+    out[5] = phdd
+
+
+@njit(**_INLINE)
+def grf(P, y):
+    """Ground reaction force ``(F_x, F_y, tau)`` (eqs 2.5-2.6)."""
+    l, b = y[0], y[1]
+    tau = hip_torque(P, y[2], y[4], y[5])
+    fl = P[P_K] * (P[P_L0] - l) - P[P_CL] * y[3]
+    sb = math.sin(b)
+    cb = math.cos(b)
+    return -fl * cb + tau / l * sb, fl * sb + tau / l * cb, tau
+
+
+@njit(**_INLINE)
+def _com_velocity(r, l, sb, cb, sp, cp, ld, bd, phd):
+    """CoM velocity (eq. A.5) from the leg and pitch with their sines and cosines."""
+    xd = -ld * cb + l * sb * bd + r * cp * phd
+    yd = ld * sb + l * cb * bd + r * sp * phd
+    return xd, yd
+
+
+@njit(**_INLINE)
+def com_velocity(P, y):
+    """CoM velocity from the stance state (eq. A.5)."""
+    l, b, ph = y[0], y[1], y[2]
+    return _com_velocity(P[P_R], l, math.sin(b), math.cos(b), math.sin(ph), math.cos(ph),
+                         y[3], y[4], y[5])
+
+
+NEVENTS = 4  # event_values
+#: Leg length, as a fraction of ``l0``, at which a stance ends as the hip reaching the
+#: ground (eq. 2.11, ``Status.FALL_HIP_GROUND``): a leg compressed that far has put the
+#: hip on its foot. Without it such a stance ground on at ever smaller steps until
+#: ``IntegratorOptions.max_steps`` (100,000 steps, about 0.1 s of CPU a stride).
+L_COLLAPSE = 1e-3
+
+
+@njit(**_JIT)
+def event_values(P, y, gv):
+    """Stance event functions; each event fires on a crossing from > 0 to <= 0.
+
+    0: lift-off, ``F_y`` (eq. 2.8); 1: hip height above the foot
+    ``l sin(beta)`` (eq. 2.11); 2: ``xdot_m`` (eq. 2.10); 3: the leg
+    collapsing, ``l - L_COLLAPSE l0``: the hip reaching the foot, on the
+    ground, which event 1 cannot see (it only approaches zero as ``l -> 0``,
+    where the polar equations are singular, ``betad ~ 1/l^2``).
+    """
+    l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
+    sb = math.sin(b)
+    cb = math.cos(b)
+    tau = hip_torque(P, ph, bd, phd)
+    fl = P[P_K] * (P[P_L0] - l) - P[P_CL] * ld
+    gv[0] = fl * sb + tau / l * cb  # F_y, eq. 2.6
+    gv[1] = l * sb
+    gv[2] = -ld * cb + l * sb * bd + P[P_R] * math.cos(ph) * phd  # xdot_m, eq. A.5
+    gv[3] = l - L_COLLAPSE * P[P_L0]
+
+
+@njit(**_INLINE)
+def stance_initial(P, td, y0):
+    """Stance state at touch-down (l = l0), from eq. A.5 inverted for ld, betad."""
+    l0 = P[P_L0]
+    r = P[P_R]
+    b, ph, xd, yd, phd = td[0], td[1], td[2], td[3], td[4]
+    u = xd - r * math.cos(ph) * phd
+    w = yd - r * math.sin(ph) * phd
+    y0[0] = l0
+    y0[1] = b
+    y0[2] = ph
+    y0[3] = -u * math.cos(b) + w * math.sin(b)
+    y0[4] = (u * math.sin(b) + w * math.cos(b)) / l0
+    y0[5] = phd
+
+
+# numba does not notice when a kernel called from another file changes; drop
+# cached kernels compiled against other sources (see tslip._kernel_cache).
+_check_cache(event_values, __file__)

@@ -1,0 +1,478 @@
+"""Compiled strides (touch-down -> lift-off -> touch-down), one kernel per integrator method.
+
+Private (see :mod:`._kernels`). One kernel holds a whole stride: the stance's
+step-size and event loop (its steps from :mod:`._stepper`), the lift-off state
+and the closed-form flight. The Runge-Kutta pair and whether the stance is
+recorded are compile-time constants of each copy (:mod:`._specialise`), and
+only what a call uses compiles: a first :func:`tslip.step_map` compiles one
+stride kernel and the three functions it calls (:func:`._stance.rhs`,
+:func:`._stance.event_values`, :func:`._flight.find_touchdown`), against 36
+when every helper was a kernel of its own and the method a run-time argument.
+
+The small helpers are ``inline="always"``; a large body never is: numba copies
+an inlined function's IR block by block, each copy with its whole variable
+scope, so inlining the stance integrator into the stride took over a minute.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+from numba import njit, prange
+
+from .._kernel_cache import check as _check_cache
+from ..model._pack import (
+    M_DOPRI5,
+    NOUT,
+    NREC,
+    O_ATOL,
+    O_H0,
+    O_HMIN,
+    O_MAXSTEPS,
+    O_RTOL,
+    O_TMAX_STANCE,
+    OUT_CLEAR,
+    OUT_FYNEG,
+    OUT_LO,
+    OUT_NREC,
+    OUT_NREJ,
+    OUT_NSTEP,
+    OUT_RECOVF,
+    OUT_TD,
+    OUT_TF,
+    OUT_TFALL,
+    OUT_TS,
+    OUT_XF,
+    P_L0,
+    P_R,
+    ST_ERR_MAX_STEPS,
+    ST_ERR_NONFINITE,
+    ST_ERR_STANCE_TIMEOUT,
+    ST_ERR_STEP_UNDERFLOW,
+    ST_FALL_BACKWARD,
+    ST_FALL_HIP_GROUND,
+    ST_FALL_LENGTHENING,
+    ST_OK,
+)
+from . import _rk
+from ._flight import find_touchdown, flight_state
+from ._rk import _INLINE, _JIT
+from ._specialise import specialise
+from ._stance import (
+    NEVENTS,
+    NSTATE,
+    com_velocity,
+    event_values,
+    grf,
+    rhs,
+    stance_initial,
+)
+from ._stepper import dense_output, event_root, initial_step, record_row, rk_step
+
+#: numba's options for the ``prange`` batch kernels (compiled only when first used)
+_PAR = dict(_JIT, parallel=True)
+
+
+@njit(**_INLINE)
+def stride_start(P, td, y0, out):
+    """Start a stride at the touch-down state ``td``: ``out`` cleared, the stance state
+    ``y0`` (eq. A.5 inverted), the foot position ``x_f`` (returned) and whether ``F_y < 0``."""
+    for i in range(NOUT):
+        out[i] = math.nan
+    out[OUT_TS] = 0.0
+    out[OUT_TF] = 0.0
+    out[OUT_NREC] = 0.0
+    out[OUT_RECOVF] = 0.0
+    stance_initial(P, td, y0)
+    xf = td[5] + P[P_L0] * math.cos(td[0]) - P[P_R] * math.sin(td[1])
+    out[OUT_XF] = xf
+    fx0, fy0, _ = grf(P, y0)
+    out[OUT_FYNEG] = 1.0 if fy0 < 0.0 else 0.0
+    return xf
+
+
+@njit(**_INLINE)
+def stride_finish(P, O, status, td, xf, y1, stats, tx, th, out):
+    """The rest of a stride after its stance (``status``, final state ``y1``,
+    ``stats``): lift-off state, closed-form flight, touch-down; returns the status."""
+    r = P[P_R]
+    h = td[6]
+    ts = stats[0]
+    out[OUT_TS] = ts
+    out[OUT_NSTEP] = stats[1]
+    out[OUT_NREJ] = stats[2]
+    out[OUT_NREC] = stats[3]
+    out[OUT_RECOVF] = stats[4]
+    # lift-off (or final) CoM state
+    l, b, ph = y1[0], y1[1], y1[2]
+    xd, yd = com_velocity(P, y1)
+    lo = np.empty(6)
+    lo[0] = xf - l * math.cos(b) + r * math.sin(ph)
+    lo[1] = h + l * math.sin(b) - r * math.cos(ph)
+    lo[2] = xd
+    lo[3] = yd
+    lo[4] = ph
+    lo[5] = y1[5]
+    for i in range(6):
+        out[OUT_LO + i] = lo[i]
+    out[OUT_LO + 6] = l
+    out[OUT_LO + 7] = b
+    out[OUT_LO + 8] = y1[3]
+    out[OUT_LO + 9] = y1[4]
+    if status != ST_OK:
+        if status < 10:
+            out[OUT_TFALL] = ts
+        return status
+    if xd < 0.0:
+        out[OUT_TFALL] = ts
+        return ST_FALL_BACKWARD
+    res = np.empty(3)
+    fstatus = find_touchdown(P, O, lo, tx, th, res)
+    tf = res[0]
+    out[OUT_TF] = tf
+    out[OUT_CLEAR] = res[2]
+    if fstatus != ST_OK:
+        if fstatus < 10:
+            out[OUT_TFALL] = ts + tf
+        return fstatus
+    fs = np.empty(10)
+    flight_state(P, lo, tf, fs)
+    out[OUT_TD + 0] = fs[6]
+    out[OUT_TD + 1] = fs[4]
+    out[OUT_TD + 2] = fs[2]
+    out[OUT_TD + 3] = fs[3]
+    out[OUT_TD + 4] = fs[5]
+    out[OUT_TD + 5] = fs[0]
+    out[OUT_TD + 6] = res[1]
+    return ST_OK
+
+
+def _make_stride(method: int, record: bool, fly: bool = True) -> Callable:
+    def stride(P, O, td, tx, th, rec, rec_dt, out):
+        """One stride from the touch-down state ``td`` (7) to the next, with the pair ``method``.
+
+        Fills ``out`` (layout ``OUT_*`` in ``_pack``) and returns the status.
+        Without ``fly``, the stance alone from the stance state ``td`` (6): ``out``
+        receives the final state and ``stats`` (below), and nothing else runs.
+
+        The stance: a stance that starts with the hip at the ground, ``xdot_m < 0``
+        or the leg lengthening (``ld > 0``: a spring leg cannot pull) ends at once
+        with that fall (docs/conventions.md, "Events"). With ``record``, ``rec``
+        (rows x NREC) receives ``t, y, F_x, F_y, tau``: at each accepted step if
+        ``rec_dt <= 0``, else on a uniform grid of spacing ``rec_dt`` from the dense
+        output; without, ``rec`` and ``rec_dt`` are not read. ``stats`` =
+        ``[t_end, n_accepted, n_rejected, n_recorded, overflow]``.
+        """
+        y0 = np.empty(NSTATE)
+        yout = np.empty(NSTATE)
+        stats = np.empty(5)
+        if fly:
+            xf = stride_start(P, td, y0, out)
+        else:
+            xf = 0.0
+            for i in range(NSTATE):
+                y0[i] = td[i]
+        rtol = O[O_RTOL]
+        atol = O[O_ATOL]
+        max_steps = int(O[O_MAXSTEPS])
+        t_max = O[O_TMAX_STANCE]
+        h_min = O[O_HMIN]
+        ns = _rk.n_stages(method)
+        K = np.empty((_rk.NK, NSTATE))
+        R = np.empty((_rk.NR, NSTATE))
+        st = np.empty(5)
+        y = np.empty(NSTATE)
+        ynew = np.empty(NSTATE)
+        ytmp = np.empty(NSTATE)
+        gv_old = np.empty(NEVENTS)
+        gv_new = np.empty(NEVENTS)
+        gv_tmp = np.empty(NEVENTS)
+        for i in range(NSTATE):
+            y[i] = y0[i]
+        nrec_max = rec.shape[0] if record else 0
+        nrec = 0
+        overflow = 0.0
+        t = 0.0
+        event_values(P, y, gv_old)
+        status = ST_OK
+        rhs(P, y, K[0])
+        # record the first row
+        if record and nrec_max > 0:
+            record_row(P, rec, nrec, t, y)
+            nrec += 1
+        t_next_rec = rec_dt
+        # fallen already at touch-down: hip at the ground, moving backward, or the leg
+        # lengthening (ld > 0: the spring would stretch past l0 and pull on the ground,
+        # docs/conventions.md "Events")
+        fallen = gv_old[1] <= 0.0 or gv_old[2] < 0.0 or y[3] > 0.0
+        if fallen:
+            if gv_old[1] <= 0.0:
+                status = ST_FALL_HIP_GROUND
+            elif gv_old[2] < 0.0:
+                status = ST_FALL_BACKWARD
+            else:
+                status = ST_FALL_LENGTHENING
+        h = O[O_H0]
+        if h <= 0.0 and not fallen:
+            h = initial_step(P, method, y, K[0], rtol, atol, ytmp, K[1])
+        n_acc = 0
+        n_rej = 0
+        last_rejected = False
+        done = fallen
+        # a step that finds an event is followed by one exact step to the event time
+        # (the next pass of the loop), for a full-order event state
+        to_event = False
+        first_ev = -1
+        h_ev = 0.0
+        while not done:
+            if not to_event:
+                if n_acc + n_rej >= max_steps:
+                    status = ST_ERR_MAX_STEPS
+                    break
+                if t >= t_max:
+                    status = ST_ERR_STANCE_TIMEOUT
+                    break
+                if h < h_min:
+                    status = ST_ERR_STEP_UNDERFLOW
+                    break
+            if not to_event or h_ev > 0.0:
+                rk_step(P, method, y, h_ev if to_event else h, K, ytmp, ynew)
+            else:
+                for i in range(NSTATE):
+                    ynew[i] = y[i]
+            if to_event:
+                t += h_ev
+                for i in range(NSTATE):
+                    y[i] = ynew[i]
+                if first_ev == 0:
+                    status = ST_OK
+                elif first_ev == 1 or first_ev == 3:
+                    status = ST_FALL_HIP_GROUND
+                else:
+                    status = ST_FALL_BACKWARD
+                done = True
+            else:
+                err = _rk.error_norm(method, NSTATE, y, ynew, h, K, rtol, atol)
+                if not math.isfinite(err):
+                    # a NaN/inf stage: shrink hard, give up below h_min
+                    h *= 0.1
+                    n_rej += 1
+                    last_rejected = True
+                    continue
+                if err > 1.0:
+                    h *= _rk.step_factor(method, err, 10.0)
+                    n_rej += 1
+                    last_rejected = True
+                    continue
+                # accepted step: look for events, on the dense output (also the grid samples')
+                n_acc += 1
+                event_values(P, ynew, gv_new)
+                dense = False
+                if record and rec_dt > 0.0 and nrec_max > 0:
+                    dense = True
+                for ev in range(NEVENTS):
+                    if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
+                        dense = True
+                if dense:
+                    dense_output(P, method, y, ynew, h, K, R, ytmp)
+                theta_ev = 2.0
+                # falls first: lift-off wins only if strictly earlier (F_y = F_l sin(beta)
+                # and the hip height l sin(beta) vanish together when beta reaches 0)
+                for j in range(NEVENTS):
+                    ev = (1, 3, 2, 0)[j]
+                    if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
+                        theta = event_root(P, method, R, ev, gv_old[ev], gv_new[ev], ytmp,
+                                           gv_tmp, st)
+                        if theta < theta_ev - 1e-9:
+                            theta_ev = theta
+                            first_ev = ev
+                if record and rec_dt > 0.0 and nrec_max > 0:
+                    t_stop = t + h * min(theta_ev, 1.0)
+                    while t_next_rec <= t_stop:
+                        if nrec >= nrec_max:
+                            overflow = 1.0
+                            break
+                        _rk.dense_eval_inline(method, R, (t_next_rec - t) / h, ytmp)
+                        record_row(P, rec, nrec, t_next_rec, ytmp)
+                        nrec += 1
+                        t_next_rec += rec_dt
+                if first_ev >= 0:
+                    h_ev = theta_ev * h
+                    to_event = True
+                    continue
+                t += h
+                for i in range(NSTATE):
+                    y[i] = ynew[i]
+                    K[0, i] = K[ns, i]  # FSAL
+                for i in range(NEVENTS):
+                    gv_old[i] = gv_new[i]
+                fac = _rk.step_factor(method, err, 10.0)
+                if last_rejected:
+                    fac = min(1.0, fac)
+                h *= fac
+                last_rejected = False
+            for i in range(NSTATE):
+                if not math.isfinite(y[i]):
+                    status = ST_ERR_NONFINITE
+                    done = True
+            if record and rec_dt <= 0.0 and nrec_max > 0:
+                if nrec < nrec_max:
+                    record_row(P, rec, nrec, t, y)
+                    nrec += 1
+                else:
+                    overflow = 1.0
+        if record and rec_dt > 0.0 and nrec_max > 0 and status == ST_OK:
+            # always close the record with the lift-off row
+            if nrec < nrec_max:
+                record_row(P, rec, nrec, t, y)
+                nrec += 1
+            else:
+                overflow = 1.0
+        for i in range(NSTATE):
+            yout[i] = y[i]
+        stats[0] = t
+        stats[1] = n_acc
+        stats[2] = n_rej
+        stats[3] = nrec
+        stats[4] = overflow
+        if fly:
+            return stride_finish(P, O, status, td, xf, yout, stats, tx, th, out)
+        for i in range(NSTATE):
+            out[i] = yout[i]
+        for i in range(5):
+            out[NSTATE + i] = stats[i]
+        return status
+
+    return stride
+
+
+#: The stride kernels ``(P, O, td, tx, th, rec, rec_dt, out) -> status``, by method:
+#: recording nothing (``rec`` has no rows) and recording the stance into ``rec``.
+STRIDE = specialise(_make_stride, "stride", False)
+STRIDE_REC = specialise(_make_stride, "stride_rec", True)
+#: ``(P, O, y0, _, _, rec, rec_dt, out) -> status``: the stance alone from ``y0``, recorded
+#: into ``rec``; ``out`` (11) receives the final state and the stats (for the tests)
+STANCE_REC = specialise(_make_stride, "stance_rec", True, False)
+_STRIDE_DOPRI5, _STRIDE_DOP853 = STRIDE
+
+
+_STRIDE_REC_DOPRI5, _STRIDE_REC_DOP853 = STRIDE_REC
+
+
+@njit(**_INLINE)
+def stride_of(method, record, P, O, td, tx, th, rec, rec_dt, out):
+    """``STRIDE[_REC][method]`` called from a kernel where both are constants."""
+    if record:
+        if method == M_DOPRI5:
+            return _STRIDE_REC_DOPRI5(P, O, td, tx, th, rec, rec_dt, out)
+        return _STRIDE_REC_DOP853(P, O, td, tx, th, rec, rec_dt, out)
+    if method == M_DOPRI5:
+        return _STRIDE_DOPRI5(P, O, td, tx, th, rec, rec_dt, out)
+    return _STRIDE_DOP853(P, O, td, tx, th, rec, rec_dt, out)
+
+
+# ---------------------------------------------------------------------------
+# Batches: each driver exists twice, a serial loop in the calling thread (small
+# batches: waking threads costs more than a row, and under load a sleeping core
+# is not free) and a ``prange`` loop over numba's thread pool; ``parallel=True``
+# kernels compile only when first used. A row calls the compiled stride.
+# ---------------------------------------------------------------------------
+
+
+def _make_run_row(method: int) -> Callable:
+    def run_row(P, O, td0, n_steps, tx, th, hist):
+        """Run up to ``n_steps`` strides from ``td0``; returns ``(status, n_done, t_fall)``.
+
+        ``hist`` (n_steps + 1, 7) receives the touch-down states (rows after a
+        fall are left as they are); ``t_fall`` is NaN unless the run fell.
+        """
+        out = np.empty(NOUT)
+        no_rec = np.empty((0, NREC))
+        td = td0.copy()
+        for j in range(7):
+            hist[0, j] = td[j]
+        t_total = 0.0
+        st = ST_OK
+        done = 0
+        t_fall = math.nan
+        for s in range(n_steps):
+            st = stride_of(method, False, P, O, td, tx, th, no_rec, 0.0, out)
+            if st != ST_OK:
+                if st < 10:
+                    t_fall = t_total + out[OUT_TFALL]
+                break
+            t_total += out[OUT_TS] + out[OUT_TF]
+            for j in range(7):
+                td[j] = out[OUT_TD + j]
+                hist[s + 1, j] = td[j]
+            done = s + 1
+        return st, done, t_fall
+
+    return run_row
+
+
+RUN_ROW = specialise(_make_run_row, "run_row")
+_RUN_ROW_DOPRI5, _RUN_ROW_DOP853 = RUN_ROW
+
+
+@njit(**_INLINE)
+def run_row_of(method, P, O, td0, n_steps, tx, th, hist):
+    """``RUN_ROW[method]`` called from a kernel whose ``method`` is a constant."""
+    if method == M_DOPRI5:
+        return _RUN_ROW_DOPRI5(P, O, td0, n_steps, tx, th, hist)
+    return _RUN_ROW_DOP853(P, O, td0, n_steps, tx, th, hist)
+
+
+def _make_run_batch(method: int, parallel: bool) -> Callable:
+    if parallel:
+        def run_batch(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall):
+            for i in prange(Ps.shape[0]):
+                status[i], n_done[i], t_fall[i] = run_row_of(method, Ps[i], O, TDs[i], n_steps,
+                                                             TX[i], TH[i], td_hist[i])
+        return run_batch
+
+    def run_batch_serial(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall):
+        for i in range(Ps.shape[0]):
+            status[i], n_done[i], t_fall[i] = run_row_of(method, Ps[i], O, TDs[i], n_steps,
+                                                         TX[i], TH[i], td_hist[i])
+    return run_batch_serial
+
+
+#: ``(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall)``: ``n_steps``
+#: strides for each row. ``Ps`` (n, NP), ``TDs`` (n, 7), per-row terrain ``TX``
+#: (n, nb) and ``TH`` (n, nb + 1) (pad breakpoints with ``+inf``). Writes each
+#: row's touch-down states into ``td_hist`` (n, n_steps + 1, 7), the final
+#: ``status``, the number of completed strides ``n_done`` and the time of the fall
+#: ``t_fall`` (NaN if none). In the calling thread, and in parallel over rows.
+RUN_BATCH_SERIAL = specialise(_make_run_batch, "run_batch_serial", False)
+RUN_BATCH = specialise(_make_run_batch, "run_batch", True, jit=_PAR)
+
+
+def _make_stride_batch(method: int, parallel: bool) -> Callable:
+    if parallel:
+        def stride_batch(Ps, O, TDs, TX, TH, OUTs, status):
+            no_rec = np.empty((0, NREC))  # zero rows: never written, shared by the threads
+            for i in prange(Ps.shape[0]):
+                status[i] = stride_of(method, False, Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0,
+                                      OUTs[i])
+        return stride_batch
+
+    def stride_batch_serial(Ps, O, TDs, TX, TH, OUTs, status):
+        no_rec = np.empty((0, NREC))
+        for i in range(Ps.shape[0]):
+            status[i] = stride_of(method, False, Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0,
+                                      OUTs[i])
+    return stride_batch_serial
+
+
+#: ``(Ps, O, TDs, TX, TH, OUTs, status)``: one stride per row (the batched Poincare
+#: map), in the calling thread and in parallel over rows.
+STRIDE_BATCH_SERIAL = specialise(_make_stride_batch, "stride_batch_serial", False)
+STRIDE_BATCH = specialise(_make_stride_batch, "stride_batch", True, jit=_PAR)
+
+
+# numba does not notice when a kernel called from another file changes; drop
+# cached kernels compiled against other sources (see tslip._kernel_cache).
+_check_cache(_STRIDE_DOPRI5, __file__)
