@@ -109,13 +109,14 @@ def scipy_run(params: tslip.Params, td: np.ndarray, n_steps: int, tol: float,
     """``n_steps`` strides with a solve_ivp stance; returns (status, strides simulated).
 
     Stance events as the kernels (``event_values``): lift-off ``F_y`` (eq. 2.8),
-    hip on the ground (eq. 2.11), ``xdot_m < 0`` (eq. 2.10); the flight is the
+    hip on the ground (eq. 2.11), ``xdot_m < 0`` (eq. 2.10), the leg collapsing (the
+    hip on its foot, also eq. 2.11); the flight is the
     package's closed form on the terrain ``(tx, th)``.
     """
     P = pk.pack_params(params)
     O = tslip.IntegratorOptions(rtol=tol, atol=tol).packed()
     accel, ev = kn.stance_accel.py_func, kn.event_values.py_func
-    gv = np.empty(3)
+    gv = np.empty(kn.NEVENTS)
 
     def f(t, y):
         ldd, bdd, phdd, _, _ = accel(P, y)
@@ -128,8 +129,8 @@ def scipy_run(params: tslip.Params, td: np.ndarray, n_steps: int, tol: float,
         g.terminal, g.direction = True, -1
         return g
 
-    events = [event(0), event(1), event(2)]
-    falls = (None, pk.ST_FALL_HIP_GROUND, pk.ST_FALL_BACKWARD)
+    events = [event(0), event(1), event(2), event(3)]
+    falls = (None, pk.ST_FALL_HIP_GROUND, pk.ST_FALL_BACKWARD, pk.ST_FALL_HIP_GROUND)
     td = np.array(td, dtype=float)
     y0, res, fs = np.empty(6), np.empty(3), np.empty(10)
     for n in range(n_steps):
