@@ -16,7 +16,7 @@ ALLOWED = {
     "biped": {"model", "simulation", "gait"},
     "plotting": {"model", "simulation", "gait", "sweeps", "experiment", "biped"},
 }
-TOP = {"_io", "_results", "_checks", "_kernel_cache", "_codehash", "_renamed", "protocols",
+TOP = {"_io", "_results", "_checks", "_kernel_cache", "_nrt", "_codehash", "_renamed", "protocols",
        "__init__", "__main__", "_typing", "__version__"}
 
 
