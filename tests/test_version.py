@@ -50,8 +50,7 @@ def tree(tmp_path, monkeypatch):
     shutil.copytree(SRC, root, ignore=shutil.ignore_patterns("__pycache__"))
     monkeypatch.setattr(ch, "_ROOT", root)
     yield root
-    ch.module_closure.cache_clear()
-    ch.code_hash.cache_clear()
+    ch.cache_clear()
 
 
 def _edit(path: Path) -> None:
@@ -64,8 +63,7 @@ def _edit(path: Path) -> None:
 
 def _keys() -> dict[str, str]:
     """The keys of the study point cache (every analysis) and the Appendix E cache."""
-    ch.module_closure.cache_clear()
-    ch.code_hash.cache_clear()
+    ch.cache_clear()
     return {"points": code_version(["floquet", "stride", "robustness"]),
             "appendix_e": ch.code_hash(*APPENDIX_E_MODULES)}
 

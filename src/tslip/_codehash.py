@@ -29,7 +29,7 @@ import re
 from importlib import metadata
 from pathlib import Path
 
-__all__ = ["module_closure", "code_hash"]
+__all__ = ["module_closure", "code_hash", "cache_clear"]
 
 _ROOT = Path(__file__).parent
 _PKG = "tslip"
@@ -67,6 +67,7 @@ def _package_of(module: str) -> str:
     return module if path is not None and path.name == "__init__.py" else module.rpartition(".")[0]
 
 
+@functools.cache
 def _provider(package: str, name: str) -> str:
     """The module that defines ``name`` imported from ``package``.
 
@@ -82,7 +83,7 @@ def _provider(package: str, name: str) -> str:
         return package
     # walk, not just the top level: a lazy ``__init__`` (PEP 562) states its
     # names in an ``if TYPE_CHECKING:`` block
-    for node in ast.walk(ast.parse(init.read_text(encoding="utf-8"))):
+    for node in _nodes(init):
         if isinstance(node, ast.ImportFrom) and any((a.asname or a.name) == name
                                                      for a in node.names):
             base = _resolve(node, package)
@@ -91,7 +92,13 @@ def _provider(package: str, name: str) -> str:
     return f"{package}:self"
 
 
-def _plot_imports(tree: ast.AST) -> set[int]:
+@functools.cache
+def _nodes(path: Path) -> tuple[ast.AST, ...]:
+    """Every node of the source file ``path``'s syntax tree (``ast.walk`` order), parsed once."""
+    return tuple(ast.walk(ast.parse(path.read_text(encoding="utf-8"))))
+
+
+def _plot_imports(nodes: tuple[ast.AST, ...]) -> set[int]:
     """``id``s of the import statements inside a function named ``plot``.
 
     A result's ``.plot`` method imports :mod:`tslip.plotting` when called
@@ -99,26 +106,30 @@ def _plot_imports(tree: ast.AST) -> set[int]:
     computed number, so those imports are not followed.
     """
     out: set[int] = set()
-    for node in ast.walk(tree):
+    for node in nodes:
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and node.name == "plot":
             out.update(id(n) for n in ast.walk(node) if isinstance(n, (ast.Import,
                                                                          ast.ImportFrom)))
     return out
 
 
-def _imports(module: str) -> set[str]:
+@functools.cache
+def _imports(module: str) -> frozenset[str]:
     """The ``tslip`` modules that ``module``'s source imports (anywhere in the file).
 
     Except :mod:`tslip.plotting` imported inside a ``plot`` method (:func:`_plot_imports`).
+    Scanned once a process, as :func:`code_hash` reads the sources once: the
+    closures of different module sets share the scans of their common modules
+    (a sweep's cache keys take several; parsing costs about 7 ms a file).
     """
     path = _file(module)
     if path is None:
-        return set()
+        return frozenset()
     package = _package_of(module)
     out: set[str] = set()
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    in_plot = _plot_imports(tree)
-    for node in ast.walk(tree):
+    nodes = _nodes(path)
+    in_plot = _plot_imports(nodes)
+    for node in nodes:
         if id(node) in in_plot and _targets(node, package) <= {f"{_PKG}.plotting"}:
             continue
         if isinstance(node, ast.Import):
@@ -133,7 +144,7 @@ def _imports(module: str) -> set[str]:
                     out.add(base)
             else:
                 out.add(base)
-    return {m for m in out if _file(m.removesuffix(":self")) is not None}
+    return frozenset(m for m in out if _file(m.removesuffix(":self")) is not None)
 
 
 def _targets(node: ast.AST, package: str) -> set[str]:
@@ -189,3 +200,9 @@ def code_hash(*modules: str) -> str:
         source = _file(m.removesuffix(":self")).read_bytes()  # type: ignore[union-attr]
         h.update(_VERSION_LINE.sub(b"", source))
     return h.hexdigest()[:24]
+
+
+def cache_clear() -> None:
+    """Forget every scan and hash of this process (for a caller that edits sources)."""
+    for f in (_nodes, _provider, _imports, module_closure, code_hash):
+        f.cache_clear()
