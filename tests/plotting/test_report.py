@@ -304,3 +304,32 @@ def test_figures_are_tasks_ready_when_their_data_arrive_and_drawn_alike_in_worke
     run_tasks(tasks, lambda task, result: plots.done(task, result) or [], workers=2)
     direct = {k: report.figure_png(make()) for k, make in report._plots(data).items()}
     assert plots.images == direct
+
+
+def _laid_out_figure():
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6.4, 3.6), layout="constrained")
+    axs = fig.subplots(1, 2)
+    m = axs[0].pcolormesh(np.arange(12.0).reshape(3, 4))
+    fig.colorbar(m, ax=axs[0], label="a long colour-bar label [-]")
+    axs[1].plot([0.0, 1.0], [1e4, 3e4], label="line")
+    axs[1].set(xlabel="speed $v_0$ [$\\sqrt{gL}$]", ylabel="height [L]")
+    axs[1].legend()
+    fig.suptitle("a title")
+    return fig
+
+
+@pytest.mark.parametrize("dpi", [80, 120])
+def test_figure_png_is_the_image_savefig_writes(dpi) -> None:
+    """Laid out once at ``dpi`` (not in savefig's extra draw): the same PNG, the engine kept."""
+    import base64
+    import io
+
+    buf = io.BytesIO()
+    _laid_out_figure().savefig(buf, format="png", dpi=dpi)
+    fig = _laid_out_figure()
+    engine = fig.get_layout_engine()
+    uri = report.figure_png(fig, dpi=dpi)
+    assert base64.b64decode(uri.split(",", 1)[1]) == buf.getvalue()
+    assert fig.get_layout_engine() is engine

@@ -18,6 +18,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from .. import __version__
@@ -29,9 +30,26 @@ __all__ = ["PLOT_SECONDS", "SECTIONS", "ReportPlots", "compute", "figure_inputs"
 
 
 def figure_png(fig: Figure, dpi: int = 80) -> str:
-    """A figure as a ``data:image/png;base64,...`` URI."""
+    """A figure as a ``data:image/png;base64,...`` URI.
+
+    A figure with a layout engine is laid out here, at ``dpi``, and saved with
+    the engine switched off (then restored): ``savefig`` would lay it out in a
+    first, unrendered drawing of every artist and then draw it again, a sixth of
+    a report figure's time. The image is the same to the byte.
+    """
+    engine = fig.get_layout_engine()
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi)
+    if engine is None:
+        fig.savefig(buf, format="png", dpi=dpi)
+    else:
+        fig.dpi = dpi
+        FigureCanvasAgg(fig)
+        engine.execute(fig)
+        fig.set_layout_engine(None)
+        try:
+            fig.savefig(buf, format="png", dpi=dpi)
+        finally:
+            fig.set_layout_engine(engine)
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
