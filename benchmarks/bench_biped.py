@@ -11,22 +11,27 @@ Three measurements, each printed as ratios measured in the same run:
    stride's end against the compiled run at 1e-12.
 2. *Per stride*, the stride map (no recording) of the Table E.2 start at the
    tolerance (default 1e-8), with each Runge-Kutta pair, against revision
-   ``1b54594`` (``_baseline.run_at``, wall time; and the CPU time of the
-   process, steadier on a shared machine) and scipy's fastest solver of 1.
+   ``1b54594``'s ``stride`` (DOPRI5 only) and scipy's fastest solver of 1.
+   The old revision is imported in this process (``_baseline.import_at``)
+   and timed interleaved with the new code, call by call (``_baseline.ab``,
+   ``--rounds`` rounds), in wall time and in the CPU time of the process
+   (steadier on a shared machine); best and median of the rounds.
 3. *A falling run*: a Table E.2 start perturbed within its rounding
    (:func:`tslip.sweeps.appendix_e.table_e2_perturbations`), 20 strides
-   requested, against ``1b54594``.
+   requested, against ``1b54594`` (in process, interleaved, ``--repeat`` rounds).
 
-    python benchmarks/bench_biped.py [--repeat 5] [--tol 1e-8] [--no-scipy] [--no-baseline]
+    python benchmarks/bench_biped.py [--rounds 30] [--repeat 5] [--tol 1e-8] [--no-scipy]
+                                     [--no-baseline]
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import time
 
 import numpy as np
-from _baseline import BASELINE_REV, best_of, run_at
+from _baseline import BASELINE_REV, ab, import_at
 
 from tslip.biped import BipedOptions, BipedParams, BipedState, simulate, step
 from tslip.biped import _kernels as kn
@@ -90,15 +95,10 @@ def scipy_stride(p: BipedParams, y0: np.ndarray, method: str, tol: float) -> dic
             cs[pk.CS_ON_R + k] = 0.0
 
 
-# the baseline revision predates the shared names: its one stride is ``stride``
-_SETUP = ("import numpy as np\n"
-          "from tslip.biped import BipedOptions, BipedParams, BipedState, simulate, stride\n"
-          "p = BipedParams(); y0 = BipedState.thesis().to_array()\n")
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--repeat", type=int, default=5, help="rounds of the falling run")
+    ap.add_argument("--rounds", type=int, default=30, help="rounds of the stride map")
     ap.add_argument("--tol", type=float, default=1e-8)
     ap.add_argument("--no-scipy", action="store_true")
     ap.add_argument("--no-baseline", action="store_true")
@@ -121,45 +121,59 @@ def main() -> None:
             print(f"   {m:8s} {r['steps']:7d} {r['nfev']:8d} {r['njev']:5d} {dt:9.3f} "
                   f"{abs(r['t'] - ref.t):11.2e} {np.abs(r['y'] - ref.state).max():11.2e}")
 
-    print(f"2. stride map, Table E.2 start, tolerance {a.tol:g} (best of {a.repeat}; wall "
-          f"time, and CPU time of the process)")
-    new, new_cpu = {}, {}
+    print(f"2. stride map, Table E.2 start, tolerance {a.tol:g} ({a.rounds} interleaved "
+          f"rounds: best and median; wall time, and CPU time of the process)")
+    fns = {}
     for m in ("dopri5", "dop853"):
         opts = BipedOptions(rtol=a.tol, atol=a.tol, method=m)
         r = step(p, y0, 0.0, options=opts)
-        new[m] = best_of(lambda opts=opts: step(p, y0, 0.0, options=opts), a.repeat)
-        new_cpu[m] = best_of(lambda opts=opts: step(p, y0, 0.0, options=opts), a.repeat,
-                           time.process_time)
-        print(f"   {m:7s}: {1e3 * new[m]:7.2f} ms/stride wall, {1e3 * new_cpu[m]:7.2f} ms CPU, "
-              f"{r.accepted} steps, |t - t_ref| {abs(r.t - ref.t):.1e}, |y - y_ref| "
+        fns[m] = lambda opts=opts: step(p, y0, 0.0, options=opts)
+        print(f"   {m:7s}: {r.accepted} steps, |t - t_ref| {abs(r.t - ref.t):.1e}, |y - y_ref| "
               f"{np.abs(r.state - ref.state).max():.1e}")
     if not a.no_baseline:
-        stmt = f"stride(p, y0, 0.0, options=BipedOptions(rtol={a.tol!r}, atol={a.tol!r}))"
-        old = run_at(BASELINE_REV, _SETUP, stmt, repeat=a.repeat)
-        old_cpu = run_at(BASELINE_REV, _SETUP, stmt, repeat=a.repeat, clock="process_time")
-        print(f"   {BASELINE_REV} (dopri5): {1e3 * old:7.2f} ms/stride wall, {1e3 * old_cpu:7.2f} "
-              f"ms CPU")
-        for m in new:
-            print(f"   speed-up vs {BASELINE_REV}, {m}: {old / new[m]:5.1f}x wall, "
-                  f"{old_cpu / new_cpu[m]:5.1f}x CPU")
+        old = import_at(BASELINE_REV).__name__  # its one stride is ``stride``, not ``step``
+        ob = importlib.import_module(f"{old}.biped")
+        p_old, y0_old = ob.BipedParams(), ob.BipedState.thesis().to_array()
+        o_old = ob.BipedOptions(rtol=a.tol, atol=a.tol)
+        r = ob.stride(p_old, y0_old, 0.0, options=o_old)
+        fns[BASELINE_REV] = lambda: ob.stride(p_old, y0_old, 0.0, options=o_old)
+        print(f"   {BASELINE_REV} (dopri5, {ob.__file__.split('/pkg/')[-1]}): {r.accepted} steps, "
+              f"|t - t_ref| {abs(r.t - ref.t):.1e}, |y - y_ref| "
+              f"{np.abs(r.state - ref.state).max():.1e}")
+    wall, cpu = ab(fns, a.rounds), ab(fns, a.rounds, time.process_time)
+    for m in fns:
+        print(f"   {m:7s}: {1e3 * wall[m]:7.2f} ms/stride wall (median "
+              f"{1e3 * wall.median[m]:7.2f}), {1e3 * cpu[m]:7.2f} ms CPU (median "
+              f"{1e3 * cpu.median[m]:7.2f})")
+    if not a.no_baseline:
+        for m in ("dopri5", "dop853"):
+            (w, wm), (c, cm) = wall.ratio(BASELINE_REV, m), cpu.ratio(BASELINE_REV, m)
+            print(f"   speed-up vs {BASELINE_REV}, {m}: {w:5.2f}x wall (median {wm:5.2f}x), "
+                  f"{c:5.2f}x CPU (median {cm:5.2f}x)")
     if np.isfinite(best_scipy):
-        for m in new:
+        for m in ("dopri5", "dop853"):
             print(f"   speed-up vs scipy's fastest explicit solver, {m}: "
-                  f"{best_scipy / new[m]:5.0f}x")
+                  f"{best_scipy / wall[m]:5.0f}x")
 
-    print(f"3. falling run: perturbed Table E.2 start, 20 strides requested (best of "
-          f"{min(a.repeat, 3)})")
+    print(f"3. falling run: perturbed Table E.2 start, 20 strides requested ({a.repeat} "
+          f"interleaved rounds)")
     yf = table_e2_perturbations(0)[0]
     tr = simulate(p, yf, 20)
-    t_new = best_of(lambda: simulate(p, yf, 20), min(a.repeat, 3))
-    print(f"   now: {t_new:6.3f} s, {tr.status.name} at t = {tr.stats['t_end']:.3f}, "
-          f"{tr.count_strides()} strides, {tr.stats['accepted']} steps "
-          f"{tr.stats['rejected']} rejected")
+    fns = {"now": lambda: simulate(p, yf, 20)}
     if not a.no_baseline:
-        old = run_at(BASELINE_REV, _SETUP + "from tslip.sweeps.appendix_e import "
-                     "table_e2_perturbations\nyf = table_e2_perturbations(0)[0]\n",
-                     "simulate(p, yf, 20)", repeat=min(a.repeat, 3))
-        print(f"   {BASELINE_REV}: {old:6.3f} s; speed-up {old / t_new:5.1f}x")
+        old_e = importlib.import_module(f"{old}.sweeps.appendix_e")
+        yf_old = old_e.table_e2_perturbations(0)[0]
+        fns[BASELINE_REV] = lambda: ob.simulate(p_old, yf_old, 20)
+    t = ab(fns, a.repeat)
+    print(f"   now: {t['now']:6.3f} s (median {t.median['now']:6.3f}), {tr.status.name} at "
+          f"t = {tr.stats['t_end']:.3f}, {tr.count_strides()} strides, {tr.stats['accepted']} "
+          f"steps {tr.stats['rejected']} rejected")
+    if not a.no_baseline:
+        tr_old = ob.simulate(p_old, yf_old, 20)
+        best, med = t.ratio(BASELINE_REV, "now")
+        print(f"   {BASELINE_REV}: {t[BASELINE_REV]:6.3f} s (median "
+              f"{t.median[BASELINE_REV]:6.3f}), {tr_old.status.name} at t = "
+              f"{tr_old.stats['t_end']:.3f}; speed-up {best:5.2f}x (median {med:5.2f}x)")
 
 
 if __name__ == "__main__":

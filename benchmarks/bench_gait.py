@@ -22,22 +22,28 @@ ratio is what counts on a shared, noisy machine:
   search by the ratio of simulated strides (both counted here).
 
 Then (issue 12 item 3) each analysis again against *today's* code, revision
-``_baseline.BASELINE_REV`` timed by ``_baseline.run_at`` in a subprocess of
-the same run (one numba thread on both sides): gait search from the automatic
-guesses, from the gait itself and from a neighbour (``v0`` + 2 %), a
+``_baseline.BASELINE_REV``, imported in this process (``_baseline.import_at``)
+and timed interleaved with this tree call by call (``_baseline.ab``,
+``--rounds`` rounds; one numba thread on both sides): gait search from the
+automatic guesses, from the gait itself and from a neighbour (``v0`` + 2 %), a
 five-point continuation with multipliers, both Floquet methods and the
-robustness triple. Printed as new / old time and the speed-up old / new
-(target 4x for gait search, Floquet and the robustness triple). Skip it
-with ``--no-today``.
+robustness triple. Printed as new / old best time and the speed-up old / new
+of the best and of the median times (target 4x for gait search, Floquet and
+the robustness triple, judged on the best), then the two revisions' answers
+side by side. Skip it with ``--no-today``, run only it with ``--only-today``.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import importlib
 import itertools
 import math
 import sys
 import time
+import types
+from collections.abc import Callable
 from pathlib import Path
 
 import numba
@@ -54,7 +60,7 @@ from tslip.simulation import _kernels as kn
 from tslip.simulation import _packed
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _baseline import BASELINE_REV, best_of, run_at  # noqa: E402
+from _baseline import BASELINE_REV, ab, best_of, import_at  # noqa: E402
 from bench_step import scipy_stride  # noqa: E402
 
 TIGHT = 1e-12  # find_gait / floquet default tolerance
@@ -197,57 +203,72 @@ def package_strides(gait: tslip.Gait, search_tol: float) -> tuple[int, list[floa
 # against today's code (revision BASELINE_REV)
 # ---------------------------------------------------------------------------
 
-TODAY_SETUP = """
-import dataclasses, numba, numpy as np, tslip
-numba.set_num_threads(1)
-from tslip.gait.continuation import continue_gait
-from tslip.gait.fixed_point import GaitProblem
-from tslip.gait.robustness import robustness_report
-from tslip.gait.stability import floquet
-p = tslip.preset("table6.1")
-g = tslip.find_gait(p)
-z = GaitProblem.from_params(p).encode(g)
-pn = dataclasses.replace(p, v0=p.v0 * 1.02)
-"""
-
-#: (name, statement on this tree, statement on today's code, one of item 3's 4x targets?)
-#: Floquet "exact" on this tree reuses the Jacobian that find_gait computed at the
-#: gait (simulation._packed keeps it); the "cold" row clears that store first.
-_COLD = "from tslip.simulation import _packed; _packed._JACOBIANS.clear(); "
-TODAY_TASKS = [
-    ("gait search (find_gait)", "tslip.find_gait(p)", None, True),
-    ("gait search from the gait", "tslip.find_gait(p, guess=z)", None, False),
-    ("gait search from a neighbour", "tslip.find_gait(pn, guess=z)", None, False),
-    ("continuation, 5 points", "continue_gait(g, 'v0', np.linspace(1.8, 2.0, 5))", None,
-     False),
-    ("multipliers, exact, cold (floquet)", _COLD + "floquet(g)", "floquet(g)", True),
-    ("multipliers, exact, after find_gait", "floquet(g)", None, False),
-    ("multipliers, fd (floquet)", "floquet(g, method='fd')", None, True),
-    ("robustness triple", "robustness_report(g)", None, True),
-]
+#: Item 3's 4x targets.
+TARGETS = ("gait search (find_gait)", "multipliers, exact, cold (floquet)",
+           "multipliers, fd (floquet)", "robustness triple")
 
 
-def today_ratios(repeat: int, rounds: int = 3) -> None:
-    """Each task on this tree (in process) and on BASELINE_REV (subprocess).
+def today_tasks(ts: types.ModuleType) -> tuple[dict[str, Callable[[], object]], dict]:
+    """The tasks on package ``ts`` (``tslip`` or the old revision), and their results.
 
-    Best of ``rounds`` alternating rounds of ``repeat`` calls on each side.
+    Floquet "exact" on this tree reuses the Jacobian that find_gait computed at
+    the gait (``simulation._packed`` keeps it); the "cold" row clears that store
+    first. The old revision keeps none: both of its "exact" rows are cold.
     """
-    ns: dict = {}
-    exec(TODAY_SETUP, ns)
-    print(f"against today's code (revision {BASELINE_REV}), one thread, best of {rounds} "
-          f"x {repeat}")
-    print(f"{'task':<38}{'new':>11}{'old':>11}{'speed-up':>10}{'target':>8}")
-    for name, stmt, stmt_old, target in TODAY_TASKS:
-        code = compile(stmt, "<stmt>", "exec")
-        exec(code, ns)  # warm
-        t_new = t_old = math.inf
-        for _ in range(rounds):  # interleaved: a busy spell slows both sides alike
-            t_new = min(t_new, best_of(lambda code=code: exec(code, ns), repeat))
-            t_old = min(t_old, run_at(BASELINE_REV, TODAY_SETUP, stmt_old or stmt,
-                                      repeat=repeat, threads=1))
-        tgt = ("met" if t_old / t_new >= 4.0 else "MISSED") if target else ""
-        print(f"{name:<38}{t_new * 1e3:>9.2f}ms{t_old * 1e3:>9.2f}ms{t_old / t_new:>9.1f}x"
-              f"{tgt:>8}")
+    def sub(name: str) -> types.ModuleType:
+        return importlib.import_module(f"{ts.__name__}.{name}")
+
+    continue_gait = sub("gait.continuation").continue_gait
+    floquet_ = sub("gait.stability").floquet
+    report = sub("gait.robustness").robustness_report
+    try:
+        jacobians = sub("simulation._packed")._JACOBIANS
+    except ModuleNotFoundError:
+        jacobians = {}
+    p = ts.preset("table6.1")
+    g = ts.find_gait(p)
+    z = sub("gait.fixed_point").GaitProblem.from_params(p).encode(g)
+    pn = dataclasses.replace(p, v0=p.v0 * 1.02)
+
+    def cold_exact() -> object:
+        jacobians.clear()
+        return floquet_(g)
+
+    tasks = {
+        "gait search (find_gait)": lambda: ts.find_gait(p),
+        "gait search from the gait": lambda: ts.find_gait(p, guess=z),
+        "gait search from a neighbour": lambda: ts.find_gait(pn, guess=z),
+        "continuation, 5 points": lambda: continue_gait(g, "v0", np.linspace(1.8, 2.0, 5)),
+        "multipliers, exact, cold (floquet)": cold_exact,
+        "multipliers, exact, after find_gait": lambda: floquet_(g),
+        "multipliers, fd (floquet)": lambda: floquet_(g, method="fd"),
+        "robustness triple": lambda: report(g),
+    }
+    return tasks, {"z": z, "exact": floquet_(g).multipliers,
+                   "fd": floquet_(g, method="fd").multipliers, "report": report(g)}
+
+
+def today_ratios(rounds: int) -> None:
+    """Each task on this tree and on BASELINE_REV, in this process, interleaved call by call."""
+    numba.set_num_threads(1)
+    new, res_new = today_tasks(tslip)
+    old, res_old = today_tasks(import_at(BASELINE_REV))
+    print(f"against today's code (revision {BASELINE_REV}, imported in this process), one "
+          f"thread, {rounds} interleaved rounds: best (and median)")
+    print(f"{'task':<38}{'new':>11}{'old':>11}{'speed-up':>10}{'(median)':>10}{'target':>8}")
+    for name in new:
+        t = ab({"new": new[name], "old": old[name]}, rounds)
+        best, med = t.ratio("old", "new")
+        tgt = ("met" if best >= 4.0 else "MISSED") if name in TARGETS else ""
+        print(f"{name:<38}{t['new'] * 1e3:>9.2f}ms{t['old'] * 1e3:>9.2f}ms{best:>9.1f}x"
+              f"{med:>9.1f}x{tgt:>8}")
+    print(f"same answers? |z new - old| {np.max(np.abs(res_new['z'] - res_old['z'])):.1e}; "
+          f"|lambda| max: exact {np.max(np.abs(res_new['exact'])):.8f} / "
+          f"{np.max(np.abs(res_old['exact'])):.8f}, fd {np.max(np.abs(res_new['fd'])):.8f} / "
+          f"{np.max(np.abs(res_old['fd'])):.8f}")
+    print("robustness limits new / old: " + ", ".join(
+        f"{a.kind} {a.limit:+.5f} / {b.limit:+.5f}"
+        for a, b in zip(res_new["report"].limits, res_old["report"].limits, strict=True)))
 
 
 # ---------------------------------------------------------------------------
@@ -262,11 +283,11 @@ def main() -> None:
                     help=f"skip the comparison with today's code ({BASELINE_REV})")
     ap.add_argument("--only-today", action="store_true",
                     help="only the comparison with today's code")
-    ap.add_argument("--rounds", type=int, default=3,
-                    help="alternating new/old rounds of the comparison with today's code")
+    ap.add_argument("--rounds", type=int, default=10,
+                    help="interleaved new/old rounds of the comparison with today's code")
     args = ap.parse_args()
     if not args.no_today:
-        today_ratios(args.repeat, args.rounds)
+        today_ratios(args.rounds)
         print()
     if args.only_today:
         return

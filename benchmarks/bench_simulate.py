@@ -9,46 +9,56 @@ default options, sampled every ``dt`` (default 0.01):
 * ``rough``: the same on random ground (heights within +-``--rough`` every half
   metre of the path).
 
-Each is timed here and on :data:`_baseline.BASELINE_REV` in a subprocess in the
-same invocation, alternately for ``--rounds`` rounds of best-of-``--repeat``
-(the best of all counts), so the ratio is what counts on a shared machine. For
-reference, the same strides as a Python loop over ``step_map`` (no recording)
-are timed too.
+The baseline :data:`_baseline.BASELINE_REV` is imported in this process
+(``_baseline.import_at``), each workload built the same way on either
+package, and old and new are timed interleaved, call by call, for
+``--rounds`` rounds (``_baseline.ab``); the speed-up is printed from the best
+and from the median times. How far the two trajectories differ is printed
+too (they should agree to the integrator tolerance). For reference, the same
+strides as a Python loop over ``step_map`` (no recording) are timed in the
+``plain`` rounds too.
 """
 
 from __future__ import annotations
 
 import argparse
+import types
+from collections.abc import Callable
 
-from _baseline import BASELINE_REV, best_of, run_at
+import numpy as np
+from _baseline import BASELINE_REV, ab, import_at
 
-SETUP = """
-import numpy as np, tslip
-g = tslip.find_gait(tslip.preset("table6.1"))
-p, s = g.params, g.state
-rng = np.random.default_rng(0)
-xs = np.arange(1.0, 2.0 * {steps}, 0.5)
-rough = tslip.Terrain.sequence(xs.tolist(), rng.uniform(-{rough}, {rough}, xs.size + 1).tolist())
-push = tslip.Disturbance(at_step=10, dh=-0.02, dxd=0.05)
-def step_map_loop(n):
-    q = s.section()
-    for _ in range(n):
-        q = tslip.step_map(p, q).q
-"""
-
-WORKLOADS = {
-    "plain": "tr = tslip.simulate(p, s, {steps}, dt={dt})",
-    "disturbed": "tr = tslip.simulate(p, s, {steps}, dt={dt}, disturbance=push)",
-    "rough": "tr = tslip.simulate(p, s, {steps}, terrain=rough, dt={dt})",
-}
+import tslip
 
 
-def best_here(setup: str, stmt: str, repeat: int) -> tuple[float, dict]:
-    """Best-of-``repeat`` seconds of ``stmt`` on this checkout (after one warm call)."""
-    ns: dict = {}
-    exec(setup, ns)
-    code = compile(stmt, "<stmt>", "exec")
-    return best_of(lambda: exec(code, ns), repeat), ns
+def workloads(ts: types.ModuleType, steps: int, dt: float,
+              rough: float) -> dict[str, Callable[[], object]]:
+    """The three runs (and the ``step_map`` loop) on package ``ts`` (``tslip`` or the old one)."""
+    g = ts.find_gait(ts.preset("table6.1"))
+    p, s = g.params, g.state
+    rng = np.random.default_rng(0)
+    xs = np.arange(1.0, 2.0 * steps, 0.5)
+    ground = ts.Terrain.sequence(xs.tolist(), rng.uniform(-rough, rough, xs.size + 1).tolist())
+    push = ts.Disturbance(at_step=10, dh=-0.02, dxd=0.05)
+
+    def step_map_loop() -> None:
+        q = s.section()
+        for _ in range(steps):
+            q = ts.step_map(p, q).q
+
+    return {
+        "plain": lambda: ts.simulate(p, s, steps, dt=dt),
+        "disturbed": lambda: ts.simulate(p, s, steps, dt=dt, disturbance=push),
+        "rough": lambda: ts.simulate(p, s, steps, terrain=ground, dt=dt),
+        "step_map loop": step_map_loop,
+    }
+
+
+def difference(a: np.ndarray, b: np.ndarray) -> str:
+    """Largest difference of two recordings, or their shapes if those differ."""
+    if a.shape != b.shape:
+        return f"shapes {a.shape} vs {b.shape}"
+    return f"{np.max(np.abs(a - b)):.1e}"
 
 
 def main() -> None:
@@ -56,30 +66,29 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=1000)
     ap.add_argument("--dt", type=float, default=0.01)
     ap.add_argument("--rough", type=float, default=0.005, help="ground height amplitude [L]")
-    ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--rounds", type=int, default=10, help="interleaved new/old rounds")
     a = ap.parse_args()
-    setup = SETUP.format(steps=a.steps, rough=a.rough)
-    print(f"Table 6.1 gait, {a.steps} strides, dt = {a.dt}; best of {a.rounds} x {a.repeat}; "
-          f"baseline revision {BASELINE_REV}")
+    new = workloads(tslip, a.steps, a.dt, a.rough)
+    old = workloads(import_at(BASELINE_REV), a.steps, a.dt, a.rough)
+    print(f"Table 6.1 gait, {a.steps} strides, dt = {a.dt}; {a.rounds} interleaved rounds; "
+          f"baseline revision {BASELINE_REV} in process")
     print(f"{'workload':<11} {'strides':>7} {'rows':>8} {'now [ms]':>9} {'then [ms]':>10} "
-          f"{'speed-up':>9}")
-    for name, stmt in WORKLOADS.items():
-        stmt = stmt.format(steps=a.steps, dt=a.dt)
-        now = then = float("inf")
-        for _ in range(a.rounds):
-            t, ns = best_here(setup, stmt, a.repeat)
-            now = min(now, t)
-            then = min(then, run_at(BASELINE_REV, setup, stmt, repeat=a.repeat))
-        tr = ns["tr"]
-        print(f"{name:<11} {len(tr.steps):>7} {len(tr.data):>8} {now * 1e3:>9.1f} "
-              f"{then * 1e3:>10.1f} {then / now:>8.1f}x")
+          f"{'speed-up':>9} {'(median)':>9}  max |now - then|")
+    for name in ("plain", "disturbed", "rough"):
+        fns = {"now": new[name], "then": old[name]}
         if name == "plain":
-            plain = now
-    loop = min(best_here(setup, f"step_map_loop({a.steps})", a.repeat)[0]
-               for _ in range(a.rounds))
-    print(f"reference: {a.steps} step_map calls (no recording) {loop * 1e3:.1f} ms; "
-          f"simulate / step_map loop = {plain / loop:.2f}")
+            fns["loop"] = new["step_map loop"]
+        t = ab(fns, a.rounds)
+        tr, tr_old = new[name](), old[name]()
+        best, med = t.ratio("then", "now")
+        print(f"{name:<11} {len(tr.steps):>7} {len(tr.data):>8} {t['now'] * 1e3:>9.1f} "
+              f"{t['then'] * 1e3:>10.1f} {best:>8.1f}x {med:>8.1f}x  "
+              f"{difference(tr.data, tr_old.data)}")
+        if name == "plain":
+            plain = t
+    print(f"reference: {a.steps} step_map calls (no recording) {plain['loop'] * 1e3:.1f} ms; "
+          f"simulate / step_map loop = {plain.ratio('now', 'loop')[0]:.2f} (median "
+          f"{plain.ratio('now', 'loop')[1]:.2f})")
 
 
 if __name__ == "__main__":
