@@ -17,7 +17,7 @@ from tslip.simulation import _record, _stride, _variational
 
 #: every per-method kernel tuple, by where it lives
 _TUPLES = {
-    "stride": _stride.STRIDE, "stride_rec": _stride.STRIDE_REC, "run_row": _stride.RUN_ROW,
+    "stride": _stride.STRIDE, "run_row": _stride.RUN_ROW,
     "run_batch": _stride.RUN_BATCH, "run_batch_serial": _stride.RUN_BATCH_SERIAL,
     "stride_batch": _stride.STRIDE_BATCH, "stride_batch_serial": _stride.STRIDE_BATCH_SERIAL,
     "stance_rec": _stride.STANCE_REC,

@@ -53,12 +53,11 @@ from ._stride import (
     STRIDE,
     STRIDE_BATCH,
     STRIDE_BATCH_SERIAL,
-    STRIDE_REC,
 )
 
 __all__ = [
     "L_COLLAPSE", "NEVENTS", "NSTATE", "RECORD_RUN",
-    "STRIDE", "STRIDE_REC", "com_velocity",
+    "STRIDE", "com_velocity",
     "event_values", "find_touchdown", "flight_leg_angle", "flight_samples", "flight_state",
     "grf", "hip_torque", "integrate_stance", "record_run", "retraction_start", "rhs",
     "run_batch", "run_batch_serial", "stance_accel", "stance_initial", "stride", "stride_batch",
@@ -71,10 +70,9 @@ def stride(P: np.ndarray, O: np.ndarray, td: np.ndarray, tx: np.ndarray,  # noqa
     """One stride from the touch-down state ``td`` (7); fills ``out``, returns the status.
 
     The stance is recorded into ``rec`` if it has rows (see
-    :func:`._stride._make_stride`): ``STRIDE_REC[method]``, else ``STRIDE[method]``.
+    :func:`._stride._make_stride`).
     """
-    kernels = STRIDE_REC if rec.shape[0] > 0 else STRIDE
-    return kernels[int(O[O_METHOD])](P, O, td, tx, th, rec, rec_dt, out)
+    return STRIDE[int(O[O_METHOD])](P, O, td, tx, th, rec, rec_dt, out)
 
 
 _NO_TERRAIN = np.empty(0)

@@ -178,7 +178,7 @@ def _make_record_run(method: int) -> Callable:
             pos[1] = t0
             pos[2] = s
             while True:
-                status = stride_of(method, True, P, O, td, tx, th, rec, dt, out)
+                status = stride_of(method, P, O, td, tx, th, rec, dt, out)
                 if out[OUT_RECOVF] == 0.0:
                     break
                 rec = np.empty((4 * rec.shape[0], NREC))

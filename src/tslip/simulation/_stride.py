@@ -2,12 +2,15 @@
 
 Private (see :mod:`._kernels`). One kernel holds a whole stride: the stance's
 step-size and event loop (its steps from :mod:`._stepper`), the lift-off state
-and the closed-form flight. The Runge-Kutta pair and whether the stance is
-recorded are compile-time constants of each copy (:mod:`._specialise`), and
-only what a call uses compiles: a first :func:`tslip.step_map` compiles one
-stride kernel and the three functions it calls (:func:`._stance.rhs`,
-:func:`._stance.event_values`, :func:`._flight.find_touchdown`), against 36
-when every helper was a kernel of its own and the method a run-time argument.
+and the closed-form flight. The Runge-Kutta pair is a compile-time constant of
+each copy (:mod:`._specialise`), and only what a call uses compiles: a first
+:func:`tslip.step_map` compiles one stride kernel and the three functions it
+calls (:func:`._stance.rhs`, :func:`._stance.event_values`,
+:func:`._flight.find_touchdown`), against 36 when every helper was a kernel of
+its own and the method a run-time argument. The same kernel records the stance
+when given rows to record into (``tslip.simulate``, the exact Jacobian): a copy
+with recording compiled out ran no faster (``run_row`` and ``simulate`` within
+1 %, alternate calls) and cost another 10 s of compilation per method.
 
 The small helpers are ``inline="always"``; a large body never is: numba copies
 an inlined function's IR block by block, each copy with its whole variable
@@ -149,7 +152,7 @@ def stride_finish(P, O, status, td, xf, y1, stats, tx, th, out):
     return ST_OK
 
 
-def _make_stride(method: int, record: bool, fly: bool = True) -> Callable:
+def _make_stride(method: int, fly: bool = True) -> Callable:
     def stride(P, O, td, tx, th, rec, rec_dt, out):
         """One stride from the touch-down state ``td`` (7) to the next, with the pair ``method``.
 
@@ -159,7 +162,7 @@ def _make_stride(method: int, record: bool, fly: bool = True) -> Callable:
 
         The stance: a stance that starts with the hip at the ground, ``xdot_m < 0``
         or the leg lengthening (``ld > 0``: a spring leg cannot pull) ends at once
-        with that fall (docs/conventions.md, "Events"). With ``record``, ``rec``
+        with that fall (docs/conventions.md, "Events"). If it has rows, ``rec``
         (rows x NREC) receives ``t, y, F_x, F_y, tau``: at each accepted step if
         ``rec_dt <= 0``, else on a uniform grid of spacing ``rec_dt`` from the dense
         output; without, ``rec`` and ``rec_dt`` are not read. ``stats`` =
@@ -191,7 +194,7 @@ def _make_stride(method: int, record: bool, fly: bool = True) -> Callable:
         gv_tmp = np.empty(NEVENTS)
         for i in range(NSTATE):
             y[i] = y0[i]
-        nrec_max = rec.shape[0] if record else 0
+        nrec_max = rec.shape[0]
         nrec = 0
         overflow = 0.0
         t = 0.0
@@ -199,7 +202,7 @@ def _make_stride(method: int, record: bool, fly: bool = True) -> Callable:
         status = ST_OK
         rhs(P, y, K[0])
         # record the first row
-        if record and nrec_max > 0:
+        if nrec_max > 0:
             record_row(P, rec, nrec, t, y)
             nrec += 1
         t_next_rec = rec_dt
@@ -270,7 +273,7 @@ def _make_stride(method: int, record: bool, fly: bool = True) -> Callable:
                 n_acc += 1
                 event_values(P, ynew, gv_new)
                 dense = False
-                if record and rec_dt > 0.0 and nrec_max > 0:
+                if rec_dt > 0.0 and nrec_max > 0:
                     dense = True
                 for ev in range(NEVENTS):
                     if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
@@ -288,7 +291,7 @@ def _make_stride(method: int, record: bool, fly: bool = True) -> Callable:
                         if theta < theta_ev - 1e-9:
                             theta_ev = theta
                             first_ev = ev
-                if record and rec_dt > 0.0 and nrec_max > 0:
+                if rec_dt > 0.0 and nrec_max > 0:
                     t_stop = t + h * min(theta_ev, 1.0)
                     while t_next_rec <= t_stop:
                         if nrec >= nrec_max:
@@ -317,13 +320,13 @@ def _make_stride(method: int, record: bool, fly: bool = True) -> Callable:
                 if not math.isfinite(y[i]):
                     status = ST_ERR_NONFINITE
                     done = True
-            if record and rec_dt <= 0.0 and nrec_max > 0:
+            if rec_dt <= 0.0 and nrec_max > 0:
                 if nrec < nrec_max:
                     record_row(P, rec, nrec, t, y)
                     nrec += 1
                 else:
                     overflow = 1.0
-        if record and rec_dt > 0.0 and nrec_max > 0 and status == ST_OK:
+        if rec_dt > 0.0 and nrec_max > 0 and status == ST_OK:
             # always close the record with the lift-off row
             if nrec < nrec_max:
                 record_row(P, rec, nrec, t, y)
@@ -348,26 +351,18 @@ def _make_stride(method: int, record: bool, fly: bool = True) -> Callable:
     return stride
 
 
-#: The stride kernels ``(P, O, td, tx, th, rec, rec_dt, out) -> status``, by method:
-#: recording nothing (``rec`` has no rows) and recording the stance into ``rec``.
-STRIDE = specialise(_make_stride, "stride", False)
-STRIDE_REC = specialise(_make_stride, "stride_rec", True)
+#: The stride kernels ``(P, O, td, tx, th, rec, rec_dt, out) -> status``, by method
+#: (recording the stance into ``rec`` if it has rows).
+STRIDE = specialise(_make_stride, "stride")
 #: ``(P, O, y0, _, _, rec, rec_dt, out) -> status``: the stance alone from ``y0``, recorded
 #: into ``rec``; ``out`` (11) receives the final state and the stats (for the tests)
-STANCE_REC = specialise(_make_stride, "stance_rec", True, False)
+STANCE_REC = specialise(_make_stride, "stance_rec", False)
 _STRIDE_DOPRI5, _STRIDE_DOP853 = STRIDE
 
 
-_STRIDE_REC_DOPRI5, _STRIDE_REC_DOP853 = STRIDE_REC
-
-
 @njit(**_INLINE)
-def stride_of(method, record, P, O, td, tx, th, rec, rec_dt, out):
-    """``STRIDE[_REC][method]`` called from a kernel where both are constants."""
-    if record:
-        if method == M_DOPRI5:
-            return _STRIDE_REC_DOPRI5(P, O, td, tx, th, rec, rec_dt, out)
-        return _STRIDE_REC_DOP853(P, O, td, tx, th, rec, rec_dt, out)
+def stride_of(method, P, O, td, tx, th, rec, rec_dt, out):
+    """``STRIDE[method]`` called from a kernel whose ``method`` is a constant."""
     if method == M_DOPRI5:
         return _STRIDE_DOPRI5(P, O, td, tx, th, rec, rec_dt, out)
     return _STRIDE_DOP853(P, O, td, tx, th, rec, rec_dt, out)
@@ -398,7 +393,7 @@ def _make_run_row(method: int) -> Callable:
         done = 0
         t_fall = math.nan
         for s in range(n_steps):
-            st = stride_of(method, False, P, O, td, tx, th, no_rec, 0.0, out)
+            st = stride_of(method, P, O, td, tx, th, no_rec, 0.0, out)
             if st != ST_OK:
                 if st < 10:
                     t_fall = t_total + out[OUT_TFALL]
@@ -455,14 +450,14 @@ def _make_stride_batch(method: int, parallel: bool) -> Callable:
         def stride_batch(Ps, O, TDs, TX, TH, OUTs, status):
             no_rec = np.empty((0, NREC))  # zero rows: never written, shared by the threads
             for i in prange(Ps.shape[0]):
-                status[i] = stride_of(method, False, Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0,
+                status[i] = stride_of(method, Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0,
                                       OUTs[i])
         return stride_batch
 
     def stride_batch_serial(Ps, O, TDs, TX, TH, OUTs, status):
         no_rec = np.empty((0, NREC))
         for i in range(Ps.shape[0]):
-            status[i] = stride_of(method, False, Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0,
+            status[i] = stride_of(method, Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0,
                                       OUTs[i])
     return stride_batch_serial
 

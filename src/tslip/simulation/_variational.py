@@ -22,9 +22,10 @@ chain; each link is differentiated exactly:
 ``d qdd = M^-1 (dR - dM qdd)``, with the closed-form ``M^-1`` of
 :func:`._stance.stance_accel`.
 
-One kernel per integrator method (:func:`._stride.specialise`), which inlines
-the recorded stride (:func:`._stride._make_stride`); :func:`_aug_rhs` compiles
-on its own, the other helpers are ``inline="always"``.
+One kernel per integrator method (:func:`._stride.specialise`), which calls
+the method's stride kernel (:func:`._stride._make_stride`) recording every
+accepted step; :func:`_aug_rhs` compiles on its own, the other helpers are
+``inline="always"``.
 """
 
 from __future__ import annotations
@@ -176,7 +177,7 @@ def _make_stride_jacobian(method: int) -> Callable:
         Returns the stride status; ``out`` is filled as by :func:`._stride._make_stride`.
         """
         rec = np.empty((4096, NREC))
-        status = stride_of(method, True, P, O, td, tx, th, rec, 0.0, out)
+        status = stride_of(method, P, O, td, tx, th, rec, 0.0, out)
         if status != ST_OK or out[26] != 0.0:  # OUT_RECOVF
             for i in range(5):
                 for j in range(5):
