@@ -45,10 +45,12 @@ from . import _pool
 
 __all__ = ["STARTUP_SECONDS", "Task", "choose_workers", "run_tasks"]
 
-#: CPU seconds to start one worker (spawn, import, load the compiled kernels)
-#: on the project's 2-core machine with a warm compile cache; below a few of
-#: these the work runs serially (:func:`choose_workers`).
-STARTUP_SECONDS = 1.5
+#: Seconds to start the workers (the fork server importing the task modules,
+#: each worker loading the compiled kernels it uses) on the project's 2-core
+#: machine with a warm compile cache: a pool of 2 took 2.3 s to run its first
+#: tasks, and a worker's first gait search loads kernels for 0.4 s. Below a few
+#: of these the work runs serially (:func:`choose_workers`).
+STARTUP_SECONDS = 2.5
 
 
 @dataclass(frozen=True)

@@ -286,9 +286,12 @@ def _run(spec: StudySpec, out: Path | None, n_workers: int | None, scheduler: st
 
 #: Estimated seconds per point (warm compile cache, one core): its gait
 #: solve, and each analysis. They order the tasks (largest first) and size
-#: the analysis chunks and the worker count; they need not be exact.
-COST_SECONDS: dict[str, float] = {"solve": 0.12, "floquet": 0.005, "stride": 0.001,
-                                  "robustness": 0.025}
+#: the analysis chunks and the worker count; they need not be exact, but
+#: within about 2x: ``benchmarks/bench_study_costs.py`` prints each catalogue
+#: study's CPU seconds against its estimate (a 40 x 40 grid with multipliers
+#: 2.7-3.9 s, 1.7-2.4 ms a point; a 50-point line with robustness 0.55-2.1 s).
+COST_SECONDS: dict[str, float] = {"solve": 0.002, "floquet": 0.0003, "stride": 0.002,
+                                  "robustness": 0.02}
 #: Aimed-at seconds of one task of analyses: points are analysed in chunks
 #: about this long (one point at least).
 CHUNK_SECONDS = 0.4
