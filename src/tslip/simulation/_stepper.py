@@ -4,6 +4,10 @@ Private (see :mod:`._kernels`). Small ``inline="always"`` functions taking the
 Runge-Kutta pair ``method`` as an argument: the stride kernels
 (:func:`._stride._make_stride`, which hold the step-size and event loop) pass it
 as a compile-time constant, so each compiled stride holds one method's stage loop.
+The two called once a stride or so, :func:`initial_step` and :func:`event_root`,
+compile on their own instead (``method`` a run-time argument; the same
+arithmetic): numba's type inference of the stride's body, most of a cold
+start, shrinks by their copies.
 """
 
 from __future__ import annotations
@@ -43,7 +47,7 @@ def dense_output(P, method, y, ynew, h, K, R, ytmp):
     _rk.dense_coeffs_inline(method, y, ynew, h, K, R)
 
 
-@njit(**_INLINE)
+@njit(**_JIT)
 def initial_step(P, method, y, f0, rtol, atol, ytmp, f1):
     """Starting step size (Hairer, Norsett & Wanner, II.4)."""
     h0, d1 = _rk.initial_probe(y, f0, rtol, atol, ytmp)
@@ -51,7 +55,7 @@ def initial_step(P, method, y, f0, rtol, atol, ytmp, f1):
     return _rk.initial_step(method, y, f0, f1, h0, d1, rtol, atol)
 
 
-@njit(**_INLINE)
+@njit(**_JIT)
 def event_root(P, method, R, ev, g_lo, g_hi, ytmp, gv, st):
     """Root in theta of event ``ev`` on the dense output (Illinois method)."""
     _rk.root_start_inline(st, g_lo, g_hi)

@@ -4,13 +4,17 @@ Private (see :mod:`._kernels`). One kernel holds a whole stride: the stance's
 step-size and event loop (its steps from :mod:`._stepper`), the lift-off state
 and the closed-form flight. The Runge-Kutta pair is a compile-time constant of
 each copy (:mod:`._specialise`), and only what a call uses compiles: a first
-:func:`tslip.step_map` compiles one stride kernel and the three functions it
-calls (:func:`._stance.rhs`, :func:`._stance.event_values`,
-:func:`._flight.find_touchdown`), against 36 when every helper was a kernel of
-its own and the method a run-time argument. The same kernel records the stance
-when given rows to record into (``tslip.simulate``, the exact Jacobian): a copy
-with recording compiled out ran no faster (``run_row`` and ``simulate`` within
-1 %, alternate calls) and cost another 10 s of compilation per method.
+:func:`tslip.step_map` compiles one stride kernel and the functions it calls
+(:func:`._stance.rhs`, :func:`._stance.event_values`,
+:func:`._flight.find_touchdown`, and, called once a stride, :func:`stride_finish`,
+:func:`._stepper.initial_step` and :func:`._stepper.event_root`), against 36
+when every helper was a kernel of its own and the method a run-time argument.
+Those three compile on their own because numba types every inlined copy with
+the body it lands in: inlined, they made a cold first stride about 1.25x longer.
+The same kernel records the stance when given rows to record into
+(``tslip.simulate``, the exact Jacobian): a copy with recording compiled out ran
+no faster (``run_row`` and ``simulate`` within 1 %, alternate calls) and cost
+another 10 s of compilation per method.
 
 The small helpers are ``inline="always"``; a large body never is: numba copies
 an inlined function's IR block by block, each copy with its whole variable
@@ -96,10 +100,12 @@ def stride_start(P, td, y0, out):
     return xf
 
 
-@njit(**_INLINE)
+@njit(**_JIT)
 def stride_finish(P, O, status, td, xf, y1, stats, tx, th, out):
     """The rest of a stride after its stance (``status``, final state ``y1``,
-    ``stats``): lift-off state, closed-form flight, touch-down; returns the status."""
+    ``stats``): lift-off state, closed-form flight, touch-down; returns the status.
+
+    Compiled on its own (once for both methods): see the module docstring."""
     r = P[P_R]
     h = td[6]
     ts = stats[0]
