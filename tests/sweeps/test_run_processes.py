@@ -42,6 +42,20 @@ run_study(StudySpec.from_toml(sys.argv[1]), sys.argv[2], workers=2)
 """
 
 
+def _sigint_default() -> None:
+    """Ctrl-C as in a terminal, for a child: a shell starts background jobs with
+    SIGINT ignored, and a child inherits that (Python then installs no handler)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+@pytest.fixture
+def ctrl_c_raises():
+    """This process raises KeyboardInterrupt on SIGINT, even if started with it ignored."""
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)
+
+
 def _env():
     src = str(Path(tslip.__file__).parents[1])
     return {**os.environ, "PYTHONPATH": src + os.pathsep + os.environ.get("PYTHONPATH", "")}
@@ -113,7 +127,7 @@ def test_ctrl_c_prints_one_resume_line_and_exits_130(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "tslip.cli", "study", str(spec_file),
                              "--out", str(out), "--workers", "2"], env=_env(),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True, preexec_fn=_sigint_default)
     try:  # the first two lines are done: one worker is busy, the other idle
         _wait_for(lambda: _n_cached(out) >= 28)
         children = psutil.Process(proc.pid).children(recursive=True)
@@ -198,7 +212,7 @@ def test_wait_blocks_until_the_holder_releases(tmp_path, caplog):
     assert f"pid {os.getpid()}" in caplog.records[0].getMessage()
 
 
-def test_ctrl_c_during_the_final_wait_stops_the_workers():
+def test_ctrl_c_during_the_final_wait_stops_the_workers(ctrl_c_raises):
     """Leaving the block starts a wait for the workers (one still busy here, as a slow
     starter would be); a Ctrl-C during it stops them instead of leaving them running."""
     import threading
