@@ -65,16 +65,6 @@ __all__ = [
 ]
 
 
-def stride(P: np.ndarray, O: np.ndarray, td: np.ndarray, tx: np.ndarray,  # noqa: E741
-           th: np.ndarray, rec: np.ndarray, rec_dt: float, out: np.ndarray) -> int:
-    """One stride from the touch-down state ``td`` (7); fills ``out``, returns the status.
-
-    The stance is recorded into ``rec`` if it has rows (see
-    :func:`._stride._make_stride`).
-    """
-    return STRIDE[int(O[O_METHOD])](P, O, td, tx, th, rec, rec_dt, out)
-
-
 _NO_TERRAIN = np.empty(0)
 
 
@@ -91,6 +81,9 @@ def integrate_stance(P: np.ndarray, O: np.ndarray, y0: np.ndarray,  # noqa: E741
     stats[:] = out[NSTATE:]
     return int(status)
 
+#: ``(P, O, td, tx, th, rec, rec_dt, out) -> status``: one stride from the touch-down
+#: state ``td`` (7), the stance recorded into ``rec`` if it has rows (``._stride``).
+stride = ByMethod(STRIDE)
 record_run = ByMethod(RECORD_RUN)
 run_batch = ByMethod(RUN_BATCH)
 run_batch_serial = ByMethod(RUN_BATCH_SERIAL)
