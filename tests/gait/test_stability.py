@@ -4,9 +4,17 @@ import dataclasses
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import tslip
-from tslip.gait.stability import conserved_gradients, floquet, map_jacobian, pitch_decoupled
+from tslip.gait.stability import (
+    conserved_gradients,
+    eigvals,
+    floquet,
+    map_jacobian,
+    pitch_decoupled,
+)
 
 CASES = {
     "table2.1": tslip.preset("table2.1"),
@@ -120,3 +128,31 @@ def test_map_jacobian_rejects_bad_input(gaits):
         map_jacobian(g.params, g.state.section(), method="magic")
     with pytest.raises(ValueError, match="step must be"):
         map_jacobian(g.params, g.state.section(), method="fd", step=-1.0)
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(1, 7), seed=st.integers(0, 2**32 - 1), scale=st.sampled_from([1e-3, 1.0, 1e3]))
+def test_eigvals_are_numpys(n, seed, scale):
+    """The dgeev shortcut gives numpy's eigenvalues, complex pairs included (rotation blocks)."""
+    rng = np.random.default_rng(seed)
+    A = scale * rng.normal(size=(n, n))
+    if n >= 2:  # force a complex pair: a rotation block similar-transformed into A
+        B = np.eye(n)
+        B[:2, :2] = [[0.3, -0.9], [0.9, 0.3]]
+        T = rng.normal(size=(n, n)) + n * np.eye(n)
+        A = A * 1e-3 + scale * (T @ B @ np.linalg.inv(T))
+    ours = eigvals(A)
+    ref = np.linalg.eigvals(A).astype(complex)
+    assert ours.dtype == np.complex128 and ours.shape == (n,)
+    key = lambda z: (round(z.real / scale, 6), round(z.imag / scale, 6))  # noqa: E731
+    ours, ref = sorted(ours, key=key), sorted(ref, key=key)
+    assert np.allclose(ours, ref, rtol=1e-10, atol=1e-12 * scale)
+
+
+def test_eigvals_refuses_non_finite_like_numpy():
+    A = np.eye(3)
+    A[1, 2] = np.nan
+    with pytest.raises(np.linalg.LinAlgError, match="infs or NaNs"):
+        eigvals(A)
+    with pytest.raises(np.linalg.LinAlgError, match="infs or NaNs"):
+        np.linalg.eigvals(A)

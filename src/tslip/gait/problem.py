@@ -450,7 +450,7 @@ class GaitProblem:
         ``r = 0``) are removed by :func:`~tslip.gait.stability.nontrivial_jacobian`.
         NaN when a perturbed stride falls.
         """
-        from .stability import map_jacobian, nontrivial_jacobian
+        from .stability import eigvals, map_jacobian, nontrivial_jacobian
 
         p, s = self.decode(z)
         q = s.section()
@@ -460,7 +460,7 @@ class GaitProblem:
             return math.nan
         if not np.all(np.isfinite(A)):
             return math.nan
-        lam = np.linalg.eigvals(nontrivial_jacobian(p, q, A))
+        lam = eigvals(nontrivial_jacobian(p, q, A))
         return float(np.max(np.abs(lam)) ** 2) if lam.size else 0.0
 
     def cost(self, z: Sequence[float] | np.ndarray, *, eps: float = C1_THRESHOLD,
