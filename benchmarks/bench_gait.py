@@ -248,20 +248,80 @@ def today_tasks(ts: types.ModuleType) -> tuple[dict[str, Callable[[], object]], 
                    "fd": floquet_(g, method="fd").multipliers, "report": report(g)}
 
 
+def floors(gait: tslip.Gait) -> dict[str, Callable[[], object]]:
+    """The compiled work alone of three tasks, on arrays packed once: what no wrapper
+    change can remove (the least each task can cost at its integrator and tolerance).
+
+    * Floquet exact, cold: one call of the variational kernel (``stride_jacobian``,
+      DOP853 at 1e-12, the options ``floquet`` uses);
+    * Floquet fd: the ten stride kernels of eq. B.2's central differences;
+    * robustness triple: the very runs ``robustness_report`` makes (recorded from
+      one call: the same packed inputs, the same order), each a compiled ``run_row``.
+    """
+    from tslip.gait.fixed_point import TIGHT
+    from tslip.simulation import _variational as va
+    from tslip.simulation._stride import RUN_ROW
+
+    P, O = pk.pack_params(gait.params), TIGHT.packed()  # noqa: E741 - the kernels' names
+    m = int(O[pk.O_METHOD])
+    q = gait.state.section()
+    td, tx, th = _packed.touchdown(q), np.empty(0), np.array([0.0])
+    J, out = np.empty((5, 5)), np.empty(pk.NOUT)
+    rows = [_packed.touchdown(q + d) for d in np.vstack([np.eye(5), -np.eye(5)]) * 1e-5]
+    jac, stride = va.STRIDE_JACOBIAN[m], kn.STRIDE[m]
+    no_rec = np.empty((0, pk.NREC))
+
+    calls: list[tuple] = []
+    real_run = _packed.run
+
+    def record(*args: object) -> tuple[int, int]:
+        calls.append(tuple(a.copy() if isinstance(a, np.ndarray) else a for a in args))
+        return real_run(*args)
+
+    _packed.run = record
+    try:
+        robustness_report(gait)
+    finally:
+        _packed.run = real_run
+
+    def runs() -> None:
+        for P_, O_, td_, n, tx_, th_ in calls:
+            RUN_ROW[int(O_[pk.O_METHOD])](P_, O_, td_, n, tx_, th_, np.empty((n + 1, pk.NTD)))
+
+    return {
+        "multipliers, exact, cold (floquet)": lambda: jac(P, O, td, tx, th, J, out),
+        "multipliers, fd (floquet)": lambda: [stride(P, O, r, tx, th, no_rec, 0.0, out)
+                                              for r in rows],
+        "robustness triple": runs,
+    }
+
+
 def today_ratios(rounds: int) -> None:
-    """Each task on this tree and on BASELINE_REV, in this process, interleaved call by call."""
+    """Each task on this tree and on BASELINE_REV, in this process, interleaved call by call.
+
+    Where :func:`floors` has a row, the floor is timed in the same rounds, and
+    ``max`` is old / floor: the largest speed-up possible without a faster
+    integrator or fewer strides.
+    """
     numba.set_num_threads(1)
     new, res_new = today_tasks(tslip)
     old, res_old = today_tasks(import_at(BASELINE_REV))
+    low = floors(tslip.find_gait(tslip.preset("table6.1")))
     print(f"against today's code (revision {BASELINE_REV}, imported in this process), one "
           f"thread, {rounds} interleaved rounds: best (and median)")
-    print(f"{'task':<38}{'new':>11}{'old':>11}{'speed-up':>10}{'(median)':>10}{'target':>8}")
+    print(f"{'task':<38}{'new':>11}{'old':>11}{'speed-up':>10}{'(median)':>10}{'target':>8}"
+          f"{'floor':>11}{'max':>7}")
     for name in new:
-        t = ab({"new": new[name], "old": old[name]}, rounds)
+        fns = {"new": new[name], "old": old[name]}
+        if name in low:
+            fns["floor"] = low[name]
+        t = ab(fns, rounds)
         best, med = t.ratio("old", "new")
         tgt = ("met" if best >= 4.0 else "MISSED") if name in TARGETS else ""
+        bound = (f"{t['floor'] * 1e3:>9.2f}ms{t.ratio('old', 'floor')[0]:>6.1f}x"
+                 if name in low else "")
         print(f"{name:<38}{t['new'] * 1e3:>9.2f}ms{t['old'] * 1e3:>9.2f}ms{best:>9.1f}x"
-              f"{med:>9.1f}x{tgt:>8}")
+              f"{med:>9.1f}x{tgt:>8}{bound}")
     print(f"same answers? |z new - old| {np.max(np.abs(res_new['z'] - res_old['z'])):.1e}; "
           f"|lambda| max: exact {np.max(np.abs(res_new['exact'])):.8f} / "
           f"{np.max(np.abs(res_old['exact'])):.8f}, fd {np.max(np.abs(res_new['fd'])):.8f} / "

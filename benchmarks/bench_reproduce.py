@@ -16,7 +16,10 @@ critical path: the longest chain of tasks, each made ready by the one before
 what the wall time would be on a quiet 2-core machine (``max(CPU / 2,
 critical path) + report``, CPU being the whole process tree's, worker
 start-up included: the machine is shared, so the measured wall time
-includes other people's work), and the ratio against revision
+includes other people's work), the machine's ceiling for that speed-up (two
+1-worker runs at once, each in its own interpreter, against one alone:
+``2 T_alone / mean(T_pair)``, what two cores give this work with no scheduling
+loss at all; ``--no-ceiling`` skips it), and the ratio against revision
 :data:`_baseline.BASELINE_REV` timed in the same run
 (``tslip.plotting.report.reproduce`` on all cores, best of ``--repeat``).
 """
@@ -145,11 +148,22 @@ def _show(label: str, r: dict[str, Any]) -> None:
     print(f"    critical path ends: {tail}")
 
 
+def _pair(resolution: str) -> tuple[float, float]:
+    """Two 1-worker runs at once, each in its own interpreter: their wall times."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(2) as ex:
+        a, b = ex.map(lambda _: _once(resolution, 1), range(2))
+    return a["wall"], b["wall"]
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--no-baseline", action="store_true")
     ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--no-ceiling", action="store_true",
+                    help="skip the two serial runs at once (the machine's 2-core ceiling)")
     ap.add_argument("--child", nargs=2, metavar=("RESOLUTION", "WORKERS"),
                     help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -167,6 +181,13 @@ def main() -> None:
     print(f"speed-up 1 -> 2 workers: {ser['wall'] / par['wall']:.2f}x measured; on a quiet "
           f"2-core machine about {quiet:.1f} s vs {quiet_ser:.1f} s serial, "
           f"{quiet_ser / quiet:.2f}x (max(CPU / 2, critical path) + report)")
+    if not args.no_ceiling:
+        walls = _pair(res)
+        ceiling = 4.0 * ser["wall"] / sum(walls)
+        print(f"ceiling of this machine: two 1-worker runs at once took {walls[0]:.1f} s and "
+              f"{walls[1]:.1f} s against {ser['wall']:.1f} s alone, so two cores do this work "
+              f"about {ceiling:.2f}x as fast as one (2 T_alone / mean T_pair), whatever the "
+              f"schedule: the 1 -> 2 worker speed-up can reach at most that")
     if args.no_baseline:
         return
     setup = "import tempfile\nfrom tslip.plotting.report import reproduce"

@@ -16,7 +16,10 @@ package, and old and new are timed interleaved, call by call, for
 and from the median times. How far the two trajectories differ is printed
 too (they should agree to the integrator tolerance). For reference, the same
 strides as a Python loop over ``step_map`` (no recording) are timed in the
-``plain`` rounds too.
+``plain`` rounds too, and so is the floor: the same strides in one compiled
+``run_batch`` call that records nothing, the least any recorded run of them
+can cost at this integrator and tolerance (its ratio against the baseline is
+the largest speed-up recording alone could give).
 """
 
 from __future__ import annotations
@@ -47,6 +50,7 @@ def workloads(ts: types.ModuleType, steps: int, dt: float,
             q = ts.step_map(p, q).q
 
     return {
+        "floor": lambda: ts.run_batch(p, [s], steps),  # the same strides, nothing recorded
         "plain": lambda: ts.simulate(p, s, steps, dt=dt),
         "disturbed": lambda: ts.simulate(p, s, steps, dt=dt, disturbance=push),
         "rough": lambda: ts.simulate(p, s, steps, terrain=ground, dt=dt),
@@ -78,6 +82,7 @@ def main() -> None:
         fns = {"now": new[name], "then": old[name]}
         if name == "plain":
             fns["loop"] = new["step_map loop"]
+            fns["floor"] = new["floor"]
         t = ab(fns, a.rounds)
         tr, tr_old = new[name](), old[name]()
         best, med = t.ratio("then", "now")
@@ -89,6 +94,13 @@ def main() -> None:
     print(f"reference: {a.steps} step_map calls (no recording) {plain['loop'] * 1e3:.1f} ms; "
           f"simulate / step_map loop = {plain.ratio('now', 'loop')[0]:.2f} (median "
           f"{plain.ratio('now', 'loop')[1]:.2f})")
+    floor, floor_med = plain.ratio("then", "floor")
+    print(f"floor: the same {a.steps} strides in one compiled call with nothing recorded "
+          f"(run_batch, one row) {plain['floor'] * 1e3:.1f} ms, so no recording can make "
+          f"`plain` more than {floor:.1f}x (median {floor_med:.1f}x) faster than {BASELINE_REV} "
+          f"at this integrator and tolerance; recording costs "
+          f"{(plain['now'] - plain['floor']) * 1e3:.1f} ms "
+          f"({(plain['now'] - plain['floor']) / len(new['plain']().data) * 1e9:.0f} ns a row)")
 
 
 if __name__ == "__main__":
