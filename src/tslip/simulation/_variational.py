@@ -57,7 +57,7 @@ from . import _rk
 from ._flight import flight_leg_angle, retraction_start
 from ._rk import _INLINE, _JIT
 from ._specialise import ByMethod, specialise
-from ._stance import NSTATE, hip_torque, rhs, stance_accel, stance_initial
+from ._stance import NSTATE, hip_torque, rhs, stance_initial
 from ._stride import stride_of
 
 
@@ -70,8 +70,12 @@ def _solve_m(P, l, sa, ca, v1, v2, v3):
 
 
 @njit(**_INLINE)
-def rhs_jacobian(P, y, Jf):
-    """Jacobian ``Df`` (6 x 6) of the stance right-hand side at ``y``."""
+def rhs_jacobian(P, y, Jf, ldd, bdd, phdd):
+    """Jacobian ``Df`` (6 x 6) of the stance right-hand side at ``y``.
+
+    ``ldd, bdd, phdd``: the accelerations at ``y`` (:func:`._stance.stance_accel`,
+    which the caller has just computed for ``f(y)``).
+    """
     m = P[P_M]
     r = P[P_R]
     g = P[P_G]
@@ -83,7 +87,6 @@ def rhs_jacobian(P, y, Jf):
     sp, cp = math.sin(ph), math.cos(ph)
     sa = sb * cp + cb * sp
     ca = cb * cp - sb * sp
-    ldd, bdd, phdd, _, _ = stance_accel(P, y)
     for i in range(6):
         for j in range(6):
             Jf[i, j] = 0.0
@@ -139,11 +142,21 @@ NAUG = NSTATE + NSTATE * NSTATE  # y and the sensitivity Phi, row-major
 
 @njit(**_JIT)
 def _aug_rhs(P, z, out, Jf):
-    """Right-hand side of ``(y, Phi)``: ``(f(y), Df(y) Phi)``, the variational equation."""
+    """Right-hand side of ``(y, Phi)``: ``(f(y), Df(y) Phi)``, the variational equation.
+
+    The position rows of ``Df`` are ``[0 I]`` (``q' = qd``), so the position
+    rows of ``Df Phi`` are the velocity rows of ``Phi``, copied: the same
+    numbers as the full product (whose other terms are exact zeros), for half
+    its multiplications.
+    """
     y = z[:NSTATE]
     rhs(P, y, out[:NSTATE])
-    rhs_jacobian(P, y, Jf)
-    for i in range(NSTATE):
+    rhs_jacobian(P, y, Jf, out[3], out[4], out[5])  # the accelerations of f(y)
+    half = NSTATE // 2
+    for i in range(half):
+        for c in range(NSTATE):
+            out[NSTATE + i * NSTATE + c] = z[NSTATE + (i + half) * NSTATE + c]
+    for i in range(half, NSTATE):
         for c in range(NSTATE):
             acc = 0.0
             for q in range(NSTATE):
