@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Annotated
 
@@ -25,6 +26,9 @@ def viability_cmd(
     workers: Annotated[int | None, typer.Option("--workers", min=1, help="Worker processes "
                                                 "(default: by the work, up to all cores).")]
     = None,
+    rule: Annotated[str | None, typer.Option("--rule", help="Cell rule: bracket (tslip's "
+                                             "default), nearest or vibly (vibly's); "
+                                             "default: the spec's rule.")] = None,
     plot: Annotated[bool, typer.Option("--plot", help="Also draw viability.png.")] = False,
     wait: Annotated[bool, typer.Option("--wait", help="If another run is writing the "
                                        "output folder, wait for it (default: stop).")] = False,
@@ -40,6 +44,8 @@ def viability_cmd(
     console = make_console()
     with errors(), interruptible():
         spec = ViabilitySpec.from_toml(spec_path)
+        if rule is not None:  # the cached map serves every rule: only the iteration reruns
+            spec = dataclasses.replace(spec, rule=rule)
         out_dir = out if out is not None else Path("viability") / spec.name
         check_output(out_dir / "run.json", "--out")  # before any work, naming the user's path
         with progress_bar("cells") as bar:

@@ -1,4 +1,4 @@
-"""The viability iteration on a discrete state-action map (vibly's ``compute_QV``).
+"""The viability iteration on a discrete state-action map (after vibly's ``compute_QV``).
 
 A state-action map on a grid gives, for every grid state ``s`` and grid
 action ``a``, whether the step fails and, if not, the successor state
@@ -14,17 +14,26 @@ there are pairs.
 What "lands in a viable state" means for a successor between grid points is
 the *cell rule*:
 
-``"bracket"`` (default, conservative, as vibly's bracketing of off-grid
-    successors): the successor counts viable only if **every** grid point
-    of the grid cell around it is a viable state: the two bracketing points
-    in one dimension, the four corners of its grid rectangle in two. A
-    successor on a grid point (within :data:`SNAP` of a grid spacing)
-    needs only that point.
-``"nearest"``: the successor counts viable if the nearest grid point is.
-
-Under both rules a successor outside the grid's range (beyond
-:data:`SNAP` of a spacing) counts as not viable: the grid must cover the
-states of interest, and nothing is assumed about what lies outside it.
+``"bracket"`` (default, tslip's own, conservative): the successor counts
+    viable only if **every** grid point of the grid cell around it is a
+    viable state: the two bracketing points in one dimension, the four
+    corners of its grid rectangle in two. A successor on a grid point
+    (within :data:`SNAP` of a grid spacing) needs only that point. A
+    successor outside the grid's range (beyond :data:`SNAP` of a spacing)
+    is not viable: nothing is assumed about what lies outside the grid.
+``"nearest"``: the successor counts viable if the nearest grid point is;
+    outside the grid's range it is not viable, as for ``"bracket"``.
+``"vibly"`` (vibly's rule, ``compute_QV`` on a map binned by
+    ``compute_Q_map``): per axis ``b = np.digitize(s', grid)``, so
+    ``grid[b-1] <= s' < grid[b]``; the successor counts viable if every grid
+    point of the product of ``{b-1, b}`` over the axes that lies inside the
+    grid is a viable state. A successor exactly on a grid point needs that
+    point and the next one up; one above the top needs the top point, one
+    below the bottom the bottom point (outside the grid it is kept when the
+    edge state is viable). The one difference from vibly: vibly stores a
+    failed step as the raveled bin 0 and so also drops a successor that
+    lies below the bottom on every axis; here that successor is kept when
+    the bottom corner is viable, and only failed steps fail.
 """
 
 from __future__ import annotations
@@ -37,7 +46,7 @@ import numpy as np
 __all__ = ["RULES", "SNAP", "check_grid", "successor_cells", "viable_sets"]
 
 #: Cell rules of :func:`successor_cells`.
-RULES = ("bracket", "nearest")
+RULES = ("bracket", "nearest", "vibly")
 #: A successor within this fraction of a grid spacing of a grid point is on it.
 SNAP = 1e-9
 
@@ -87,34 +96,41 @@ def successor_cells(axes: Sequence[np.ndarray], nxt: np.ndarray, ok: np.ndarray,
         Successor states (ignored where ``ok`` is false).
     ok : ndarray of bool, shape (n,)
         The step did not fail.
-    rule : {"bracket", "nearest"}
+    rule : {"bracket", "nearest", "vibly"}
         The cell rule (module docstring).
 
     Returns
     -------
-    ndarray of int64, shape (n, 2**d) for ``"bracket"``, (n, 1) for ``"nearest"``
-        Indices into the flattened (C-order) state grid; a row with a ``-1``
-        is a successor that counts as not viable whatever the states are.
+    ndarray of int64, shape (n, 2**d) for ``"bracket"`` and ``"vibly"``, (n, 1) for ``"nearest"``
+        Indices into the flattened (C-order) state grid (a point may repeat);
+        a row with a ``-1`` is a successor that counts as not viable whatever
+        the states are.
     """
     if rule not in RULES:
         raise ValueError(f"rule must be one of {list(RULES)}, got {rule!r}")
     nxt = np.asarray(nxt, dtype=float)
-    n, d = nxt.shape
     shape = tuple(len(g) for g in axes)
     valid = np.asarray(ok, dtype=bool) & np.all(np.isfinite(nxt), axis=1)
     x = np.where(valid[:, None], nxt, np.array([g[0] for g in axes]))
-    brackets = [_bracket_1d(g, x[:, j]) for j, g in enumerate(axes)]
-    for _, _, inside in brackets:
-        valid &= inside
+    if rule == "vibly":
+        # per axis the in-grid points of {b-1, b}: clipped onto the grid, a pair (0, 0) or
+        # (n-1, n-1) is the one edge point
+        pairs = []
+        for j, g in enumerate(axes):
+            b = np.digitize(x[:, j], g)  # g[b-1] <= x < g[b]
+            pairs.append((np.clip(b - 1, 0, g.size - 1), np.clip(b, 0, g.size - 1)))
+    else:
+        brackets = [_bracket_1d(g, x[:, j]) for j, g in enumerate(axes)]
+        for _, _, inside in brackets:
+            valid &= inside
+        pairs = [(lo, hi) for lo, hi, _ in brackets]
     if rule == "nearest":
-        idx = []
-        for j, (lo, hi, _) in enumerate(brackets):
-            g = axes[j]
-            idx.append(np.where(np.abs(x[:, j] - g[hi]) < np.abs(x[:, j] - g[lo]), hi, lo))
+        idx = [np.where(np.abs(x[:, j] - g[hi]) < np.abs(x[:, j] - g[lo]), hi, lo)
+               for j, (g, (lo, hi)) in enumerate(zip(axes, pairs))]
         cells = np.ravel_multi_index(tuple(idx), shape)[:, None]
     else:
-        corners = [np.ravel_multi_index(tuple(brackets[j][c] for j, c in enumerate(pick)), shape)
-                   for pick in itertools.product((0, 1), repeat=d)]
+        corners = [np.ravel_multi_index(tuple(pairs[j][c] for j, c in enumerate(pick)), shape)
+                   for pick in itertools.product((0, 1), repeat=len(shape))]
         cells = np.stack(corners, axis=1)
     cells = cells.astype(np.int64)
     cells[~valid] = -1

@@ -9,8 +9,10 @@ Three results, all numpy arrays on a grid with its coordinates:
   energy, or the reason it failed. All cells run in one call of the
   batched compiled kernels (:func:`tslip.simulation.step_batch`).
 * :func:`viability` -> :class:`Viability`: the viable state-action pairs
-  and states, by vibly's iteration (:mod:`tslip.gait._viable`, which also
-  states the cell rules ``"bracket"`` and ``"nearest"``).
+  and states, by the iteration of vibly's ``compute_QV``
+  (:mod:`tslip.gait._viable`, which also states the cell rules: tslip's
+  conservative ``"bracket"`` (the default), ``"nearest"``, and vibly's own
+  ``"vibly"``).
 * :func:`basin` -> :class:`Basin`: from every grid start state at the
   apex, the strides until the runs reach a gait, or fall
   (:func:`tslip.simulation.run_batch`).
@@ -222,7 +224,7 @@ class Viability(Result):
     Attributes
     ----------
     map : StateActionMap
-    rule : {"bracket", "nearest"}
+    rule : {"bracket", "nearest", "vibly"}
         The cell rule (:mod:`tslip.gait._viable`).
     q : ndarray of bool, shape map.shape
         Viable state-action pairs: the stride does not fail and leads to a
@@ -286,7 +288,7 @@ class Viability(Result):
 
 
 def viability(smap: StateActionMap, rule: str = "bracket") -> Viability:
-    """The viability kernel of a state-action map, by vibly's iteration.
+    """The viability kernel of a state-action map, by the iteration of vibly's ``compute_QV``.
 
     Starting from every pair whose stride does not fail, each sweep keeps a
     pair only if its successor lands in a viable state by ``rule``, and a
@@ -295,18 +297,26 @@ def viability(smap: StateActionMap, rule: str = "bracket") -> Viability:
 
     Cell rule (``rule``), for a successor between grid points:
 
-    * ``"bracket"`` (default, conservative): viable only if every grid point
-      of the cell around it (2 in 1-D, 4 in 2-D) is a viable state; on a grid
-      point, only that point.
-    * ``"nearest"``: viable if the nearest grid point is.
+    * ``"bracket"`` (default, tslip's, conservative): viable only if every
+      grid point of the cell around it (2 in 1-D, 4 in 2-D) is a viable
+      state; on a grid point (within 1e-9 of a spacing), only that point;
+      outside the grid's range, never.
+    * ``"nearest"``: viable if the nearest grid point is; outside the grid's
+      range, never.
+    * ``"vibly"`` (vibly's rule): per axis ``b = np.digitize(s', grid)``;
+      viable if every grid point of the product of ``{b-1, b}`` that lies
+      inside the grid is a viable state. On a grid point it needs that point
+      and the next one up; above the top, the top point; below the bottom,
+      the bottom point. Unlike vibly, which stores a failure as bin 0, a
+      successor below the bottom on every axis is not taken for a failure.
 
-    Under both, a successor outside the grid's range is not viable, and so
-    is a failed stride (a fall, a flight with no apex, an integration error).
+    Under every rule a failed stride (a fall, a flight with no apex, an
+    integration error) is not viable.
 
     Parameters
     ----------
     smap : StateActionMap
-    rule : {"bracket", "nearest"}
+    rule : {"bracket", "nearest", "vibly"}
 
     Returns
     -------

@@ -20,7 +20,8 @@ with ``run.json``; one run at a time per folder (``.lock``)::
     name = "slip"
     preset = "slip"
     energy = 2.6              # total energy of every cell [MgL]
-    rule = "bracket"          # or "nearest" (tslip.gait.viability.viability)
+    rule = "bracket"          # tslip's default; or "nearest", or "vibly" (vibly's
+                              # rule; tslip.gait.viability.viability)
 
     [params]                  # overrides of the preset
     k = 25.0
