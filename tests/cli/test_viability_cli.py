@@ -109,7 +109,8 @@ def test_two_workers_give_the_bytes_of_one(spec, tmp_path):
 @pytest.mark.parametrize(("old", "new", "match"), [
     ("energy = 2.6", "energy = -1.0", r"energy \[MgL\] must be a number in \(0, inf\)"),
     ("energy = 2.6", "energy = 'high'", r"energy \[MgL\] must be a number"),
-    ('rule = "bracket"', 'rule = "closest"', "rule must be one of"),
+    ('rule = "bracket"', 'rule = "closest"', r"rule must be one of \['bracket', 'nearest', "
+     r"'vibly'\], got 'closest'"),
     ('name = "y"', 'name = "xd"', "unknown apex variable 'xd'"),
     ("to = 2.2", "to = 2.7", r"states\['y'\] must stay below 2.6"),
     ("points = 20", "points = 0", r"\[action\] alpha_r: points must be an integer"),
@@ -128,4 +129,30 @@ def test_a_bad_spec_value_is_one_line_naming_the_field(tmp_path, old, new, match
     import re
 
     assert re.search(match, lines[0]), lines[0]
+    assert not (tmp_path / "out" / "run.json").exists()
+
+
+def test_rule_vibly_from_the_spec_or_the_option_reuses_the_cached_map(spec, tmp_path):
+    out = tmp_path / "out"
+    assert _run(spec, "--out", out, "--workers", "1").exit_code == 0
+    bracket = Viability.load(out / "results.parquet")
+    res = _run(spec, "--out", out, "--rule", "vibly")
+    assert res.exit_code == 0, res.output
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["cached"] == 240 and meta["spec"]["rule"] == "vibly"
+    by_option = Viability.load(out / "results.parquet")
+    assert by_option.rule == "vibly" and by_option.map.next.tobytes() == bracket.map.next.tobytes()
+    # this grid has successors above its top (y = 2.2): vibly's rule keeps more pairs
+    assert by_option.q.sum() > bracket.q.sum()
+    path = tmp_path / "vibly.toml"
+    path.write_text(SPEC.format(rule="vibly"))
+    assert _run(path, "--out", tmp_path / "spec", "--workers", "1").exit_code == 0
+    _same(Viability.load(tmp_path / "spec" / "results.parquet"), by_option)
+
+
+def test_a_bad_rule_option_is_one_line(spec, tmp_path):
+    res = _run(spec, "--out", tmp_path / "out", "--rule", "closest")
+    assert res.exit_code == 2, res.output
+    lines = res.stderr.strip().splitlines()
+    assert lines == ["error: rule must be one of ['bracket', 'nearest', 'vibly'], got 'closest'"]
     assert not (tmp_path / "out" / "run.json").exists()
