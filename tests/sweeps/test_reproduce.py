@@ -51,32 +51,6 @@ def test_tiny_resolution() -> None:
         catalogue.studies("huge")
 
 
-def test_appendix_e_cache_is_reused_until_the_code_changes(tmp_path, monkeypatch) -> None:
-    from tslip.sweeps import appendix_e, reproduce
-
-    calls = []
-
-    def fake(**settings):
-        calls.append(settings)
-        return {"e2": {"strides": len(calls)}}
-
-    monkeypatch.setattr(appendix_e, "fig_appendix_e", fake)
-    first = reproduce.appendix_e_cached(tmp_path, "tiny")
-    assert calls == [reproduce.APPENDIX_E_SETTINGS["tiny"]]
-    assert (tmp_path / "figures" / "appendix_e-tiny.pkl").is_file()
-    assert reproduce.appendix_e_cached(tmp_path, "tiny") == first  # reused
-    assert len(calls) == 1
-    # another resolution is another entry
-    reproduce.appendix_e_cached(tmp_path, "quick")
-    assert len(calls) == 2
-    # an edit to the biped code changes the hash: recomputed
-    monkeypatch.setattr(reproduce, "code_hash", lambda *modules: "edited")
-    again = reproduce.appendix_e_cached(tmp_path, "tiny")
-    assert len(calls) == 3 and again == {"e2": {"strides": 3}}
-    assert reproduce.appendix_e_cached(tmp_path, "tiny") == again
-    assert len(calls) == 3
-
-
 def test_appendix_e_cache_key_covers_the_biped():
     from tslip._codehash import module_closure
     from tslip.sweeps.reproduce import APPENDIX_E_MODULES

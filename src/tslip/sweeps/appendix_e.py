@@ -9,6 +9,11 @@ Strides are counted right touch-down to right touch-down, scuffs not
 counted (:func:`tslip.biped.simulate.count_strides`). Table E.2 prints its
 initial conditions to three or four decimals, so the count is also given
 for starts perturbed within that rounding (:func:`table_e2_perturbations`).
+
+The data is cached as JSON text (:func:`to_json`) and read back by a strict
+decoder (:func:`from_json`): exactly the fields of :data:`DATA_FIELDS` with
+their types, built only from the classes of :data:`DATA_CLASSES`, so a
+cache file can hold numbers and nothing that runs.
 """
 
 from __future__ import annotations
@@ -17,14 +22,17 @@ from typing import Any
 
 import numpy as np
 
+from .._results import decode, encode
 from ..biped import BipedParams, BipedState, simulate
-from ..biped.gait import floquet, to_section, tracking_errors
+from ..biped.gait import TrackingErrors, floquet, to_section, tracking_errors
 from ..biped.metacentre import metacentric_test
-from ..biped.simulate import default_min_contact
+from ..biped.simulate import BipedEvent, Trajectory, default_min_contact
 from ..biped.stored import load_gait
+from ..gait.impulse import Impulse, PitchResponse
+from ..simulation.result import Status
 
-__all__ = ["PIECE_SECONDS", "TABLE_E2_HALF_UNIT", "assemble", "fig_appendix_e", "pieces",
-           "table_e2_perturbations"]
+__all__ = ["DATA_CLASSES", "DATA_FIELDS", "PIECE_SECONDS", "TABLE_E2_HALF_UNIT", "assemble",
+           "fig_appendix_e", "from_json", "pieces", "table_e2_perturbations", "to_json"]
 
 #: Half a unit of the last printed digit of each Table E.2 entry, in
 #: :data:`tslip.biped.STATE_FIELDS` order: positions to 3 decimals; velocities
@@ -165,3 +173,69 @@ def fig_appendix_e(n_strides: int = 20, n_converged: int = 50, n_random: int = 0
     work = pieces(n_strides, n_converged, n_random, one_at_a_time, min_contact)
     return assemble({k: fn(*args) for k, (fn, args) in work.items()}, n_strides, n_converged,
                     min_contact)
+
+
+#: The fields of :func:`fig_appendix_e`'s data, section by section, and their types
+#: (``list`` is a list of ``int``): what :func:`from_json` accepts, nothing more or less.
+DATA_FIELDS: dict[str, dict[str, type]] = {
+    "e2": {"run": Trajectory, "strides": int, "strides_raw": int, "min_contact": float,
+           "strides_perturbed": list, "of": int, "reason": str, "largest": float,
+           "residual": float, "tracking": TrackingErrors},
+    "converged": {"largest": float, "residual": float, "strides": int, "of": int,
+                  "metacentric": PitchResponse},
+}
+#: The classes a cached copy may name (the run, its events, parameters and status; the
+#: tracking errors; the metacentric test, its impulses and states) and its one array dtype.
+DATA_CLASSES = frozenset(f"{c.__module__}:{c.__qualname__}" for c in (
+    Trajectory, BipedEvent, BipedParams, BipedState, Status, TrackingErrors, PitchResponse,
+    Impulse))
+_DTYPES = frozenset({"<f8"})
+#: The tags of :func:`tslip._results.encode` the data uses (no object arrays, frames, paths).
+_TAGS = frozenset({"__type__", "__enum__", "__ndarray__", "__tuple__", "__float__"})
+
+
+def _is(v: Any, kind: type) -> bool:
+    """``v`` is a ``kind``: exactly for numbers and text (no bool for an int), a list of int."""
+    if kind is list:
+        return isinstance(v, list) and all(type(n) is int for n in v)
+    return type(v) is kind if kind in (int, float, str) else isinstance(v, kind)
+
+
+def to_json(data: dict[str, Any]) -> Any:
+    """:func:`fig_appendix_e`'s data as JSON values (floats and arrays bit for bit)."""
+    return encode(data, "appendix_e")
+
+
+def from_json(tree: Any) -> dict[str, Any]:
+    """The data :func:`to_json` made ``tree`` from, if it is exactly that; else ``ValueError``.
+
+    Before anything is built, every tagged value must be one of :data:`DATA_CLASSES`, a
+    float64 array, a tuple or a non-finite float; after, the sections and fields must be
+    those of :data:`DATA_FIELDS`, of their types.
+    """
+    stack = [tree]
+    while stack:
+        x = stack.pop()
+        if isinstance(x, list):
+            stack.extend(x)
+        elif isinstance(x, dict):
+            tags = {k for k in x if k.startswith("__")}
+            if not tags <= _TAGS or len(tags) > 1:
+                raise ValueError(f"unexpected tags {sorted(tags)}")
+            for tag, allowed in (("__type__", DATA_CLASSES), ("__enum__", DATA_CLASSES),
+                                 ("__ndarray__", _DTYPES)):
+                if tag in x and not (isinstance(x[tag], str) and x[tag] in allowed):
+                    raise ValueError(f"unexpected {tag} {x[tag]!r}")
+            stack.extend(x.values())
+    data = decode(tree)
+    if not isinstance(data, dict) or set(data) != set(DATA_FIELDS):
+        raise ValueError(f"expected the sections {sorted(DATA_FIELDS)}")
+    for section, fields in DATA_FIELDS.items():
+        got = data[section]
+        if not isinstance(got, dict) or set(got) != set(fields):
+            raise ValueError(f"{section}: expected the fields {sorted(fields)}")
+        for name, kind in fields.items():
+            if not _is(got[name], kind):
+                raise ValueError(f"{section}.{name}: expected {kind.__name__}, "
+                                 f"got {type(got[name]).__name__}")
+    return data

@@ -32,8 +32,9 @@ from __future__ import annotations
 import dataclasses
 import functools
 import itertools
+import json
+import logging
 import math
-import pickle
 import time
 from collections.abc import Callable, Mapping
 from contextlib import ExitStack
@@ -211,31 +212,54 @@ def _appendix_e_entry(out_dir: str | Path, resolution: str) -> tuple[Path, str]:
     """Appendix E's cache file and the key its content must carry."""
     settings = APPENDIX_E_SETTINGS[catalogue.resolution_name(resolution)]
     key = f"{code_hash(*APPENDIX_E_MODULES)}:{sorted(settings.items())!r}"
-    return Path(out_dir) / "figures" / f"appendix_e-{resolution}.pkl", key
+    return Path(out_dir) / "figures" / f"appendix_e-{resolution}.json", key
+
+
+#: The format of Appendix E's cache file, stored in it.
+APPENDIX_E_FORMAT = {"name": "tslip-appendix-e", "version": 1}
 
 
 def _appendix_e_load(path: Path, key: str) -> dict[str, Any] | None:
+    """The cached data if ``path`` holds it under ``key``; else None (a bad file warns once).
+
+    JSON text, decoded strictly (:func:`tslip.sweeps.appendix_e.from_json`): nothing
+    in the file can run. A file of another key (the code changed) is silently stale.
+    """
+    from .appendix_e import from_json
+
+    if not path.exists():
+        return None
     try:
-        cached = pickle.loads(path.read_bytes())
-        if isinstance(cached, dict) and cached.get("key") == key:
-            return cached["data"]
-    except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ImportError):
-        pass  # missing or unreadable: recompute
-    return None
+        record = json.loads(path.read_text(encoding="utf-8"))
+        if not (isinstance(record, dict) and set(record) == {"format", "key", "data"}
+                and record["format"] == APPENDIX_E_FORMAT):
+            raise ValueError("not an Appendix E cache of this format")
+        return from_json(record["data"]) if record["key"] == key else None
+    except (OSError, ValueError, TypeError, KeyError, IndexError, AttributeError,
+            OverflowError, RecursionError) as exc:
+        why = " ".join(str(exc).split()) or type(exc).__name__
+        logging.getLogger("tslip").warning("ignoring %s (%s); recomputing Appendix E",
+                                           path, why[:200])
+        return None
 
 
 def _appendix_e_store(path: Path, key: str, data: dict[str, Any]) -> None:
-    blob = pickle.dumps({"key": key, "data": data}, protocol=pickle.HIGHEST_PROTOCOL)
-    atomic_write(path, lambda tmp: Path(tmp).write_bytes(blob))
+    from .appendix_e import to_json
+
+    text = json.dumps({"format": APPENDIX_E_FORMAT, "key": key, "data": to_json(data)},
+                      allow_nan=False)
+    atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
 def appendix_e_cached(out_dir: str | Path, resolution: str = "full") -> dict[str, Any]:
-    """Appendix E's data, from ``out_dir/figures/appendix_e-<resolution>.pkl`` if still valid.
+    """Appendix E's data, from ``out_dir/figures/appendix_e-<resolution>.json`` if still valid.
 
     The cache is keyed by :func:`tslip._codehash.code_hash` of
     :data:`APPENDIX_E_MODULES` (their sources, everything they import from
     tslip, and the numerical libraries' versions) and the settings: a rerun
-    reuses it, a change to the biped code recomputes it. Written atomically.
+    reuses it, a change to the biped code recomputes it. Written atomically;
+    read as data only (:func:`_appendix_e_load`), a damaged or foreign file
+    recomputed.
     """
     from .appendix_e import fig_appendix_e
 
