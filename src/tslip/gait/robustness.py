@@ -44,20 +44,31 @@ direction (step up, forward push, positive pitch rate).
 
 The search (:func:`limit_search`) is pure: it sees only a predicate
 ``survives(magnitudes) -> bool array``, so the simulation stays outside the
-algorithm. Survival need not be monotone in the magnitude, so the limit is
-*defined* by the procedure, as in the thesis's binary search:
+algorithm. Survival is not monotone in the magnitude: beyond the first
+failure there can be islands of survival (the Table 2.1 gait at
+``omega_r_bar >= 1.5`` survives step-downs of 0.15-0.30 L in patches after
+falling at 0.14 L). The limit is the *first* failure, on a grid:
 
-1. bracketing: a geometric ladder ``start * 2**j`` (doubling) is evaluated in
-   one batch; the first failing rung ``hi`` and the rung below it ``lo``
-   (0 for the first rung: the periodic gait itself) bracket the limit;
+1. grid scan: the magnitudes ``h, 2h, 3h, ...`` (step ``h``, per kind
+   :data:`GRID_STEPS`) are evaluated in ascending batches of ``ladder``; the
+   first failing one ``hi`` and the grid point below it ``lo`` (0 for the
+   first: the periodic gait itself) bracket the limit;
 2. k-section: ``k`` equally spaced interior points of ``(lo, hi)`` are
    evaluated in one batch; the smallest failing one becomes ``hi`` and the
    point below it ``lo``, so each round shrinks the bracket ``k + 1`` times,
    until ``hi - lo <= tol``.
 
-The reported limit is ``lo``: a magnitude that survives, within ``tol`` of a
-magnitude ``hi`` that fails. Larger surviving islands beyond the first
-failure are not searched for.
+The reported limit is ``lo``: every grid magnitude up to it and every
+k-section point below it survives, and ``hi`` (within ``tol``) fails. This
+replaces the thesis's "binary search" (Section 3.1.3), which on such a curve
+can return a limit past a failure; with a monotone curve both give the same
+boundary to ``tol``. A failing sliver narrower than ``h`` can lie between
+two grid points below the limit and is not seen (the boundary of a 25-stride
+survival set can be ragged: Table 2.1 at ``omega_r_bar = 1.9`` fails at a
+pitch-rate change of 1.335 but survives 1.334 and 1.336), so the limit is
+the first failure *at resolution h*. If the first grid point ``h`` fails,
+the limit lies in ``[0, h)`` (0 when no k-section point survives); if
+nothing fails up to ``max_magnitude`` the limit is ``sign * inf``.
 
 Since only the first failure of a batch matters, :func:`robustness` runs a
 batch's magnitudes in ascending order, one after another on arrays packed
@@ -76,12 +87,13 @@ and :class:`RobustnessLimits`.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from .._renamed import warn_renamed
 from .._results import Result, frame
 from ..model import _pack as pk
 from ..model.parameters import Params
@@ -100,6 +112,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 __all__ = [
+    "GRID_STEPS",
     "KINDS",
     "PLACEMENTS",
     "LimitSearch",
@@ -131,13 +144,27 @@ UNITS: dict[str, str] = {
     "pitch_rate": "rad g^1/2 L^-1/2",
 }
 
+#: Grid step ``h`` of the first-failure scan per disturbance kind, in its
+#: unit (:data:`UNITS`; module notes). About 1/30 of the kind's typical limit,
+#: so that a search costs some 20-40 surviving runs (``n_steps`` strides
+#: each) before the first failure, and islands and failing gaps wider than
+#: ``h`` are resolved: step-down 0.005 L (limits 0.12-0.21 L: Table 6.1,
+#: Table 2.1 and its controllers); push 0.02 g^1/2 L^1/2 (Table 6.1: -0.73;
+#: the Table 2.1 gaits reach -1.1 to -2.2, up to ~110 grid runs); pitch rate
+#: 0.02 rad g^1/2 L^-1/2 (limits 0.68-1.6 here, Table 6.1 prints -1.50). In
+#: the retraction study (Figure 4.23, ``omega_r_bar`` 0.7-2) the first
+#: failing gap is 0.0005-0.044 L wide for the step-down, 0.001-0.047 for the
+#: push and 0.005-0.095 for the pitch rate: narrower ones can fall between
+#: grid points (module notes).
+GRID_STEPS: dict[str, float] = {"step_down": 0.005, "push": 0.02, "pitch_rate": 0.02}
+
 _SECTION_COLUMN = {"push": 2, "pitch_rate": 4}  # xd, phid in TouchdownState.as_array()
 _FLIGHT_COLUMN = {"push": 2, "pitch_rate": 5}  # xd, phid in the lift-off (x, y, xd, yd, phi, phid)
 _DEFAULT_OPTIONS = IntegratorOptions()  # the thesis's 1e-8, built (and checked) once
 
 
 # ---------------------------------------------------------------------------
-# The search: bracketing by doubling, then k-section (pure)
+# The search: a grid scan for the first failure, then k-section (pure)
 # ---------------------------------------------------------------------------
 
 
@@ -148,11 +175,11 @@ class LimitSearch:
     Attributes
     ----------
     lo : float
-        Largest magnitude known to survive below the first failure (the
-        limit); 0 if the first rung failed, ``inf`` if nothing failed up to
-        ``max_magnitude``.
+        The limit: every grid magnitude up to it survives, as does every
+        k-section point below it; in ``[0, h)`` if the first grid point
+        failed, ``inf`` if nothing failed up to ``max_magnitude``.
     hi : float
-        Smallest failing magnitude found, ``hi - lo <= tol`` (``inf`` if none).
+        The first failure found, ``hi - lo <= tol`` (``inf`` if none).
     n_calls : int
         Calls of the predicate (batches).
     n_evals : int
@@ -177,57 +204,65 @@ class LimitSearch:
 def limit_search(
     survives: Callable[[np.ndarray], np.ndarray],
     *,
-    start: float = 0.01,
+    h: float | None = None,
     tol: float = 1e-4,
     ladder: int = 8,
     k: int = 3,
     max_magnitude: float = 100.0,
+    start: float | None = None,
 ) -> LimitSearch:
-    """Largest surviving magnitude: bracketing by doubling, then k-section.
+    """The first failure: a grid scan of step ``h``, then k-section (module notes).
 
     Parameters
     ----------
     survives : callable
-        ``survives(m)`` with ``m`` an ndarray of magnitudes (> 0) returns a
-        bool array of the same shape: True where the disturbance of that
-        magnitude is survived. Called once per batch.
-    start : float
-        First rung of the doubling ladder (> 0).
+        ``survives(m)`` with ``m`` an ndarray of ascending magnitudes (> 0)
+        returns a bool array of the same shape: True where the disturbance of
+        that magnitude is survived. Called once per batch.
+    h : float
+        Grid step (> 0), in the magnitude's unit; the grid is ``h, 2h, ...``
+        (:data:`GRID_STEPS` for the three disturbances).
     tol : float
         Final bracket width ``hi - lo`` (> 0), in the magnitude's unit.
     ladder : int
-        Rungs ``start * 2**j`` evaluated per bracketing call (>= 1); if all
-        survive, the next call continues the ladder.
+        Grid points evaluated per scan call (>= 1); if all survive, the next
+        call continues the grid.
     k : int
         Interior points per k-section call (>= 1; 1 is bisection). Each call
         shrinks the bracket ``k + 1`` times.
     max_magnitude : float
-        Stop bracketing here (the last rung is clipped to it).
+        End of the grid (the last point is clipped to it); the scan costs up
+        to ``max_magnitude / h`` evaluations when nothing fails.
+    start : float, optional
+        The old name of ``h`` (the doubling ladder's first rung, as ``h`` is
+        the grid's); give one of the two.
 
     Returns
     -------
     LimitSearch
-        ``lo`` survives and ``hi`` fails, with ``hi - lo <= tol``; when
-        survival is not monotone, ``hi`` is the first failure met by the
-        ladder and the k-section inside its bracket (see the module notes).
+        ``lo`` survives and ``hi`` fails, with ``hi - lo <= tol``; no grid
+        point at or below ``lo`` and no k-section point below ``lo`` fails.
 
     Raises
     ------
     ValueError
-        For non-positive ``start``/``tol``/``max_magnitude``, ``ladder < 1``,
-        ``k < 1``, or a predicate answer of the wrong shape.
+        For no or a non-positive ``h``, non-positive ``tol``/``max_magnitude``,
+        ``ladder < 1``, ``k < 1``, or a predicate answer of the wrong shape.
 
     Examples
     --------
-    >>> s = limit_search(lambda m: m < 0.3, tol=1e-3)
+    Survival on [0, 0.3) and on an island [0.5, 0.6): the limit is 0.3.
+
+    >>> s = limit_search(lambda m: (m < 0.3) | ((m >= 0.5) & (m < 0.6)), h=0.01, tol=1e-3)
     >>> s.lo < 0.3 <= s.hi, s.hi - s.lo <= 1e-3, s.n_calls
-    (True, True, 5)
+    (True, True, 6)
     """
-    for name, v in (("start", start), ("tol", tol), ("max_magnitude", max_magnitude)):
+    h = _grid_step(h, start)
+    for name, v in (("tol", tol), ("max_magnitude", max_magnitude)):
         if not (math.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be in (0, inf), got {v!r}")
-    if start > max_magnitude:
-        raise ValueError(f"start ({start!r}) must not exceed max_magnitude ({max_magnitude!r})")
+    if h > max_magnitude:
+        raise ValueError(f"h ({h!r}) must not exceed max_magnitude ({max_magnitude!r})")
     for name, n in (("ladder", ladder), ("k", k)):
         if not isinstance(n, (int, np.integer)) or n < 1:
             raise ValueError(f"{name} must be an integer >= 1, got {n!r}")
@@ -243,9 +278,10 @@ def limit_search(
         return ok
 
     lo, hi = 0.0, math.inf
-    first = start
-    while not math.isfinite(hi):  # bracketing: a doubling ladder per call
-        rungs = first * 2.0 ** np.arange(int(ladder))
+    j = 0  # grid points asked so far
+    while not math.isfinite(hi):  # grid scan: ``ladder`` points j*h per call
+        rungs = h * np.arange(j + 1, j + int(ladder) + 1)
+        j += int(ladder)
         rungs = rungs[rungs < max_magnitude]
         if len(rungs) < ladder:
             rungs = np.append(rungs, max_magnitude)
@@ -259,7 +295,6 @@ def limit_search(
             lo = float(rungs[-1])
             if lo >= max_magnitude:
                 return _done(math.inf, math.inf, mags, oks)
-            first = 2.0 * lo
     while hi - lo > tol:  # k-section: k interior points per call
         pts = lo + (hi - lo) * np.arange(1, int(k) + 1) / (k + 1)
         pts = pts[(pts > lo) & (pts < hi)]  # guard against rounding at tiny brackets
@@ -274,6 +309,27 @@ def limit_search(
         else:
             lo = float(pts[-1])
     return _done(lo, hi, mags, oks)
+
+
+def _deprecated_start(start: float | None) -> float | None:
+    """The public functions' old ``start`` (the ladder's first rung), now ``h``: warns."""
+    if start is not None:
+        warn_renamed("start= (the first rung of the old doubling ladder)",
+                     "h= (the grid step, tslip.gait.robustness.GRID_STEPS)", stacklevel=4)
+    return start
+
+
+def _grid_step(h: float | None, start: float | None) -> float:
+    """``h``, or its old name ``start``; refuse neither, both different, or a bad value."""
+    if h is None:
+        h = start
+    elif start is not None and start != h:
+        raise ValueError(f"give h or its old name start, not both (h={h!r}, start={start!r})")
+    if h is None:
+        raise ValueError("h (the grid step) must be given")
+    if not (math.isfinite(h) and h > 0):
+        raise ValueError(f"h must be in (0, inf), got {h!r}")
+    return float(h)
 
 
 def _done(lo: float, hi: float, mags: list[np.ndarray], oks: list[np.ndarray]) -> LimitSearch:
@@ -591,11 +647,12 @@ def robustness(
     tol: float = 1e-4,
     options: IntegratorOptions | None = None,
     check: bool = True,
-    start: float = 0.01,
+    h: float | None = None,
     ladder: int = 8,
     k: int = 3,
     max_magnitude: float = 100.0,
     placement: Placement = "touchdown",
+    start: float | None = None,
 ) -> float:
     """Largest disturbance of one kind the gait survives for ``n_steps`` strides.
 
@@ -618,21 +675,28 @@ def robustness(
         Integrator of the disturbed runs (default: the thesis's 1e-8).
     check : bool
         Refuse unconverged or unstable gaits (see :func:`check_gait`).
-    start, ladder, k, max_magnitude
+    h : float, optional
+        Grid step of the first-failure scan, in the unit of ``kind``
+        (default :data:`GRID_STEPS` ``[kind]``).
+    ladder, k, max_magnitude
         Search settings (:func:`limit_search`).
     placement : {"touchdown", "touchdown_hip", "liftoff", "apex"}
         Where a push or pitch-rate change is applied (module notes).
+    start : float, optional
+        Deprecated old name of ``h`` (it warns; removed in 0.4).
 
     Returns
     -------
     float
-        The signed limit (``sign * inf`` if no failure up to ``max_magnitude``).
+        The signed limit: the first failure on the grid of step ``h``,
+        refined to ``tol`` (module notes); ``sign * inf`` if no failure up to
+        ``max_magnitude``.
 
     Raises
     ------
     ValueError
-        For a bad ``kind`` or ``sign``, or (with ``check``) an unconverged or
-        unstable gait.
+        For a bad ``kind``, ``sign`` or ``h``, or (with ``check``) an
+        unconverged or unstable gait.
 
     References
     ----------
@@ -648,9 +712,11 @@ def robustness(
     """
     _check_kind(kind)
     _check_placement(kind, placement)
+    old = _deprecated_start(start)
+    h = GRID_STEPS[kind] if h is None and old is None else _grid_step(h, old)
     if check:
         check_gait(gait)
-    return _limit(gait, kind, sign, n_steps=n_steps, tol=tol, options=options, start=start,
+    return _limit(gait, kind, sign, n_steps=n_steps, tol=tol, options=options, h=h,
                   ladder=ladder, k=k, max_magnitude=max_magnitude, placement=placement).limit
 
 
@@ -663,11 +729,12 @@ def robustness_report(
     tol: float = 1e-4,
     options: IntegratorOptions | None = None,
     check: bool = True,
-    start: float = 0.01,
+    h: Mapping[str, float] | None = None,
     ladder: int = 8,
     k: int = 3,
     max_magnitude: float = 100.0,
     placement: Placement = "touchdown",
+    start: float | None = None,
 ) -> RobustnessResult:
     """Robustness limits of a gait for several disturbances, with reasons.
 
@@ -675,6 +742,8 @@ def robustness_report(
     disturbances and ``both_signs`` adds the +1 direction (step up, forward
     push, positive pitch rate) to the thesis's -1. ``placement`` applies to
     the push and pitch-rate searches (a step-down is always at touch-down).
+    ``h`` maps a kind to its grid step; kinds it omits use
+    :data:`GRID_STEPS`.
 
     Returns
     -------
@@ -692,11 +761,17 @@ def robustness_report(
         _check_kind(kind)
         if kind != "step_down":
             _check_placement(kind, placement)
+    given = dict(h or {})
+    if not set(given) <= set(KINDS):
+        raise ValueError(f"h must map kinds among {KINDS} to grid steps, got keys {sorted(given)}")
+    old = _deprecated_start(start)
+    steps = {kind: _grid_step(given.get(kind), old) if kind in given or old is not None
+             else GRID_STEPS[kind] for kind in kinds}
     if check:
         check_gait(gait)
     signs = (-1, 1) if both_signs else (-1,)
     limits = tuple(
-        _limit(gait, kind, s, n_steps=n_steps, tol=tol, options=options, start=start,
+        _limit(gait, kind, s, n_steps=n_steps, tol=tol, options=options, h=steps[kind],
                ladder=ladder, k=k, max_magnitude=max_magnitude,
                placement="touchdown" if kind == "step_down" else placement)
         for kind in kinds for s in signs
@@ -707,12 +782,12 @@ def robustness_report(
 
 
 def _limit(gait: Gait, kind: Kind, sign: int, *, n_steps: int, tol: float,
-           options: IntegratorOptions | None, start: float, ladder: int, k: int,
+           options: IntegratorOptions | None, h: float | None, ladder: int, k: int,
            max_magnitude: float, placement: Placement = "touchdown") -> RobustnessLimit:
     _check_sign_and_steps(sign, n_steps)
     if placement in ("touchdown", "touchdown_hip"):
         run_one = _touchdown_runner(gait, kind, placement, int(n_steps), options)
-        return search_limit(kind, sign, run_one, n_steps=int(n_steps), tol=tol, start=start,
+        return search_limit(kind, sign, run_one, n_steps=int(n_steps), tol=tol, h=h,
                             ladder=ladder, k=k, max_magnitude=max_magnitude)
 
     def run_many(d: np.ndarray) -> tuple[list[int], list[int]]:  # flight placements: one batch
@@ -721,7 +796,7 @@ def _limit(gait: Gait, kind: Kind, sign: int, *, n_steps: int, tol: float,
         return run.status.tolist(), run.n_done.tolist()
 
     return search_limit(kind, sign, run_many=run_many, n_steps=int(n_steps), tol=tol,
-                        start=start, ladder=ladder, k=k, max_magnitude=max_magnitude)
+                        h=h, ladder=ladder, k=k, max_magnitude=max_magnitude)
 
 
 def _check_sign_and_steps(sign: int, n_steps: int) -> None:
@@ -734,8 +809,8 @@ def _check_sign_and_steps(sign: int, n_steps: int) -> None:
 def search_limit(kind: str, sign: int,
                  run_one: Callable[[float], tuple[int, int]] | None = None, *,
                  run_many: Callable[[np.ndarray], tuple[list[int], list[int]]] | None = None,
-                 n_steps: int, tol: float, start: float = 0.01, ladder: int = 8, k: int = 3,
-                 max_magnitude: float = 100.0) -> RobustnessLimit:
+                 n_steps: int, tol: float, h: float | None = None, ladder: int = 8, k: int = 3,
+                 max_magnitude: float = 100.0, start: float | None = None) -> RobustnessLimit:
     """The robustness limit of one disturbance and direction, for either model.
 
     ``run_one(d) -> (status, strides done)`` runs one disturbed run of signed
@@ -743,13 +818,18 @@ def search_limit(kind: str, sign: int,
     strides. :func:`limit_search` asks ascending magnitudes and uses only a
     batch's first failure, so the batch runs in order and stops there (the
     rest count as failures, unrun). ``run_many(d_array) -> (statuses,
-    strides done)`` instead runs a whole batch at once.
+    strides done)`` instead runs a whole batch at once. The grid step ``h``
+    defaults to :data:`GRID_STEPS` ``[kind]``; ``start`` is its old name
+    (:func:`limit_search`), taken without a warning while
+    :mod:`tslip.biped.robustness` still passes it.
 
     Returns
     -------
     RobustnessLimit
         With the status and stride of the failing run that bounds the limit.
     """
+    if h is None and start is None:
+        h = GRID_STEPS[kind]
     _check_sign_and_steps(sign, n_steps)
     if (run_one is None) == (run_many is None):
         raise ValueError("give exactly one of run_one and run_many")
@@ -778,7 +858,7 @@ def search_limit(kind: str, sign: int,
         n_runs += len(sts)
         return ok
 
-    s = limit_search(survives, start=start, tol=tol, ladder=ladder, k=k,
+    s = limit_search(survives, h=h, start=start, tol=tol, ladder=ladder, k=k,
                      max_magnitude=max_magnitude)
     if s.bounded:
         st, nd = outcome[s.hi]
