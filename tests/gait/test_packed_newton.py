@@ -16,7 +16,13 @@ from scipy.optimize import least_squares
 import tslip
 from tslip.gait import fixed_point as fp
 from tslip.gait.fixed_point import GaitProblem, gait_residual, newton_solve
-from tslip.gait.robustness import KINDS, limit_search, robustness_report, run_disturbed
+from tslip.gait.robustness import (
+    GRID_STEPS,
+    KINDS,
+    limit_search,
+    robustness_report,
+    run_disturbed,
+)
 from tslip.gait.stability import floquet
 from tslip.model import _pack as pk
 from tslip.simulation import _packed
@@ -188,13 +194,13 @@ def report(fit):
 
 @pytest.mark.parametrize("kind", KINDS)
 def test_robustness_equals_the_batched_search(fit, report, kind):
-    """The old implementation: every ladder rung and k-section point run as one batch."""
+    """The old implementation: every grid point and k-section point run as one batch."""
 
     def survives(m):
         run = run_disturbed(fit.params, fit.state, kind, -m)
         return (run.status == 0) & (run.n_done == 25)
 
-    s = limit_search(survives, tol=1e-4)
+    s = limit_search(survives, h=GRID_STEPS[kind], tol=1e-4)
     lim = report.get(kind)
     assert (lim.limit, lim.first_failing) == (-s.lo, -s.hi)
     assert lim.n_runs < s.n_evals  # the runs past the first failure were skipped

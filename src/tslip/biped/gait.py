@@ -629,12 +629,16 @@ def disturbance_limit(params: BipedParams, z: NDArray[np.float64], kind: str, *,
     limit is ``sign * result.lo``.
     """
     from ..gait.robustness import limit_search
+    from .robustness import GRID_STEPS
 
+    if kind not in DISTURBANCES:
+        raise ValueError(f"unknown disturbance {kind!r}; known: {list(DISTURBANCES)}")
     def survives(m: NDArray[np.float64]) -> NDArray[np.bool_]:
         return np.array([survives_disturbance(params, z, kind, sign * float(v), n_steps,
                                               options)[0] for v in np.ravel(m)])
 
-    return limit_search(survives, start=0.01, tol=tol, ladder=8, k=1, max_magnitude=10.0)
+    return limit_search(survives, h=GRID_STEPS[kind], tol=tol, ladder=8, k=1,
+                        max_magnitude=10.0)
 
 
 #: Old names (deprecated, removed in 0.4): docs/model.md, "Vocabulary".

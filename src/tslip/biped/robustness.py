@@ -5,24 +5,38 @@ The TSLIP's names and search (:mod:`tslip.gait.robustness`) on the biped:
 :class:`RobustnessResult` of :class:`~tslip.gait.robustness.RobustnessLimit`.
 The three disturbances are applied as :func:`tslip.biped.gait.disturbed_outcome`
 describes; a run survives if it completes ``n_steps`` strides. The search is
-:func:`tslip.gait.robustness.search_limit`: a doubling ladder, then
-k-section, each batch run in order and stopped at its first failure.
+:func:`tslip.gait.robustness.search_limit`: the first failure on a grid of
+step :data:`GRID_STEPS` ``[kind]``, then k-section, each batch run in order
+and stopped at its first failure.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..gait.robustness import RobustnessLimit, RobustnessLimits, search_limit
+from ..gait.robustness import (
+    RobustnessLimit,
+    RobustnessLimits,
+    _deprecated_start,
+    _grid_step,
+    search_limit,
+)
 from .gait import DISTURBANCES, REFINE_OPTIONS, Gait, disturbed_outcome, floquet
 from .parameters import BipedParams
 from .simulate import BipedOptions
 
-__all__ = ["RobustnessResult", "check_gait", "robustness", "robustness_report"]
+__all__ = ["GRID_STEPS", "RobustnessResult", "check_gait", "robustness", "robustness_report"]
+
+#: Grid step of each disturbance's first-failure search on the biped, in the
+#: kind's unit. About 1/30 of the converged gait's limits (-0.16 L, -0.82,
+#: -3.3: ``tslip biped robustness``), as :data:`tslip.gait.robustness.GRID_STEPS`
+#: is of the TSLIP's; each biped run costs about 1000 times a TSLIP stride, so
+#: the grid is not finer than that.
+GRID_STEPS: dict[str, float] = {"step_down": 0.005, "push": 0.025, "pitch_rate": 0.1}
 
 
 @dataclass(frozen=True, slots=True, repr=False)
@@ -71,15 +85,18 @@ def check_gait(gait: Gait, options: BipedOptions | None = None) -> None:
 
 
 def robustness(gait: Gait, kind: str, *, n_steps: int = 25, sign: int = -1, tol: float = 1e-3,
-               options: BipedOptions | None = None, check: bool = True, start: float = 0.01,
-               ladder: int = 8, k: int = 1, max_magnitude: float = 10.0) -> float:
+               options: BipedOptions | None = None, check: bool = True,
+               h: float | None = None, ladder: int = 8, k: int = 1,
+               max_magnitude: float = 10.0, start: float | None = None) -> float:
     """Largest disturbance of one kind the biped gait survives for ``n_steps`` strides.
 
     As :func:`tslip.robustness`: ``kind`` is ``"step_down"`` [L], ``"push"``
     [g^1/2 L^1/2] or ``"pitch_rate"`` [rad g^1/2 L^-1/2]; ``sign=-1`` searches
     down, backward and negative pitch rates; ``tol`` is the accuracy of the
-    limit; ``start``, ``ladder``, ``k`` and ``max_magnitude`` set the search
-    (:func:`tslip.gait.robustness.limit_search`). ``options`` are the
+    limit; ``h`` (the grid step, default :data:`GRID_STEPS` ``[kind]``),
+    ``ladder``, ``k`` and ``max_magnitude`` set the search
+    (:func:`tslip.gait.robustness.limit_search`); ``start`` is ``h``'s old
+    name (deprecated). ``options`` are the
     disturbed runs' (default :class:`BipedOptions`, the thesis's 1e-8).
 
     Returns
@@ -93,21 +110,25 @@ def robustness(gait: Gait, kind: str, *, n_steps: int = 25, sign: int = -1, tol:
         For a bad ``kind``, ``sign`` or ``n_steps``, or (with ``check``) an
         unconverged or unstable gait.
     """
+    old = _deprecated_start(start)
+    step = None if h is None and old is None else {kind: _grid_step(h, old)}
     return robustness_report(gait, n_steps=n_steps, kinds=(kind,), signs=(sign,), tol=tol,
-                             options=options, check=check, start=start, ladder=ladder, k=k,
+                             options=options, check=check, h=step, ladder=ladder, k=k,
                              max_magnitude=max_magnitude).limits[0].limit
 
 
 def robustness_report(gait: Gait, *, n_steps: int = 25, kinds: Sequence[str] = DISTURBANCES,
                       both_signs: bool = False, signs: Sequence[int] | None = None,
                       tol: float = 1e-3, options: BipedOptions | None = None,
-                      check: bool = True, start: float = 0.01, ladder: int = 8, k: int = 1,
-                      max_magnitude: float = 10.0) -> RobustnessResult:
+                      check: bool = True, h: Mapping[str, float] | None = None,
+                      ladder: int = 8, k: int = 1, max_magnitude: float = 10.0,
+                      start: float | None = None) -> RobustnessResult:
     """Robustness limits of a biped gait for several disturbances, with reasons.
 
     Parameters are those of :func:`robustness`; ``kinds`` selects the
     disturbances and ``both_signs`` adds the +1 direction to the thesis's -1
-    (``signs`` names the directions explicitly instead).
+    (``signs`` names the directions explicitly instead). ``h`` maps a kind
+    to its grid step; kinds it omits use :data:`GRID_STEPS`.
 
     Returns
     -------
@@ -119,6 +140,13 @@ def robustness_report(gait: Gait, *, n_steps: int = 25, kinds: Sequence[str] = D
     for kind in kinds:
         if kind not in DISTURBANCES:
             raise ValueError(f"kind must be one of {DISTURBANCES}, got {kind!r}")
+    given = dict(h or {})
+    if not set(given) <= set(DISTURBANCES):
+        raise ValueError(f"h must map kinds among {DISTURBANCES} to grid steps, "
+                         f"got keys {sorted(given)}")
+    old = _deprecated_start(start)
+    steps = {kind: _grid_step(given.get(kind), old) if kind in given or old is not None
+             else GRID_STEPS[kind] for kind in kinds}
     signs = tuple(signs) if signs is not None else (-1, 1) if both_signs else (-1,)
     if check:
         check_gait(gait)
@@ -134,7 +162,7 @@ def robustness_report(gait: Gait, *, n_steps: int = 25, kinds: Sequence[str] = D
                 return int(st), done
 
             limits.append(search_limit(kind, sign, run_one, n_steps=n_steps, tol=tol,
-                                       start=start, ladder=ladder, k=k,
+                                       h=steps[kind], ladder=ladder, k=k,
                                        max_magnitude=max_magnitude))
     return RobustnessResult(limits=tuple(limits), params=gait.params,
                             z=np.asarray(gait.z, dtype=np.float64), n_steps=int(n_steps),
