@@ -38,7 +38,7 @@ from ..model.units import COLUMN_UNITS, param_unit
 from ..simulation.options import IntegratorOptions
 from .continuation import get_param, set_param
 from .fixed_point import Gait, find_gait
-from .problem import GaitProblem, Section
+from .problem import _FALL_PENALTY, GaitProblem, Section
 from .stability import Floquet, floquet
 
 if TYPE_CHECKING:
@@ -53,6 +53,7 @@ __all__ = ["GaitSet", "StableRegion", "all_gaits", "stable_region", "DEFAULT_DEL
 DEFAULT_DELTAS = -np.unique(np.concatenate([np.geomspace(1e-3, 0.1, 12),
                                              np.arange(0.1, 1.5 + 1e-9, 0.025)]))
 _SAME = 1e-7  # two solutions with delta and alpha_r this close are one gait
+_EDGE_TOL = 1e-10  # [rad] how close to the edge of the defined domain the scan is refined
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,18 +135,54 @@ class GaitSet(Result):
 
 
 def _brackets(prob: GaitProblem, deltas: np.ndarray) -> list[np.ndarray]:
-    """Starts at the sign changes of the ``delta`` residual along the scan (interpolated)."""
+    """Starts at the sign changes of the ``delta`` residual along the scan (interpolated).
+
+    An interval whose two ends differ in outcome (one stride falls) is bisected
+    toward the edge of the map's defined domain, down to :data:`_EDGE_TOL`, and
+    the residual's sign on the defined side is bracketed there too.
+    """
     zs = [prob._guess(float(d)) for d in deltas]
     r = np.array([prob.residual(z) for z in zs])
-    ok = ~np.all(r == 10.0, axis=1)  # a fall: the constant penalty of every component
+    ok = ~np.all(r == _FALL_PENALTY, axis=1)
     f = r[:, 3]
     starts = []
     for i in range(len(deltas) - 1):
-        if not (ok[i] and ok[i + 1]) or f[i] * f[i + 1] > 0.0:
-            continue
-        w = f[i] / (f[i] - f[i + 1]) if f[i] != f[i + 1] else 0.5
-        starts.append(zs[i] + w * (zs[i + 1] - zs[i]))
+        if ok[i] and ok[i + 1]:
+            if f[i] * f[i + 1] <= 0.0:
+                starts.append(_interpolate(zs[i], zs[i + 1], f[i], f[i + 1]))
+        elif ok[i] != ok[i + 1]:
+            j, m = (i, i + 1) if ok[i] else (i + 1, i)
+            z = _toward_edge(prob, float(deltas[j]), zs[j], f[j], float(deltas[m]))
+            if z is not None:
+                starts.append(z)
     return starts
+
+
+def _interpolate(za: np.ndarray, zb: np.ndarray, fa: float, fb: float) -> np.ndarray:
+    w = fa / (fa - fb) if fa != fb else 0.5
+    return za + w * (zb - za)
+
+
+def _toward_edge(prob: GaitProblem, d_ok: float, z_ok: np.ndarray, f_ok: float,
+                 d_fail: float) -> np.ndarray | None:
+    """A start where the residual changes sign between ``d_ok`` and the domain's edge.
+
+    Bisection between a defined scan point and a failing one: a failing middle
+    moves the failing end, a defined one of the same sign the defined end,
+    one of the other sign closes a bracket (None when the edge is within
+    :data:`_EDGE_TOL` without a sign change).
+    """
+    while abs(d_fail - d_ok) > _EDGE_TOL:
+        d = 0.5 * (d_ok + d_fail)
+        z = prob._guess(d)
+        r = prob.residual(z)
+        if np.all(r == _FALL_PENALTY):
+            d_fail = d
+        elif r[3] * f_ok <= 0.0:
+            return _interpolate(z_ok, z, f_ok, float(r[3]))
+        else:
+            d_ok, z_ok, f_ok = d, z, float(r[3])
+    return None
 
 
 def all_gaits(
