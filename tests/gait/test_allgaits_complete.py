@@ -15,7 +15,7 @@ Cells (``slip-human``'s k and energy unless stated):
 
 * seven (k, beta0) cells where the scan before this fix (brackets only
   between two defined strides) missed the flat, flip-unstable gait that lies
-  right next to a failing stride (multipliers -2.1 to -11; k 20 to 50 across
+  right next to a failing stride (multipliers -2.6 to -11.2; k 20 to 50 across
   the band where the flat gait exists, mapped with 3,000-point scans);
 * three cells 0.01, 0.02 and 0.04 deg above the fold where the flat and the
   steep gait merge (found by bisection on beta0 of the residual's extremum;
@@ -176,3 +176,17 @@ def test_both_gaits_are_found_next_to_the_fold(k, fold, above):
     low = minimize_scalar(apex_excess, bounds=(y1 - 0.02, y2 + 0.02), args=(k, below),
                           method="bounded", options={"xatol": 1e-8})
     assert low.fun > 0.0
+
+
+def test_at_fixed_speed_the_slip_gaits_are_those_at_its_energy():
+    """The SLIP's touch-down speed and angle fix its energy: the same gaits, the reference's."""
+    k, beta = EDGE_CELLS[3]
+    p = dataclasses.replace(HUMAN, k=k, beta0=beta, alpha_r=beta,
+                            v0=math.sqrt(2.0 * (E - math.sin(beta))))
+    s = all_gaits(p)
+    assert math.isnan(s.energy) and "speed" in repr(s)
+    ref = sorted(y for y, _ in reference_gaits(k, beta))
+    assert len(s) == len(ref) == 2
+    for g, y in zip(sorted(s, key=lambda g: g.apex.y), ref):
+        assert g.apex.y == pytest.approx(y, abs=1e-8)
+        assert g.state.v == pytest.approx(p.v0, abs=1e-12) and g.fix == "speed"
