@@ -56,7 +56,7 @@ __all__ = ["GaitSet", "StableRegion", "all_gaits", "stable_region", "DEFAULT_DEL
 DEFAULT_DELTAS = -np.unique(np.concatenate([np.geomspace(1e-3, 0.1, 12),
                                              np.arange(0.1, 1.5 + 1e-9, 0.025)]))
 _SAME = 1e-7  # two solutions with delta and alpha_r this close are one gait
-_EDGE_TOL = 1e-8  # [rad] how close to the edge of the defined domain the scan is refined
+_EDGE_TOL = 1e-7  # [rad] how close to the edge of the defined domain the scan is refined
 
 
 @dataclass(frozen=True, eq=False)
@@ -236,15 +236,18 @@ def all_gaits(
     gaits): every gait whose touch-down angle lies in the scanned range is
     returned, unless
 
-    * an even number of gaits lies between two neighbouring scan points, or
-      between a defined scan point and the sign change found toward a failing
-      one (two gaits within one refined interval: right at a fold; on
-      ``slip-human`` at ``k = 35`` the default scan finds both gaits 0.005 deg
-      of ``beta0`` above the fold and neither 0.001 deg above it). A finer
-      ``deltas`` there finds them;
-    * it lies within 1e-8 rad of the edge of the defined domain (where the
-      residual's slope, the multiplier, grows without bound), or in a defined
-      stretch between two failing scan points;
+    * two gaits lie in one refined interval: between two neighbouring defined
+      scan points (the residual has the same sign at both; right at a fold:
+      on ``slip-human`` at ``k = 35`` the default scan finds both gaits 0.005
+      deg of ``beta0`` above the fold and neither 0.001 deg above it, where a
+      finer ``deltas`` finds them), or between a defined scan point and a
+      failing one, where only the first sign change of the bisection toward
+      the edge is solved;
+    * it lies within 1e-7 rad of the edge of the domain where strides are
+      defined (the SLIP's multiplier grows without bound toward that edge: on
+      ``slip-human`` about ``-0.2 / sqrt(distance)``, -11 at 3e-4 rad, so a
+      gait missed this way has a multiplier beyond about -600), or in a
+      defined stretch that lies wholly between two failing scan points;
     * Newton does not converge from the bracket's start (none seen).
 
     ``tests/gait/test_allgaits_complete.py`` checks this against an
