@@ -1,4 +1,4 @@
-"""Every periodic gait at fixed energy, and the self-stable region over two parameters.
+"""Every periodic gait at fixed energy (or speed), and the stable region over two parameters.
 
 At given total energy and leg angle the SLIP has two periodic gaits, one of
 them self-stable (Seyfarth et al. 2002): a flat one with a short flight and
@@ -13,9 +13,12 @@ energy (the other unknowns at the starting guesses of
 from the flight time), brackets each sign change of the ``delta`` residual
 (``delta' - delta``, the one-dimensional apex-height map at fixed energy in
 the SLIP), solves each bracket with Newton and keeps the distinct gaits,
-each with its Floquet multipliers. Two gaits closer than one grid step
-(near a fold) can be missed: pass a finer ``deltas``. For the TSLIP the scan
-runs along the level-trunk line, so a gait far from it may be missed too.
+each with its Floquet multipliers. Where a scan point's stride fails and its
+neighbour's does not, the interval is bisected toward the edge of the map's
+defined domain, so a gait right next to a failing stride (the flat,
+strongly unstable gaits of the SLIP, multipliers down to -11 on
+``slip-human``) is bracketed too. What is guaranteed and what can still be
+missed: :func:`all_gaits`, Notes.
 
 :func:`stable_region` solves every cell of a two-parameter grid
 independently with :func:`all_gaits`, so a cell's answer does not depend on
@@ -38,7 +41,7 @@ from ..model.units import COLUMN_UNITS, param_unit
 from ..simulation.options import IntegratorOptions
 from .continuation import get_param, set_param
 from .fixed_point import Gait, find_gait
-from .problem import GaitProblem, Section
+from .problem import _FALL_PENALTY, Fix, GaitProblem, Section
 from .stability import Floquet, floquet
 
 if TYPE_CHECKING:
@@ -53,6 +56,7 @@ __all__ = ["GaitSet", "StableRegion", "all_gaits", "stable_region", "DEFAULT_DEL
 DEFAULT_DELTAS = -np.unique(np.concatenate([np.geomspace(1e-3, 0.1, 12),
                                              np.arange(0.1, 1.5 + 1e-9, 0.025)]))
 _SAME = 1e-7  # two solutions with delta and alpha_r this close are one gait
+_EDGE_TOL = 1e-7  # [rad] how close to the edge of the defined domain the scan is refined
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,7 +68,7 @@ class GaitSet(Result):
     params : Params
         The parameters scanned.
     energy : float
-        Total energy held [MgL].
+        Total energy held [MgL]; NaN where the speed ``params.v0`` was held.
     gaits : tuple of Gait
         Distinct gaits, flattest touch-down first (``delta`` closest to 0).
     floquets : tuple of (Floquet or None)
@@ -112,7 +116,9 @@ class GaitSet(Result):
 
     def __repr__(self) -> str:
         what = ", ".join(f"{s} {m:.4g}" for s, m in zip(self.stability, self.max_nontrivial))
-        return (f"GaitSet({len(self)} gaits at energy {self.energy:.6g}"
+        held = (f"energy {self.energy:.6g}" if math.isfinite(self.energy)
+                else f"speed {self.params.v0:.6g} ({self.section})")
+        return (f"GaitSet({len(self)} gaits at {held}"
                 + (f": {what})" if what else ")"))
 
     def to_dataframe(self) -> pd.DataFrame:
@@ -134,38 +140,78 @@ class GaitSet(Result):
 
 
 def _brackets(prob: GaitProblem, deltas: np.ndarray) -> list[np.ndarray]:
-    """Starts at the sign changes of the ``delta`` residual along the scan (interpolated)."""
+    """Starts at the sign changes of the ``delta`` residual along the scan (interpolated).
+
+    An interval whose two ends differ in outcome (one stride falls) is bisected
+    toward the edge of the map's defined domain, down to :data:`_EDGE_TOL`, and
+    the residual's sign on the defined side is bracketed there too.
+    """
     zs = [prob._guess(float(d)) for d in deltas]
     r = np.array([prob.residual(z) for z in zs])
-    ok = ~np.all(r == 10.0, axis=1)  # a fall: the constant penalty of every component
+    ok = ~np.all(r == _FALL_PENALTY, axis=1)
     f = r[:, 3]
     starts = []
     for i in range(len(deltas) - 1):
-        if not (ok[i] and ok[i + 1]) or f[i] * f[i + 1] > 0.0:
-            continue
-        w = f[i] / (f[i] - f[i + 1]) if f[i] != f[i + 1] else 0.5
-        starts.append(zs[i] + w * (zs[i + 1] - zs[i]))
+        if ok[i] and ok[i + 1]:
+            if f[i] * f[i + 1] <= 0.0:
+                starts.append(_interpolate(zs[i], zs[i + 1], f[i], f[i + 1]))
+        elif ok[i] != ok[i + 1]:
+            j, m = (i, i + 1) if ok[i] else (i + 1, i)
+            z = _toward_edge(prob, float(deltas[j]), zs[j], f[j], float(deltas[m]))
+            if z is not None:
+                starts.append(z)
     return starts
+
+
+def _interpolate(za: np.ndarray, zb: np.ndarray, fa: float, fb: float) -> np.ndarray:
+    w = fa / (fa - fb) if fa != fb else 0.5
+    return za + w * (zb - za)
+
+
+def _toward_edge(prob: GaitProblem, d_ok: float, z_ok: np.ndarray, f_ok: float,
+                 d_fail: float) -> np.ndarray | None:
+    """A start where the residual changes sign between ``d_ok`` and the domain's edge.
+
+    Bisection between a defined scan point and a failing one: a failing middle
+    moves the failing end, a defined one of the same sign the defined end,
+    one of the other sign closes a bracket (None when the edge is within
+    :data:`_EDGE_TOL` without a sign change).
+    """
+    while abs(d_fail - d_ok) > _EDGE_TOL:
+        d = 0.5 * (d_ok + d_fail)
+        z = prob._guess(d)
+        r = prob.residual(z)
+        if np.all(r == _FALL_PENALTY):
+            d_fail = d
+        elif r[3] * f_ok <= 0.0:
+            return _interpolate(z_ok, z, f_ok, float(r[3]))
+        else:
+            d_ok, z_ok, f_ok = d, z, float(r[3])
+    return None
 
 
 def all_gaits(
     params: Params,
     *,
-    energy: float,
+    energy: float | None = None,
     deltas: Sequence[float] | np.ndarray | None = None,
     tol: float = 1e-10,
     options: IntegratorOptions | None = None,
     section: Section = "touchdown",
     multipliers: bool = True,
 ) -> GaitSet:
-    """Every periodic gait at total energy ``energy`` and the parameters' ``beta0``.
+    """Every periodic gait at energy ``energy`` (or speed ``v0``) and ``beta0``.
 
     Parameters
     ----------
     params : Params
-        Model, with the touch-down angle ``beta0``.
-    energy : float
-        Total energy [MgL] (:func:`tslip.gait.section.total_energy`).
+        Model, with the touch-down angle ``beta0`` (and the speed ``v0`` held
+        without ``energy``).
+    energy : float, optional
+        Total energy [MgL] (:func:`tslip.gait.section.total_energy`). Without
+        it the speed ``params.v0`` at ``section`` is held instead
+        (``fix="speed"`` of :func:`tslip.find_gait`): the touch-down speed, or
+        the apex's forward speed.
     deltas : sequence of float, optional
         Touch-down velocity angles to scan [rad], in (-pi/2, 0); default
         :data:`DEFAULT_DELTAS`. Finer near a fold.
@@ -174,13 +220,46 @@ def all_gaits(
     options : IntegratorOptions, optional
         Default tolerance 1e-12 with DOP853.
     section : {"touchdown", "apex"}
-        Section of the multipliers.
+        Section of the multipliers (and of the speed held without ``energy``).
     multipliers : bool
         Compute each gait's Floquet multipliers.
 
     Returns
     -------
     GaitSet
+        ``energy`` is NaN when the speed was held (each gait has its own).
+
+    Notes
+    -----
+    What is guaranteed, for the SLIP (where the scan line holds the leg reset
+    at ``beta0``, so the ``delta`` residual's zeros on it are exactly the
+    gaits): every gait whose touch-down angle lies in the scanned range is
+    returned, unless
+
+    * two gaits lie in one refined interval: between two neighbouring defined
+      scan points (the residual has the same sign at both; right at a fold:
+      on ``slip-human`` at ``k = 35`` the default scan finds both gaits 0.005
+      deg of ``beta0`` above the fold and neither 0.001 deg above it, where a
+      finer ``deltas`` finds them), or between a defined scan point and a
+      failing one, where only the first sign change of the bisection toward
+      the edge is solved;
+    * it lies within 1e-7 rad of the edge of the domain where strides are
+      defined (the SLIP's multiplier grows without bound toward that edge: on
+      ``slip-human`` about ``-0.2 / sqrt(distance)``, -11 at 3e-4 rad, so a
+      gait missed this way has a multiplier beyond about -600), or in a
+      defined stretch that lies wholly between two failing scan points;
+    * Newton does not converge from the bracket's start (none seen).
+
+    ``tests/gait/test_allgaits_complete.py`` checks this against an
+    independent SLIP on ten ``slip-human`` cells, including seven with a gait
+    next to a failing stride and three within 0.05 deg of the fold. For the
+    TSLIP the scan runs along the level-trunk line and the ``delta``
+    residual's sign changes on it only seed the searches, so a gait far from
+    that line can be missed too.
+
+    With the speed held, the SLIP's touch-down speed and angle fix its energy
+    (``m v0^2 / 2 + m g l0 sin beta0``), so the gaits are those at that
+    energy; the apex's forward speed held does not fix it.
 
     Examples
     --------
@@ -190,15 +269,15 @@ def all_gaits(
     ('asymptotic', 'unstable')
     """
     t0 = time.perf_counter()
-    prob = GaitProblem.from_params(params, options, fix="energy", energy=energy,
-                                   section=section)
+    fix: Fix = "speed" if energy is None else "energy"
+    prob = GaitProblem.from_params(params, options, fix=fix, energy=energy, section=section)
     d = DEFAULT_DELTAS if deltas is None else np.asarray(deltas, dtype=float).ravel()
     if d.size < 2 or not np.all((d > -math.pi / 2) & (d < 0.0)):
         raise ValueError("deltas must hold at least 2 angles in (-pi/2, 0) rad")
     d = np.sort(d)[::-1]  # from 0 down
     found: list[Gait] = []
     for z in _brackets(prob, d):
-        g = find_gait(params, guess=z, tol=tol, options=options, fix="energy", energy=energy,
+        g = find_gait(params, guess=z, tol=tol, options=options, fix=fix, energy=energy,
                       section=section)
         if not g.converged:
             continue
