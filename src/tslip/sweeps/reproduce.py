@@ -129,7 +129,7 @@ def pitch_rate_variants(gait: Gait) -> dict[str, float]:
     return {label: pitch_rate_variant(gait, label) for label in PITCH_RATE_VARIANTS}
 
 
-def alphad_ref_forced(gait: Gait, alphad_ref: float = THESIS_ALPHAD_REF) -> dict[str, float]:
+def alphad_ref_forced(gait: Gait, alphad_ref: float = THESIS_ALPHAD_REF) -> dict[str, Any]:
     """Force the local velocity controller's ``alphad_ref`` and solve the rest of the gait.
 
     With ``alphad_ref`` fixed the search of Section 2.8 has four unknowns

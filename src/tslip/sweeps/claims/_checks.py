@@ -625,8 +625,10 @@ def _c423(d: Mapping[str, Any]) -> Check:
             "rank corr(omega_r_bar, |step_down|) above the best": _r(r_sd),
             "rank corr(omega_r_bar, |pitch_rate|)": _r(r_p)}
     ok = sp[i] > sd0 and falls and ok_p
+    evidence = {"omega_r_bar from the best rate up": [_r(x) for x in wp[i:]],
+                "|step_down| there [L]": [_r(x) for x in sp[i:]]}
     return _judge(nums, bool(ok), {"rank corr(omega_r_bar, |pitch_rate|)":
-                                   _n(w, _abs(s, "pitch_rate"))})
+                                   _n(w, _abs(s, "pitch_rate"))}, evidence)
 
 
 _CONTROLLERS = {"passive": "mass_offset", "global PD": "controller_global_pd",

@@ -497,10 +497,10 @@ def _quick_note(data: Mapping[str, Any], claim: Claim, check: Check) -> str:
     """The check's note, plus, at quick resolution, the resolution that decides the verdict.
 
     A claim judged on studies (not on one gait) at quick resolution may get
-    another verdict from the full run: unless it holds plainly, the note
+    another verdict from the full run (whichever it gets here): the note
     names the point counts and says that the full resolution decides.
     """
-    if check.verdict is Verdict.HOLDS or not data.get("quick"):
+    if not data.get("quick"):
         return check.note
     sizes = [f"{n}: {len(data[n].frame)} points" for n in claim.needs
              if hasattr(data.get(n), "frame")]
