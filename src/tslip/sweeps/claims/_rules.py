@@ -251,8 +251,9 @@ def _judge(numbers: Numbers, ok: bool, points: Mapping[str, int] | None = None,
     """
     short = {k: n for k, n in (points or {}).items() if n < MIN_POINTS}
     if short:
-        nums = {**numbers, **{f"points for {k}": n for k, n in short.items()}}
-        return Check(nums, Verdict.NOT_ASSESSED, evidence or {}, _TOO_FEW)
+        counts = {f"points for {k}": n for k, n in short.items()}
+        return Check({**numbers, **counts}, Verdict.NOT_ASSESSED,
+                     {**(evidence or {}), **counts, "points needed": MIN_POINTS}, _TOO_FEW)
     return Check(numbers, Verdict.HOLDS if ok else Verdict.FAILS, evidence or {})
 
 
