@@ -4,8 +4,8 @@ Each parametrised case runs (once, cached for the module) the catalogue studies
 a claim needs at the resolution of ``tslip reproduce --quick`` and asserts the
 claim holds -- plainly or under the reading its result names -- with the
 claim's own numbers in the failure message. The claims that do not hold at this
-resolution (4.13's pitch rate, 4.18-4.19 with one stable stiffness, 4.25's
-"similar" limits of the other controllers, the Table 6.1 pitch-rate limit) are
+resolution (4.8's "converge most quickly"; 4.13, 4.18 and 4.19, judged on few points
+here; 4.25's pitch-rate claims compared on the same r; the Table 6.1 numbers) are
 reported as such by ``tslip reproduce`` and are not asserted here.
 """
 
@@ -16,13 +16,16 @@ import pytest
 from tslip.sweeps import catalogue, run_study
 from tslip.sweeps.claims import CLAIMS, Verdict, evaluate
 
-pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning")
-
-#: (figure, index among that figure's claims)
-HOLDING = [("4.8", 0), ("4.9", 0), ("4.9", 1), ("4.9", 2), ("4.11", 0), ("4.11", 1),
-           ("4.12", 0), ("4.14", 0), ("4.15", 0), ("4.16", 0), ("4.17", 0), ("4.20", 0),
-           ("4.21", 0), ("4.22", 0), ("4.23", 0), ("4.24", 0), ("4.24", 1), ("4.24", 2),
-           ("4.25", 0), ("4.25", 2)]
+#: Claim ids that hold at quick resolution.
+HOLDING = ["4.8-minimum-speed", "4.8-stable-above-minimum", "4.9-push-linear-in-speed",
+           "4.9-step-down-peak", "4.9-pitch-rate-minimal", "4.11-times-match-equations",
+           "4.11-flight-time-trends", "4.11-stance-time-trends", "4.12-leg-damping-stability",
+           "4.14-hip-damping-stability", "4.15-hip-damping-robustness",
+           "4.16-stable-mass-offsets", "4.17-mass-offset-robustness",
+           "4.20-touchdown-angle-range", "4.21-touchdown-angle-robustness",
+           "4.22-retraction-stability", "4.23-retraction-robustness", "4.24-passive-r-positive",
+           "4.24-local-velocity-asymptotic", "4.24-global-pd-neutral",
+           "4.25-local-velocity-least-push"]
 #: Studies a claim reads besides its ``needs``: the second set-up of Figures 4.8-4.9.
 EXTRA = {"velocity": ("velocity_bar",)}
 
@@ -38,10 +41,11 @@ def _data(needs: tuple[str, ...]) -> dict:
     return {n: _results[n] for n in names}
 
 
-@pytest.mark.parametrize(("figure", "index"), HOLDING, ids=[f"{f}-{i}" for f, i in HOLDING])
-def test_thesis_claim_holds(figure: str, index: int) -> None:
-    claim = [c for c in CLAIMS if c.figure == figure][index]
+@pytest.mark.parametrize("claim_id", HOLDING)
+def test_thesis_claim_holds(claim_id: str) -> None:
+    (claim,) = [c for c in CLAIMS if c.id == claim_id]
     (res,) = evaluate(_data(claim.needs), (claim,))
-    assert res.holds, f"{figure}: {claim.text} -- our numbers: {res.numbers}"
+    assert res.verdict in (Verdict.HOLDS, Verdict.HOLDS_UNDER_READING), \
+        f"{claim_id}: {claim.text} -- our numbers: {res.numbers}"
     if res.verdict is Verdict.HOLDS_UNDER_READING:
         assert res.note.startswith("holds under:") and res.evidence, res

@@ -89,7 +89,7 @@ def reproduce_cmd(
 
     from ..plotting.report import reproduce
     from ..sweeps import catalogue
-    from ..sweeps.claims import Verdict
+    from ..sweeps.claims import Verdict, count_verdicts
 
     console = make_console()
     n_studies = len(catalogue.STUDIES)
@@ -120,11 +120,11 @@ def reproduce_cmd(
     t.add_column("claim")
     t.add_column("verdict")
     style = {Verdict.HOLDS: "green", Verdict.HOLDS_UNDER_READING: "yellow",
-             Verdict.FAILS: "bold red"}
+             Verdict.FAILS: "bold red", Verdict.NOT_ASSESSED: "dim"}
     for c in claims:
         v = Verdict(c["verdict"])
         t.add_row(Text(c["figure"]), Text(c["claim"]), Text(v.value, style=style[v]))
     console.print(t)
-    counts = ", ".join(f"{v.value}: {sum(c['verdict'] == v for c in claims)}" for v in Verdict)
+    counts = ", ".join(f"{v.value}: {n}" for v, n in count_verdicts(claims).items())
     console.print(f"{len(claims)} claims; {counts}; {time.perf_counter() - t0:.1f} s")
     console.print(f"report: {path}")

@@ -176,7 +176,8 @@ code{font-size:.85em}
 #: CSS class of each verdict (three colours).
 VERDICT_CLASS: dict[Verdict, str] = {Verdict.HOLDS: "holds",
                                      Verdict.HOLDS_UNDER_READING: "reading",
-                                     Verdict.FAILS: "fails"}
+                                     Verdict.FAILS: "fails",
+                                     Verdict.NOT_ASSESSED: "reading"}
 
 
 def _e(x: Any) -> str:
@@ -454,7 +455,7 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
     path = Path(path)
     atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
     claims_json = [{"figure": c.figure, "claim": c.text, "verdict": _verdict(c).value,
-                    "holds": c.holds, "quote": c.quote, "source": c.source,
+                    "holds": c.verdict is not Verdict.FAILS, "quote": c.quote, "source": c.source,
                     "reading": c.reading, "numbers": c.numbers, "evidence": c.evidence,
                     "note": c.note, "error": c.error} for c in claims]
     write_json(path.with_name("claims.json"), claims_json, indent=1)

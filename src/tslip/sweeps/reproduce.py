@@ -41,8 +41,6 @@ from contextlib import ExitStack
 from pathlib import Path
 from typing import Any, Protocol
 
-import numpy as np
-
 from .._codehash import code_hash
 from .._io import atomic_write
 from ..gait import find_gait, floquet, robustness_report, stride_properties
@@ -132,7 +130,7 @@ def pitch_rate_variants(gait: Gait) -> dict[str, float]:
     return {label: pitch_rate_variant(gait, label) for label in PITCH_RATE_VARIANTS}
 
 
-def alphad_ref_forced(gait: Gait, alphad_ref: float = THESIS_ALPHAD_REF) -> dict[str, float]:
+def alphad_ref_forced(gait: Gait, alphad_ref: float = THESIS_ALPHAD_REF) -> dict[str, Any]:
     """Force the local velocity controller's ``alphad_ref`` and solve the rest of the gait.
 
     With ``alphad_ref`` fixed the search of Section 2.8 has four unknowns
@@ -140,8 +138,11 @@ def alphad_ref_forced(gait: Gait, alphad_ref: float = THESIS_ALPHAD_REF) -> dict
     solved in the least-squares sense (:func:`tslip.gait.fixed_point.newton_solve`,
     from the free gait and the automatic guesses). ``residual`` is the
     max-norm of the periodicity residual left (as :attr:`Gait.residual`),
-    ``c1`` its eq. 2.20 cost (the thesis accepted ``C1 < 1e-4``); ``free``
-    is our solved ``alphad_ref``.
+    ``c1`` its eq. 2.20 cost (the thesis accepted ``C1 < 1e-4``, eq. 2.22); ``free``
+    is our solved ``alphad_ref``; ``stride`` the first stride from that
+    least-squares start (``stance_time``, ``flight_time``, ``duty_factor``,
+    ``step_frequency``, as :func:`tslip.gait.stride_properties`; Table 6.2's
+    columns), empty if no start was found.
     """
     p = gait.params
     if not isinstance(p.controller, LocalVelocity):
@@ -154,9 +155,14 @@ def alphad_ref_forced(gait: Gait, alphad_ref: float = THESIS_ALPHAD_REF) -> dict
     z0 = GaitProblem.from_params(p).encode(gait)[:4]
     z, err, _ = newton_solve(prob.residual, itertools.chain([z0], prob.guesses()), tol=1e-10,
                              max_starts=5)
-    c1 = float(np.sum(prob.residual(z) ** 2)) if z is not None else float("inf")
+    c1 = prob.c1(z) if z is not None else float("inf")
+    stride: dict[str, float] = {}
+    if z is not None:
+        _, ts, tf = prob.evaluate(z)
+        stride = {"stance_time": float(ts), "flight_time": float(tf),
+                  "duty_factor": float(ts / (ts + tf)), "step_frequency": float(1 / (ts + tf))}
     return {"alphad_ref": float(alphad_ref), "residual": float(err), "c1": c1,
-            "free": float(free)}
+            "free": float(free), "stride": stride}
 
 
 def _pitch_rate_piece(label: str, g: Gait) -> float:
@@ -271,6 +277,23 @@ def appendix_e_cached(out_dir: str | Path, resolution: str = "full") -> dict[str
     return data
 
 
+#: Figure 4.4's two gaits (:func:`tslip.sweeps.catalogue.fig_height_change`), by key.
+HEIGHT_CHANGE_PRESETS = {"passive": "table2.1", "local_velocity": "table2.1-local-velocity"}
+
+
+def height_change(coarse: bool = False) -> dict[str, Any]:
+    """Figure 4.4's speed changes and each gait's own step-down limit.
+
+    ``step_down_limit`` maps ``"passive"`` and ``"local_velocity"`` to the
+    largest step down [L] the gait survives (:func:`tslip.gait.robustness.robustness`):
+    the claim judges convergence at the steps within it and shows the falls beyond.
+    """
+    out = catalogue.fig_height_change(coarse)
+    out["step_down_limit"] = {key: robustness(catalogue._gait(name), "step_down", check=False)
+                              for key, name in HEIGHT_CHANGE_PRESETS.items()}
+    return out
+
+
 def _figure_jobs(res: str) -> dict[str, Callable[[], Any]]:
     """The single-gait figures other than Table 6.1 and Appendix E, by key."""
     coarse = res != "full"
@@ -279,7 +302,7 @@ def _figure_jobs(res: str) -> dict[str, Callable[[], Any]]:
         "4.2": lambda: catalogue.fig_pitch_disturbance("table2.1"),
         "4.3": lambda: catalogue.fig_pitch_disturbance("table2.1-global-pd"),
         "6.2": lambda: catalogue.fig_pitch_disturbance("table6.1"),
-        "4.4": lambda: catalogue.fig_height_change(coarse),
+        "4.4": lambda: height_change(coarse),
         "4.5": catalogue.fig_step_down,
         "4.7": catalogue.fig_velocity_angle,
         "C.1": catalogue.fig_friction,

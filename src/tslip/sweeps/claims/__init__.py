@@ -12,7 +12,12 @@ the multipliers' accuracy (:data:`MULT_TOL`) is neutral. Where the sentence
 allows two readings (or the set-up is open, as for Figure 4.9's speed line)
 both are checked and both readings' numbers are in the evidence. The tests
 are written from the claims, never from our numbers: a claim that fails is
-reported as failing, with the numbers, and, at quick resolution, a note.
+reported as failing, with the numbers and evidence, and, at quick resolution, a
+note that the full resolution decides. A check whose statistic has too few
+points (fewer than :data:`MIN_POINTS` for a rank correlation) returns
+``Verdict.NOT_ASSESSED``, never a failure. Each claim has a stable ``id``
+(:data:`ID_PATTERN`); :func:`count_verdicts` counts results per verdict
+(``ClaimResult.holds`` is deprecated: read ``verdict``).
 
 ``data`` maps a study name (:data:`tslip.sweeps.catalogue.STUDIES`) to its
 :class:`~tslip.sweeps.StudyResult`, and a figure key ("4.1", "4.2", "4.3",
@@ -28,6 +33,8 @@ study (Figures 4.8-4.9 with ``omega_r_bar`` held).
 from ._checks import grid_stable_fractions
 from ._list import CLAIMS, evaluate
 from ._rules import (
+    ID_PATTERN,
+    MIN_POINTS,
     MULT_TOL,
     PRINTED,
     REL,
@@ -37,9 +44,11 @@ from ._rules import (
     Claim,
     ClaimResult,
     Verdict,
+    count_verdicts,
     stable_mask,
     stable_range,
 )
 
-__all__ = ["Check", "Claim", "ClaimResult", "CLAIMS", "MULT_TOL", "PRINTED", "REL", "TEND",
-           "TREND", "Verdict", "evaluate", "grid_stable_fractions", "stable_mask", "stable_range"]
+__all__ = ["Check", "Claim", "ClaimResult", "CLAIMS", "ID_PATTERN", "MIN_POINTS", "MULT_TOL",
+           "PRINTED", "REL", "TEND", "TREND", "Verdict", "count_verdicts", "evaluate",
+           "grid_stable_fractions", "stable_mask", "stable_range"]

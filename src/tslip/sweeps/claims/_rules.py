@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+import warnings
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
@@ -22,11 +23,15 @@ class Verdict(StrEnum):
     set-up) and it holds under the one named in the result's ``reading``;
     the numbers of every reading are shown. ``FAILS``: it does not hold; the
     result's ``evidence`` holds what the package computed to find out why.
+    ``NOT_ASSESSED``: the data have fewer points than the check's statistic
+    needs (3 for a rank correlation); the numbers say how many. Never a
+    failure.
     """
 
     HOLDS = "holds"
     HOLDS_UNDER_READING = "holds under a stated reading"
     FAILS = "does not hold"
+    NOT_ASSESSED = "not assessed"
 
 
 @dataclass(frozen=True)
@@ -53,7 +58,8 @@ class Claim:
     ``text`` is the claim in one short sentence (the summary table);
     ``quote`` the thesis's own words and ``source`` where they stand (section,
     figure or table); ``reading`` what the test checks and why its threshold
-    is a fair reading of the wording.
+    is a fair reading of the wording; ``id`` a stable name (``<figure>-<words>``,
+    :data:`ID_PATTERN`) that never changes once released.
     """
 
     figure: str
@@ -63,11 +69,16 @@ class Claim:
     quote: str = ""
     source: str = ""
     reading: str = ""
+    id: str = ""
+
+
+#: What a claim id looks like: the figure, a dash, lower-case words joined by dashes.
+ID_PATTERN = r"^[a-z0-9.]+-[a-z0-9-]+$"
 
 
 @dataclass(frozen=True)
 class ClaimResult:
-    """A claim with the numbers we measured and its verdict."""
+    """A claim (by its ``id``) with the numbers we measured and its verdict."""
 
     figure: str
     text: str
@@ -79,11 +90,25 @@ class ClaimResult:
     reading: str = ""
     evidence: Numbers = field(default_factory=dict)
     note: str = ""
+    id: str = ""
 
     @property
     def holds(self) -> bool:
-        """True for ``HOLDS`` and ``HOLDS_UNDER_READING``."""
+        """Deprecated: read :attr:`verdict` (True unless it is ``FAILS``)."""
+        warnings.warn("ClaimResult.holds is deprecated and will be removed; read "
+                      "ClaimResult.verdict (a Verdict) instead", DeprecationWarning,
+                      stacklevel=2)
         return self.verdict is not Verdict.FAILS
+
+
+def count_verdicts(results: Iterable[Any]) -> dict[Verdict, int]:
+    """Claims per verdict, every :class:`Verdict` present (0 if none), in enum order.
+
+    ``results`` are :class:`ClaimResult` or anything with a ``verdict`` (a
+    :class:`Verdict` or its value, as in ``claims.json``).
+    """
+    seen = [Verdict(getattr(r, "verdict", None) or r["verdict"]) for r in results]
+    return {v: seen.count(v) for v in Verdict}
 
 
 # -- helpers ------------------------------------------------------------------
@@ -174,14 +199,17 @@ def _flat(prefix: str, nums: Numbers) -> Numbers:
     return {f"{prefix}: {k}": v for k, v in nums.items()}
 
 
-def _readings(parts: Mapping[str, tuple[Numbers, bool] | None],
+def _readings(parts: Mapping[str, tuple[Numbers, bool | None] | None],
               numbers: Numbers | None = None) -> Check:
     """One verdict from the readings of an ambiguous sentence.
 
     ``parts`` maps each reading (the plain one first) to its numbers and
-    whether the claim holds under it, or to None if it was not computed. All
-    hold: ``HOLDS``; some: ``HOLDS_UNDER_READING``; none: ``FAILS``. Every
-    reading's numbers go to the evidence.
+    whether the claim holds under it (None: not assessed, too few points),
+    or to None if it was not computed. All hold: ``HOLDS``; some:
+    ``HOLDS_UNDER_READING``; none, with one not assessed: ``NOT_ASSESSED``;
+    none: ``FAILS``. Every reading's numbers go to the evidence; the headline
+    ``numbers`` (unless given) are those of the reading the verdict rests on:
+    the first that holds, else the plain one.
     """
     evidence: Numbers = {}
     for name, part in parts.items():
@@ -189,20 +217,54 @@ def _readings(parts: Mapping[str, tuple[Numbers, bool] | None],
             evidence[name] = "not computed"
         else:
             evidence.update(_flat(name, part[0]))
-            evidence[f"{name}: holds"] = bool(part[1])
+            evidence[f"{name}: holds"] = ("not assessed" if part[1] is None
+                                          else bool(part[1]))
     done = {k: v for k, v in parts.items() if v is not None}
     held = [k for k, (_, ok) in done.items() if ok]
     if numbers is None:
-        numbers = next(iter(done.values()))[0] if done else {}
+        first = held[0] if held else next(iter(done), None)
+        numbers = done[first][0] if first is not None else {}
     if held and len(held) == len(parts):
         return Check(numbers, Verdict.HOLDS, evidence)
     if held:
         missed = [k for k in parts if k not in held]
         return Check(numbers, Verdict.HOLDS_UNDER_READING, evidence,
                      f"holds under: {'; '.join(held)}; not under: {'; '.join(missed)}")
+    if any(ok is None for _, ok in done.values()):
+        return Check(numbers, Verdict.NOT_ASSESSED, evidence, _TOO_FEW)
     return Check(numbers, Verdict.FAILS, evidence)
 
 
-def _printed(ours: float, thesis: float, tol: float = PRINTED) -> tuple[Numbers, bool]:
-    return {"ours": _r(ours, 4), "thesis": thesis, "|difference|": _r(abs(ours - thesis), 4),
-            "tolerance": tol}, bool(abs(ours - thesis) <= tol)
+#: Points a rank correlation needs.
+MIN_POINTS = 3
+_TOO_FEW = (f"not assessed: fewer than {MIN_POINTS} points for the check's rank correlation "
+            "(the numbers give the count)")
+
+
+def _judge(numbers: Numbers, ok: bool, points: Mapping[str, int] | None = None,
+           evidence: Numbers | None = None) -> Check:
+    """``HOLDS`` or ``FAILS`` by ``ok``; ``NOT_ASSESSED`` if a statistic has too few points.
+
+    ``points`` maps each statistic the verdict needs to the points it had;
+    below :data:`MIN_POINTS` the claim is not assessed (the counts are added
+    to the numbers).
+    """
+    short = {k: n for k, n in (points or {}).items() if n < MIN_POINTS}
+    if short:
+        counts = {f"points for {k}": n for k, n in short.items()}
+        return Check({**numbers, **counts}, Verdict.NOT_ASSESSED,
+                     {**(evidence or {}), **counts, "points needed": MIN_POINTS}, _TOO_FEW)
+    return Check(numbers, Verdict.HOLDS if ok else Verdict.FAILS, evidence or {})
+
+
+def _n(x: np.ndarray, y: np.ndarray) -> int:
+    """Points where both ``x`` and ``y`` are finite (what a correlation of them uses)."""
+    return int((np.isfinite(np.asarray(x, float)) & np.isfinite(np.asarray(y, float))).sum())
+
+
+def _printed(ours: float, thesis: float, tol: float = PRINTED,
+             unit: str = "") -> tuple[Numbers, bool]:
+    u = f" [{unit}]" if unit else ""
+    return {f"ours{u}": _r(ours, 4), f"thesis{u}": thesis,
+            f"|difference|{u}": _r(abs(ours - thesis), 4), f"tolerance{u}": tol}, bool(
+        abs(ours - thesis) <= tol)
