@@ -36,7 +36,7 @@ def test_report_is_self_contained(tmp_path) -> None:
     assert len(imgs) >= 4 and all(s.startswith("data:image/png;base64,") for s in imgs)
     for figs, _ in SECTIONS:
         assert f"id='fig-{figs[0].replace('.', '-')}'" in text
-    assert "does not hold" in text or all(c.holds for c in claims)
+    assert "does not hold" in text or all(c.verdict != "does not hold" for c in claims)
     assert (tmp_path / "claims.json").exists()
 
 
@@ -132,7 +132,9 @@ def test_reproduce_end_to_end_tiny(tmp_path, monkeypatch) -> None:
     assert appendix_e_cached(tmp_path, "tiny")["e2"]["strides_perturbed"] == \
         e2["strides_perturbed"]
 
-    rows = json.loads((tmp_path / "claims.json").read_text())
+    doc = json.loads((tmp_path / "claims.json").read_text())
+    assert doc["schema"] == 2
+    rows = doc["claims"]
     assert len(rows) == len(claims)
     assert all("verdict" in r and "evidence" in r for r in rows)
 
