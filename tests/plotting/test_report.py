@@ -123,6 +123,82 @@ def test_every_axis_is_labelled_with_a_quantity_and_unit(figures) -> None:
     assert not bad, "\n".join(bad)
 
 
+def _texts(fig) -> list[str]:
+    """Every label, title, tick-free text and legend entry of ``fig``."""
+    out = [t.get_text() for t in fig.findobj(lambda a: hasattr(a, "get_text"))]
+    return [t for t in out if t]
+
+
+def test_units_are_typeset_one_way_no_caret_outside_mathtext(figures) -> None:
+    """Issue 24: no "g^1/2" beside "g$^{1/2}$": every exponent is mathtext."""
+    bad = [(key, t) for key, fig in figures.items() for t in _texts(fig)
+           if "^" in re.sub(r"\$[^$]*\$", "", t)]
+    assert not bad, bad
+
+
+def test_panel_titles_are_words_not_study_identifiers(figures) -> None:
+    names = set(catalogue.STUDIES)
+    bad = [(key, ax.get_title()) for key, fig in figures.items() for ax in fig.axes
+           if any(("_" in n and n in ax.get_title()) or ax.get_title().startswith(n + ":")
+                  for n in names)]
+    assert not bad, bad
+
+
+@pytest.mark.parametrize("figs", [figs for figs, _, _ in report._STUDY_PAIRS])
+def test_robustness_panels_share_the_multiplier_panels_x_range(figures, figs) -> None:
+    eig, rob = figures[figs[0]], figures[figs[1]]
+    (ax,) = eig.axes
+    assert all(a.get_xlim() == pytest.approx(ax.get_xlim()) for a in rob.axes)
+
+
+def _data_in_legend(fig) -> list[str]:
+    """Legends drawn inside an axes that overlap one of its data points."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(fig).draw()
+    bad = []
+    for ax in fig.axes:
+        leg = ax.get_legend()
+        if leg is None:
+            continue
+        box = leg.get_window_extent()
+        for line in ax.get_lines():
+            xy = ax.transData.transform(np.asarray(line.get_xydata(), float))
+            xy = xy[np.isfinite(xy).all(axis=1)]
+            inside = ((xy[:, 0] > box.x0) & (xy[:, 0] < box.x1) & (xy[:, 1] > box.y0)
+                      & (xy[:, 1] < box.y1))
+            if inside.any():
+                bad.append(f"{ax.get_title()!r}: {line.get_label()}")
+    return bad
+
+
+@pytest.mark.parametrize("key", ["4.8", "4.12", "4.24", "E.3", "E.4"])
+def test_legends_do_not_cover_data(figures, key) -> None:
+    assert not _data_in_legend(figures[key])
+
+
+def test_figure_4_12_shows_the_trivial_multiplier(data, figures) -> None:
+    """The trivial energy multiplier (1 at an undamped point) is drawn, apart from the rest."""
+    (ax,) = figures["4.12"].axes
+    lines = {ln.get_label(): ln for ln in ax.get_lines()}
+    trivial = [ln for k, ln in lines.items() if "trivial" in k and "non-trivial" not in k]
+    assert len(trivial) == 1
+    f = data["leg_damping"].frame
+    assert np.isfinite(trivial[0].get_ydata()).sum() == f["n_trivial"].sum()
+
+
+def test_figure_4_4_marks_a_fall_at_its_step() -> None:
+    """A run that falls (NaN dv) is drawn at its step as a fall, not dropped."""
+    ok, fell = SimpleNamespace(dv=0.1, dv_expected=0.12), SimpleNamespace(dv=float("nan"),
+                                                                          dv_expected=0.2)
+    h = {"dh": (-0.2, -0.1, 0.05), "passive": [ok, ok, ok], "local_velocity": [fell, ok, ok]}
+    fig = report._plots({"4.4": h})["4.4"]()
+    right = fig.axes[1]
+    (falls,) = [ln for ln in right.get_lines() if "fall" in ln.get_label()]
+    assert list(falls.get_xdata()) == [-0.2]
+    assert not [ln for ln in fig.axes[0].get_lines() if "fall" in ln.get_label()]
+
+
 def _legend_texts(legend) -> list[str]:
     return [t.get_text() for t in legend.get_texts()]
 
@@ -131,9 +207,9 @@ def test_figure_4_11_legend_names_eqs_3_10_and_3_11(figures) -> None:
     fig = figures["4.11"]
     axes = np.array(fig.axes).reshape(2, -1)
     for ax in axes[0]:
-        assert _legend_texts(ax.get_legend()) == ["t_s model", "t_s eq. 3.10"]
+        assert _legend_texts(ax.get_legend()) == ["$t_s$ model", "$t_s$ eq. 3.10"]
     for ax in axes[1]:
-        assert _legend_texts(ax.get_legend()) == ["t_f model", "t_f eq. 3.11"]
+        assert _legend_texts(ax.get_legend()) == ["$t_f$ model", "$t_f$ eq. 3.11"]
 
 
 def test_figure_4_10_legend_names_each_colour(data, figures) -> None:

@@ -17,6 +17,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
@@ -24,7 +25,7 @@ from .. import __version__
 from .._io import atomic_write, write_json
 from ..model.units import UNIT
 from ..sweeps.claims import Verdict
-from .notation import key_html, tex_html, unit_html, value
+from .notation import axis_label, key_html, tex_html, unit_html, value
 
 __all__ = ["CLAIMS_SCHEMA", "PLOT_SECONDS", "SECTIONS", "ReportPlots", "claims_json", "compute",
            "figure_inputs", "figure_png", "plot_task", "read_claims", "render_ready", "reproduce",
@@ -59,11 +60,16 @@ def figure_png(fig: Figure, dpi: int = 80) -> str:
 _CONTROLLERS = {"passive": "mass_offset", "global PD": "controller_global_pd",
                 "local velocity": "controller_local_velocity",
                 "constant torque": "controller_constant_torque"}
-#: The studies drawn as a multipliers figure and a robustness figure: (figures, study).
-_STUDY_PAIRS = ((("4.8", "4.9"), "velocity"), (("4.12", "4.13"), "leg_damping"),
-                (("4.14", "4.15"), "hip_damping"), (("4.16", "4.17"), "mass_offset"),
-                (("4.18", "4.19"), "stiffness"), (("4.20", "4.21"), "touchdown_angle"),
-                (("4.22", "4.23"), "retraction"))
+#: The studies drawn as a multipliers figure and a robustness figure: (figures, study,
+#: what varies in the thesis's caption words).
+_STUDY_PAIRS = ((("4.8", "4.9"), "velocity", "velocity (passive)"),
+                (("4.12", "4.13"), "leg_damping", "leg damping (constant driving torque)"),
+                (("4.14", "4.15"), "hip_damping", "hip damping (constant driving torque)"),
+                (("4.16", "4.17"), "mass_offset", "mass offset (passive)"),
+                (("4.18", "4.19"), "stiffness", "leg stiffness (passive)"),
+                (("4.20", "4.21"), "touchdown_angle", "initial leg angle (passive)"),
+                (("4.22", "4.23"), "retraction",
+                 "normalized swing-leg retraction rate (passive)"))
 _STRIDE_STUDIES = ("stride_v0", "stride_k", "stride_beta0")
 
 
@@ -77,7 +83,7 @@ def figure_inputs() -> dict[str, tuple[str, ...]]:
     inputs["4.10"] = tuple(f"grid_v{v:g}" for v in GRID_SPEEDS)
     inputs["4.11"] = _STRIDE_STUDIES
     inputs["4.24"] = inputs["4.25"] = tuple(_CONTROLLERS.values())
-    for figs, name in _STUDY_PAIRS:
+    for figs, name, _ in _STUDY_PAIRS:
         inputs.update(dict.fromkeys(figs, (name,)))
     return inputs
 
@@ -89,24 +95,33 @@ def _plots(data: Mapping[str, Any]) -> dict[str, Callable[[], Figure]]:
     from . import gait as g
     from . import studies as s
 
-    def pair(name: str) -> dict[str, Callable[[], Figure]]:
-        return {"eig": lambda: s.plot_study_multipliers(data[name]),
-                "rob": lambda: s.plot_study_robustness(data[name])}
+    def pair(name: str, words: str) -> dict[str, Callable[[], Figure]]:
+        return {"eig": lambda: s.plot_study_multipliers(
+                    data[name], title=f"Eigenvalue magnitudes over varying {words}; "
+                    "green: stable domain"),
+                "rob": lambda: s.plot_study_robustness(
+                    data[name], title=f"Robustness over varying {words}")}
 
     def fig44() -> Figure:
         h = data["4.4"]
         fig = Figure(figsize=(8.0, 3.2), layout="constrained")
         axes = fig.subplots(1, 2, sharey=True)
+        dh = np.asarray(h["dh"], float)
         for a, key, title in ((axes[0], "passive", "passive vs eq. 3.8"),
                               (axes[1], "local_velocity", "local velocity control")):
-            a.plot(h["dh"], [r.dv for r in h[key]], "o", label="model")
+            dv = np.array([r.dv for r in h[key]], float)
+            fell = ~np.isfinite(dv)  # a run that falls has no converged speed
+            a.plot(dh[~fell], dv[~fell], "o", label="model")
             if key == "passive":
-                a.plot(h["dh"], [r.dv_expected for r in h[key]], "-", label="eq. 3.8")
+                a.plot(dh, [r.dv_expected for r in h[key]], "-", label="eq. 3.8")
+            if fell.any():
+                a.plot(dh[fell], np.zeros(int(fell.sum())), "X", color="C3", ms=9,
+                       label="falls (no Δv)")
             a.axhline(0, color="k", lw=0.6)
-            a.set_xlabel("Δh [L]")
+            a.set_xlabel(axis_label(r"ground step $\Delta h$", UNIT["length"]))
             a.set_title(title, fontsize=9)
             a.legend(fontsize=7)
-        axes[0].set_ylabel("Δv [g^1/2 L^1/2]")
+        axes[0].set_ylabel(axis_label(r"$\Delta v$", UNIT["speed"]))
         return fig
 
     ctrl = _CONTROLLERS
@@ -128,8 +143,8 @@ def _plots(data: Mapping[str, Any]) -> dict[str, Callable[[], Figure]]:
         "4.24": lambda: s.plot_controllers_multipliers({k: data[v] for k, v in ctrl.items()}),
         "4.25": lambda: s.plot_controllers_robustness({k: data[v] for k, v in ctrl.items()}),
     }
-    for figs, name in _STUDY_PAIRS:
-        p = pair(name)
+    for figs, name, words in _STUDY_PAIRS:
+        p = pair(name, words)
         plots[figs[0]], plots[figs[1]] = p["eig"], p["rob"]
     return plots
 
