@@ -62,14 +62,13 @@ _CONTROLLERS = {"passive": "mass_offset", "global PD": "controller_global_pd",
                 "constant torque": "controller_constant_torque"}
 #: The studies drawn as a multipliers figure and a robustness figure: (figures, study,
 #: what varies in the thesis's caption words).
-_STUDY_PAIRS = ((("4.8", "4.9"), "velocity", "velocity (passive)"),
-                (("4.12", "4.13"), "leg_damping", "leg damping (constant driving torque)"),
-                (("4.14", "4.15"), "hip_damping", "hip damping (constant driving torque)"),
-                (("4.16", "4.17"), "mass_offset", "mass offset (passive)"),
-                (("4.18", "4.19"), "stiffness", "leg stiffness (passive)"),
-                (("4.20", "4.21"), "touchdown_angle", "initial leg angle (passive)"),
-                (("4.22", "4.23"), "retraction",
-                 "normalized swing-leg retraction rate (passive)"))
+_STUDY_PAIRS = ((("4.8", "4.9"), "velocity", "velocity"),
+                (("4.12", "4.13"), "leg_damping", "leg damping"),
+                (("4.14", "4.15"), "hip_damping", "hip damping"),
+                (("4.16", "4.17"), "mass_offset", "mass offset"),
+                (("4.18", "4.19"), "stiffness", "leg stiffness"),
+                (("4.20", "4.21"), "touchdown_angle", "initial leg angle"),
+                (("4.22", "4.23"), "retraction", "normalized swing-leg retraction rate"))
 _STRIDE_STUDIES = ("stride_v0", "stride_k", "stride_beta0")
 
 
@@ -97,8 +96,7 @@ def _plots(data: Mapping[str, Any]) -> dict[str, Callable[[], Figure]]:
 
     def pair(name: str, words: str) -> dict[str, Callable[[], Figure]]:
         return {"eig": lambda: s.plot_study_multipliers(
-                    data[name], title=f"Eigenvalue magnitudes over varying {words}; "
-                    "green: stable domain"),
+                    data[name], title=f"Eigenvalue magnitudes over varying {words}"),
                 "rob": lambda: s.plot_study_robustness(
                     data[name], title=f"Robustness over varying {words}")}
 

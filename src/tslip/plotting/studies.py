@@ -86,7 +86,7 @@ def _xlim(ax: Axes, result: StudyResult) -> None:
 
 def plot_study_multipliers(result: StudyResult, ax: Axes | None = None, *,
                            title: str | None = None) -> Figure:
-    """``|lambda|`` against the swept parameter; stable domain green.
+    """``|lambda|`` against the swept parameter; the stable domain green.
 
     The non-trivial multipliers as dots; the trivial ones (the energy
     multiplier 1 of a conservative gait, :func:`tslip.gait.floquet`) as open
@@ -103,20 +103,20 @@ def plot_study_multipliers(result: StudyResult, ax: Axes | None = None, *,
         ax.plot(x, mags[:, k], "o", ms=3, color="C0",
                 label=f"{_LAMBDA} non-trivial" if k == 0 else None)
     if np.isfinite(trivial).any():
-        ax.plot(np.repeat(x, trivial.shape[1]), trivial.ravel(), "o", ms=5, mfc="none",
-                mec="0.45", mew=0.8, label=f"{_LAMBDA} trivial (energy)")
+        ax.plot(np.repeat(x, trivial.shape[1]), trivial.ravel(), "o", ms=7, mfc="none",
+                mec="k", mew=0.8, zorder=3, label=f"{_LAMBDA} trivial (energy)")
     none = ~f["converged"].to_numpy(bool)
     if none.any():
         ax.plot(x[none], np.zeros(none.sum()), "x", color="C3", ms=4, label="no periodic gait")
     ax.axhline(1.0, color="k", ls="--", lw=0.8)
+    ax.fill_between([], [], color=_STABLE_GREEN, label="stable domain")  # legend entry only
     top = np.nanmax(mags) if np.isfinite(mags).any() else 1.5
     ax.set_ylim(0, min(max(1.5, top * 1.05), 3.0))
     _xlim(ax, result)
     ax.set_xlabel(param_label(param))
     ax.set_ylabel(f"{_LAMBDA} [-]")
     ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize=7, frameon=False)
-    ax.set_title(title or f"Floquet multipliers: {result.spec.description} (green: stable)",
-                 fontsize=9)
+    ax.set_title(title or f"Floquet multipliers: {result.spec.description}", fontsize=9)
     return fig
 
 
