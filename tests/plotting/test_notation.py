@@ -111,5 +111,8 @@ def test_no_raw_latex_is_left_in_any_claim_text() -> None:
             out = tex_html(text)
             assert "$" not in out and "\\" not in out, (c.figure, out)
             assert not re.search(r"[\^{}]", out), (c.figure, out)
+            for name in set(re.findall(r"\\([A-Za-z]+)", text)):  # no command name leaks
+                plain = re.sub(r"\\[A-Za-z]+", "", text)
+                assert out.count(name) <= plain.count(name), (c.figure, name, out)
             seen += "$" in text
     assert seen >= 4  # the list does quote formulas (4.9, 4.16, 4.24, 6.1, 6.2)

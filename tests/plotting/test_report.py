@@ -164,6 +164,9 @@ def _data_in_legend(fig) -> list[str]:
         box = leg.get_window_extent()
         for line in ax.get_lines():
             xy = ax.transData.transform(np.asarray(line.get_xydata(), float))
+            if line.get_linestyle() not in ("None", "none", "", " ") and len(xy) > 1:
+                t = np.linspace(0.0, 1.0, 12)[:, None, None]  # points along each segment
+                xy = (xy[:-1] + t * (xy[1:] - xy[:-1])).reshape(-1, 2)
             xy = xy[np.isfinite(xy).all(axis=1)]
             inside = ((xy[:, 0] > box.x0) & (xy[:, 0] < box.x1) & (xy[:, 1] > box.y0)
                       & (xy[:, 1] < box.y1))
@@ -172,9 +175,22 @@ def _data_in_legend(fig) -> list[str]:
     return bad
 
 
-@pytest.mark.parametrize("key", ["4.8", "4.12", "4.24", "E.3", "E.4"])
+@pytest.mark.parametrize("key", ["4.4", "4.8", "4.12", "4.24", "E.3", "E.4"])
 def test_legends_do_not_cover_data(figures, key) -> None:
     assert not _data_in_legend(figures[key])
+
+
+@pytest.mark.parametrize("key", ["4.8", "4.12", "4.24", "E.3", "E.4"])
+def test_crowded_legends_sit_outside_their_axes(figures, key) -> None:
+    """Issue 24: these legends covered data; now beside or below the axes, whatever the data."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig = figures[key]
+    FigureCanvasAgg(fig).draw()
+    legends = [(ax, ax.get_legend()) for ax in fig.axes if ax.get_legend() is not None]
+    assert legends
+    for ax, leg in legends:
+        assert not leg.get_window_extent().overlaps(ax.get_window_extent()), ax.get_title()
 
 
 def test_figure_4_12_shows_the_trivial_multiplier(data, figures) -> None:
@@ -460,3 +476,38 @@ def test_figure_png_is_the_image_savefig_writes(dpi) -> None:
     uri = report.figure_png(fig, dpi=dpi)
     assert base64.b64decode(uri.split(",", 1)[1]) == buf.getvalue()
     assert fig.get_layout_engine() is engine
+
+
+def test_docs_verdict_table_is_read_from_claims_json(page, tmp_path) -> None:
+    """The documentation's table (docs/_ext/tslip_docs.py) counts each verdict by name
+    from the claims.json the report wrote, and lists every claim's id."""
+    import importlib.util
+    from pathlib import Path
+
+    ext = Path(__file__).resolve().parents[2] / "docs" / "_ext" / "tslip_docs.py"
+    spec = importlib.util.spec_from_file_location("tslip_docs", ext)
+    assert spec is not None and spec.loader is not None
+    docs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(docs)
+    claims = page[0]
+    table = docs.verdict_table(report.read_claims(tmp_path / "claims.json"), "quick")
+    first = table.splitlines()[0]
+    counts = ", ".join(f"{sum(c.verdict is v for c in claims)} {v.value}" for v in Verdict)
+    assert first == f"{len(claims)} claims at **quick** resolution: {counts}."
+    rows = [ln for ln in table.splitlines() if ln.startswith("| `")]
+    assert [r.split("`")[1] for r in rows] == [c.id for c in claims]
+    assert all(c.verdict.value in r for c, r in zip(claims, rows, strict=True))
+
+
+def test_figure_e3_fills_its_box() -> None:
+    """The foot path is drawn at equal aspect: the figure is sized to it, no tall empty box."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from tslip.biped import BipedParams, BipedState, simulate
+    from tslip.plotting.biped import plot_foot_path
+
+    fig = plot_foot_path(simulate(BipedParams(), BipedState.thesis(), 1), stride=0)
+    FigureCanvasAgg(fig).draw()
+    (ax,) = fig.axes
+    drawn = ax.get_window_extent()  # the axes box after equal aspect shrank it
+    assert drawn.height / fig.bbox.height > 0.5  # 0.22 in the old 6 x 5 inch box

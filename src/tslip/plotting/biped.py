@@ -72,7 +72,7 @@ def plot_foot_path(tr: Trajectory, leg: int = 0, ax: Any = None,
     if ax is None:  # sized to the path at equal aspect, with room for the labels and legend
         xs, zs = np.r_[ref_x, rel[:, 0]], np.r_[ref_z, rel[:, 1]]
         ratio = float(np.ptp(zs) / max(np.ptp(xs), 1e-9))
-        fig = Figure(figsize=(6.4, min(6.0, 1.3 + 5.0 * ratio)), layout="constrained")
+        fig = Figure(figsize=(6.4, min(6.0, 0.9 + 4.4 * ratio)), layout="constrained")
         ax = fig.subplots()
     else:
         fig = ax.figure
