@@ -1,8 +1,12 @@
-"""The SLIP recipe at the top of docs/analyses/slip.md, run exactly as printed.
+"""The SLIP recipe at the top of docs/analyses/slip.md, and the README's snippets, run
+exactly as printed.
 
-Its answers are checked against the independent point-mass SLIP of
+The recipe's answers are checked against the independent point-mass SLIP of
 tests/gait/test_section.py (scipy DOP853 stance, closed-form flight), not
-against tslip's own numbers.
+against tslip's own numbers. The README's printed outputs are checked against
+the comments beside them (what a reader is told the line prints), and its
+pages are checked to state no verdict counts, which only ``tslip reproduce``
+and the documentation table generated from its ``claims.json`` give.
 """
 
 from __future__ import annotations
