@@ -23,7 +23,6 @@ first anyway (Sphinx looks in the current module before anywhere else).
 
 from __future__ import annotations
 
-import json
 import os
 import shutil
 from pathlib import Path
@@ -157,25 +156,31 @@ def _report_dir() -> tuple[Path, str]:
 
 
 def verdict_table(claims: list[dict[str, Any]], resolution: str) -> str:
-    """Markdown table of the claims and their verdicts."""
-    counts: dict[str, int] = {}
-    for c in claims:
-        counts[c["verdict"]] = counts.get(c["verdict"], 0) + 1
-    lines = [f"{len(claims)} claims at **{resolution}** resolution: "
-             + ", ".join(f"{n} {v}" for v, n in counts.items()) + ".", "",
-             "| figure | claim | verdict | note |", "| --- | --- | --- | --- |"]
+    """Markdown table of the claims of a schema-2 ``claims.json`` and their verdicts.
+
+    The first line counts the claims and, by name, every verdict (zero included),
+    in :class:`tslip.sweeps.claims.Verdict`'s order: the only verdict counts the
+    documentation states.
+    """
+    from tslip.sweeps.claims import Verdict
+
+    counts = ", ".join(f"{sum(c['verdict'] == v for c in claims)} {v.value}" for v in Verdict)
+    lines = [f"{len(claims)} claims at **{resolution}** resolution: {counts}.", "",
+             "| id | figure | claim | verdict | note |", "| --- | --- | --- | --- | --- |"]
     for c in claims:
         note = c.get("error") or c.get("note") or ""
-        lines.append(f"| {_cell(c['figure'])} | {_cell(c['claim'])} | {_cell(c['verdict'])} "
-                     f"| {_cell(note)} |")
+        lines.append(f"| `{_cell(c['id'])}` | {_cell(c['figure'])} | {_cell(c['claim'])} "
+                     f"| {_cell(c['verdict'])} | {_cell(note)} |")
     return "\n".join(lines) + "\n"
 
 
 def _generate(app: Any, config: Any) -> None:
+    from tslip.plotting.report import read_claims
+
     _write(GENERATED / "cli.md", cli_reference())
     _write(GENERATED / "parameters.md", parameter_table())
     folder, res = _report_dir()
-    claims = json.loads((folder / "claims.json").read_text(encoding="utf-8"))
+    claims = read_claims(folder / "claims.json")
     _write(GENERATED / "verdicts.md", verdict_table(claims, res))
     report = GENERATED / "extra" / "report"  # html_extra_path: served as report/index.html
     report.mkdir(parents=True, exist_ok=True)

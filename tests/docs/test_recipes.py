@@ -1,8 +1,12 @@
-"""The SLIP recipe at the top of docs/analyses/slip.md, run exactly as printed.
+"""The SLIP recipe at the top of docs/analyses/slip.md, and the README's snippets, run
+exactly as printed.
 
-Its answers are checked against the independent point-mass SLIP of
+The recipe's answers are checked against the independent point-mass SLIP of
 tests/gait/test_section.py (scipy DOP853 stance, closed-form flight), not
-against tslip's own numbers.
+against tslip's own numbers. The README's printed outputs are checked against
+the comments beside them (what a reader is told the line prints), and its
+pages are checked to state no verdict counts, which only ``tslip reproduce``
+and the documentation table generated from its ``claims.json`` give.
 """
 
 from __future__ import annotations
@@ -99,3 +103,57 @@ def test_viable_set_contains_the_stable_gait_and_excludes_falls(recipe):
     for a, b in list(zip(vi, vj))[:: max(1, len(vi) // 15)]:
         nxt = ref_apex_map(float(ys[a]), 2.2, float(alphas[b]), p.k)
         assert nxt is not None and ys.min() <= nxt[0] <= ys.max()
+
+
+# -- the README's snippets, run as printed -------------------------------------------
+
+ROOT = Path(__file__).resolve().parents[2]
+README = ROOT / "README.md"
+_NUM = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
+
+
+def _printing_blocks() -> list[str]:
+    """The README's Python blocks that print, each as written."""
+    blocks = re.findall(r"```python\n(.*?)```", README.read_text(encoding="utf-8"), re.S)
+    return [b for b in blocks if "print(" in b]
+
+
+def _same(printed: str, expected: str) -> bool:
+    """A printed token against the README's: a number to the README's decimals, else equal."""
+    expected = expected.rstrip(":;,") if _NUM.fullmatch(expected.rstrip(":;,")) else expected
+    if _NUM.fullmatch(expected) and _NUM.fullmatch(printed):
+        decimals = len(expected.split(".")[1]) if "." in expected else 0
+        return round(float(printed), decimals) == pytest.approx(float(expected), abs=1e-12)
+    return printed == expected
+
+
+@pytest.mark.parametrize("block", _printing_blocks(), ids=lambda b: b.split("\n")[0][:40])
+def test_readme_prints_what_its_comments_say(block, tmp_path, monkeypatch, capsys) -> None:
+    """Each ``print(...)  # output`` line of the README prints that output (its numbers to
+    the decimals shown; the text after them in the comment is explanation)."""
+    monkeypatch.chdir(tmp_path)  # the snippets write their example files here
+    comments = [ln.split("#", 1)[1].strip() for ln in block.splitlines()
+                if ln.startswith("print(") and "#" in ln]
+    assert comments, "a printing README block states its output in a comment"
+    exec(compile(block, str(README), "exec"), {})  # noqa: S102 - our own documentation
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == len(comments)
+    for line, comment in zip(lines, comments, strict=True):
+        got, want = line.split(), comment.split()
+        assert len(want) >= len(got) and all(
+            _same(g, w) for g, w in zip(got, want[: len(got)])), (line, comment)
+
+
+def test_no_page_states_a_verdict_count_and_a_claim_count_is_the_list_s() -> None:
+    """Verdict counts live only in what ``tslip reproduce`` writes (and the docs table
+    generated from it); a number of claims, where a page states one, is ``len(CLAIMS)``."""
+    from tslip.sweeps.claims import CLAIMS
+
+    pages = [README, *(p for p in (ROOT / "docs").rglob("*.md")
+                       if not {"_generated", "_build"} & set(p.parts))]
+    for page in pages:
+        text = page.read_text(encoding="utf-8")
+        counts = re.findall(r"\b\d+ (?:hold|do not hold|holds? under|not assessed)\b", text)
+        assert not counts, (page.name, counts)
+        for n in re.findall(r"\b(\d+) (?:thesis )?claims\b", text):
+            assert int(n) == len(CLAIMS), (page.name, n)

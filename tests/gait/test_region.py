@@ -102,7 +102,7 @@ def test_stable_region_cells_against_the_reference(slip):
     assert len(df) == 4 and df.attrs["units"]["k"] == "MgL^-1"
     fig = Figure()
     ax = fig.add_subplot()
-    assert r.plot(ax=ax) is fig and ax.get_xlabel().startswith("beta0")
+    assert r.plot(ax=ax) is fig and ax.get_xlabel().startswith(r"$\beta_{0}$ [rad]")
     assert repr(r).count("\n") == 0
 
 

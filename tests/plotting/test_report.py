@@ -123,6 +123,98 @@ def test_every_axis_is_labelled_with_a_quantity_and_unit(figures) -> None:
     assert not bad, "\n".join(bad)
 
 
+def _texts(fig) -> list[str]:
+    """Every label, title, tick-free text and legend entry of ``fig``."""
+    out = [t.get_text() for t in fig.findobj(lambda a: hasattr(a, "get_text"))]
+    return [t for t in out if t]
+
+
+def test_units_are_typeset_one_way_no_caret_outside_mathtext(figures) -> None:
+    """Issue 24: no "g^1/2" beside "g$^{1/2}$": every exponent is mathtext."""
+    bad = [(key, t) for key, fig in figures.items() for t in _texts(fig)
+           if "^" in re.sub(r"\$[^$]*\$", "", t)]
+    assert not bad, bad
+
+
+def test_panel_titles_are_words_not_study_identifiers(figures) -> None:
+    names = set(catalogue.STUDIES)
+    bad = [(key, ax.get_title()) for key, fig in figures.items() for ax in fig.axes
+           if any(("_" in n and n in ax.get_title()) or ax.get_title().startswith(n + ":")
+                  for n in names)]
+    assert not bad, bad
+
+
+@pytest.mark.parametrize("figs", [figs for figs, _, _ in report._STUDY_PAIRS])
+def test_robustness_panels_share_the_multiplier_panels_x_range(figures, figs) -> None:
+    eig, rob = figures[figs[0]], figures[figs[1]]
+    (ax,) = eig.axes
+    assert all(a.get_xlim() == pytest.approx(ax.get_xlim()) for a in rob.axes)
+
+
+def _data_in_legend(fig) -> list[str]:
+    """Legends drawn inside an axes that overlap one of its data points."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(fig).draw()
+    bad = []
+    for ax in fig.axes:
+        leg = ax.get_legend()
+        if leg is None:
+            continue
+        box = leg.get_window_extent()
+        for line in ax.get_lines():
+            xy = ax.transData.transform(np.asarray(line.get_xydata(), float))
+            if line.get_linestyle() not in ("None", "none", "", " ") and len(xy) > 1:
+                t = np.linspace(0.0, 1.0, 12)[:, None, None]  # points along each segment
+                xy = (xy[:-1] + t * (xy[1:] - xy[:-1])).reshape(-1, 2)
+            xy = xy[np.isfinite(xy).all(axis=1)]
+            inside = ((xy[:, 0] > box.x0) & (xy[:, 0] < box.x1) & (xy[:, 1] > box.y0)
+                      & (xy[:, 1] < box.y1))
+            if inside.any():
+                bad.append(f"{ax.get_title()!r}: {line.get_label()}")
+    return bad
+
+
+@pytest.mark.parametrize("key", ["4.4", "4.8", "4.12", "4.24", "E.3", "E.4"])
+def test_legends_do_not_cover_data(figures, key) -> None:
+    assert not _data_in_legend(figures[key])
+
+
+@pytest.mark.parametrize("key", ["4.8", "4.12", "4.24", "E.3", "E.4"])
+def test_crowded_legends_sit_outside_their_axes(figures, key) -> None:
+    """Issue 24: these legends covered data; now beside or below the axes, whatever the data."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig = figures[key]
+    FigureCanvasAgg(fig).draw()
+    legends = [(ax, ax.get_legend()) for ax in fig.axes if ax.get_legend() is not None]
+    assert legends
+    for ax, leg in legends:
+        assert not leg.get_window_extent().overlaps(ax.get_window_extent()), ax.get_title()
+
+
+def test_figure_4_12_shows_the_trivial_multiplier(data, figures) -> None:
+    """The trivial energy multiplier (1 at an undamped point) is drawn, apart from the rest."""
+    (ax,) = figures["4.12"].axes
+    lines = {ln.get_label(): ln for ln in ax.get_lines()}
+    trivial = [ln for k, ln in lines.items() if "trivial" in k and "non-trivial" not in k]
+    assert len(trivial) == 1
+    f = data["leg_damping"].frame
+    assert np.isfinite(trivial[0].get_ydata()).sum() == f["n_trivial"].sum()
+
+
+def test_figure_4_4_marks_a_fall_at_its_step() -> None:
+    """A run that falls (NaN dv) is drawn at its step as a fall, not dropped."""
+    ok, fell = SimpleNamespace(dv=0.1, dv_expected=0.12), SimpleNamespace(dv=float("nan"),
+                                                                          dv_expected=0.2)
+    h = {"dh": (-0.2, -0.1, 0.05), "passive": [ok, ok, ok], "local_velocity": [fell, ok, ok]}
+    fig = report._plots({"4.4": h})["4.4"]()
+    right = fig.axes[1]
+    (falls,) = [ln for ln in right.get_lines() if "fall" in ln.get_label()]
+    assert list(falls.get_xdata()) == [-0.2]
+    assert not [ln for ln in fig.axes[0].get_lines() if "fall" in ln.get_label()]
+
+
 def _legend_texts(legend) -> list[str]:
     return [t.get_text() for t in legend.get_texts()]
 
@@ -131,9 +223,9 @@ def test_figure_4_11_legend_names_eqs_3_10_and_3_11(figures) -> None:
     fig = figures["4.11"]
     axes = np.array(fig.axes).reshape(2, -1)
     for ax in axes[0]:
-        assert _legend_texts(ax.get_legend()) == ["t_s model", "t_s eq. 3.10"]
+        assert _legend_texts(ax.get_legend()) == ["$t_s$ model", "$t_s$ eq. 3.10"]
     for ax in axes[1]:
-        assert _legend_texts(ax.get_legend()) == ["t_f model", "t_f eq. 3.11"]
+        assert _legend_texts(ax.get_legend()) == ["$t_f$ model", "$t_f$ eq. 3.11"]
 
 
 def test_figure_4_10_legend_names_each_colour(data, figures) -> None:
@@ -192,6 +284,7 @@ class _Page(HTMLParser):
 
 def _claim(verdict: Verdict, k: int, **kw) -> ClaimResult:
     return ClaimResult(
+        id=f"4.{k}-claim-{k}",
         figure=kw.pop("figure", "4.8"), text=f"claim number {k}", numbers={"x_max": 1.5 + k},
         verdict=verdict, quote=f"The thesis says <sentence {k}> & more.",
         source=f"Section 4.{k}", reading=f"we read it as reading {k}",
@@ -228,8 +321,7 @@ def test_every_link_resolves_and_the_contents_reach_every_section_and_claim(page
 def test_each_claim_section_shows_quote_reading_numbers_verdict_evidence(page) -> None:
     claims, p, _, _ = page
     sections = [el for el in p.ids.values() if "claim" in el["class"].split()]
-    kind = {"holds": Verdict.HOLDS, "reading": Verdict.HOLDS_UNDER_READING,
-            "fails": Verdict.FAILS}
+    kind = {report.VERDICT_CLASS[v]: v for v in Verdict}
     for c in claims:
         (el,) = [e for e in sections if c.text in "".join(e["text"])]
         body = "".join(el["text"])
@@ -253,14 +345,59 @@ def test_summary_counts_three_verdicts_and_escapes_quotes(page) -> None:
     assert "<sentence" not in text and "&lt;sentence 3&gt; &amp; more" in text
 
 
-def test_claims_json_carries_verdict_quote_reading_evidence(page) -> None:
-    claims, _, _, js = page
+def test_claims_json_schema_2_carries_id_verdict_quote_reading_evidence(page, tmp_path) -> None:
+    claims, _, _, doc = page
+    assert set(doc) == {"schema", "claims"} and doc["schema"] == 2
+    js = doc["claims"]
+    assert js == report.read_claims(tmp_path / "claims.json")
     assert len(js) == len(claims)
     for c, j in zip(claims, js, strict=True):
-        assert j["verdict"] == c.verdict.value and j["holds"] == (c.verdict != Verdict.FAILS)
-        for k in ("quote", "source", "reading", "note", "error"):
+        assert set(j) == {"id", "figure", "claim", "verdict", "quote", "source", "reading",
+                          "numbers", "evidence", "note", "error"}  # no "holds": the verdict
+        assert j["verdict"] == c.verdict.value and j["id"] == c.id and j["claim"] == c.text
+        for k in ("figure", "quote", "source", "reading", "note", "error"):
             assert j[k] == getattr(c, k)
         assert j["evidence"] == json.loads(json.dumps(c.evidence))
+
+
+@pytest.mark.parametrize("old", [[{"figure": "4.1", "verdict": "holds", "holds": True}],
+                                 {"claims": []}, {"schema": 3, "claims": []}])
+def test_an_old_or_unknown_claims_json_is_refused_in_one_line(tmp_path, old) -> None:
+    path = tmp_path / "claims.json"
+    path.write_text(json.dumps(old))
+    with pytest.raises(ValueError, match="schema") as exc:
+        report.read_claims(path)
+    assert "\n" not in str(exc.value) and "tslip reproduce" in str(exc.value)
+
+
+def test_not_assessed_has_its_class_and_count_by_name(tmp_path) -> None:
+    na = Verdict("not assessed")
+    claims = [_claim(Verdict.HOLDS, 0), _claim(na, 1), _claim(na, 2, figure="4.19")]
+    text = report.write_report(tmp_path / "index.html", {}, claims).read_text(encoding="utf-8")
+    p = _Page()
+    p.feed(text)
+    assert "not assessed: 2" in "".join(p.ids["summary"]["text"])
+    classes = [el["class"].split() for el in p.ids.values() if "claim" in el["class"].split()]
+    assert sorted(c[1] for c in classes) == ["holds", "not-assessed", "not-assessed"]
+    assert ".verdict.not-assessed{" in text and ".claim.not-assessed{" in text
+    assert "class='verdict not-assessed'>not assessed</span>" in text
+
+
+def test_numbers_show_typeset_units_and_rendered_quotes(tmp_path) -> None:
+    """Units of number keys as superscripts, -0 as 0, a range's ends apart, no raw LaTeX."""
+    c = ClaimResult(id="6.1-push", figure="6.1", text="push", verdict=Verdict.FAILS,
+                    numbers={"push limit [g^1/2 L^1/2]": -0.725, "tilt [rad]": -0.0,
+                             "stance time range [g^-1/2 L^1/2]": [0.19987, 0.20041]},
+                    quote=r"push disturbance is $-0.73 \text{ g}^{1/2} \text{ L}^{1/2}$",
+                    evidence={"by reading": {"slope [rad g^1/2 L^-1/2]": 1.0}})
+    text = report.write_report(tmp_path / "index.html", {}, [c]).read_text(encoding="utf-8")
+    (sec,) = re.findall(r"<div class='claim fails'.*?</div>", text, re.S)
+    assert "push limit [g<sup>1/2</sup> L<sup>1/2</sup>]" in sec
+    assert "<td>tilt [rad]</td><td>0</td>" in sec
+    assert "[0.1999, 0.2004]" in sec  # 3 digits would print [0.2, 0.2]
+    assert "slope [rad g<sup>1/2</sup> L<sup>-1/2</sup>]: 1" in sec
+    assert "is -0.73 g<sup>1/2</sup> L<sup>1/2</sup>”" in sec
+    assert "$" not in sec and "\\" not in sec and "^" not in sec
 
 
 def test_reproduce_cli_prints_each_verdict_and_the_count_per_verdict(page, tmp_path,
@@ -333,3 +470,38 @@ def test_figure_png_is_the_image_savefig_writes(dpi) -> None:
     uri = report.figure_png(fig, dpi=dpi)
     assert base64.b64decode(uri.split(",", 1)[1]) == buf.getvalue()
     assert fig.get_layout_engine() is engine
+
+
+def test_docs_verdict_table_is_read_from_claims_json(page, tmp_path) -> None:
+    """The documentation's table (docs/_ext/tslip_docs.py) counts each verdict by name
+    from the claims.json the report wrote, and lists every claim's id."""
+    import importlib.util
+    from pathlib import Path
+
+    ext = Path(__file__).resolve().parents[2] / "docs" / "_ext" / "tslip_docs.py"
+    spec = importlib.util.spec_from_file_location("tslip_docs", ext)
+    assert spec is not None and spec.loader is not None
+    docs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(docs)
+    claims = page[0]
+    table = docs.verdict_table(report.read_claims(tmp_path / "claims.json"), "quick")
+    first = table.splitlines()[0]
+    counts = ", ".join(f"{sum(c.verdict is v for c in claims)} {v.value}" for v in Verdict)
+    assert first == f"{len(claims)} claims at **quick** resolution: {counts}."
+    rows = [ln for ln in table.splitlines() if ln.startswith("| `")]
+    assert [r.split("`")[1] for r in rows] == [c.id for c in claims]
+    assert all(c.verdict.value in r for c, r in zip(claims, rows, strict=True))
+
+
+def test_figure_e3_fills_its_box() -> None:
+    """The foot path is drawn at equal aspect: the figure is sized to it, no tall empty box."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from tslip.biped import BipedParams, BipedState, simulate
+    from tslip.plotting.biped import plot_foot_path
+
+    fig = plot_foot_path(simulate(BipedParams(), BipedState.thesis(), 1), stride=0)
+    FigureCanvasAgg(fig).draw()
+    (ax,) = fig.axes
+    drawn = ax.get_window_extent()  # the axes box after equal aspect shrank it
+    assert drawn.height / fig.bbox.height > 0.5  # 0.22 in the old 6 x 5 inch box

@@ -38,7 +38,7 @@ def test_report_is_self_contained(tmp_path) -> None:
         assert f"id='fig-{figs[0].replace('.', '-')}'" in text
     # every claim evaluated is on the page, with its verdict in claims.json
     assert claims and all(html.escape(c.text, quote=False) in text for c in claims)
-    rows = json.loads((tmp_path / "claims.json").read_text())
+    rows = json.loads((tmp_path / "claims.json").read_text())["claims"]
     assert [r["verdict"] for r in rows] == [c.verdict.value for c in claims]
 
 
@@ -108,7 +108,9 @@ def test_reproduce_end_to_end_tiny(tmp_path, monkeypatch) -> None:
     assert appendix_e_cached(tmp_path, "tiny")["e2"]["strides_perturbed"] == \
         e2["strides_perturbed"]
 
-    rows = json.loads((tmp_path / "claims.json").read_text())
+    doc = json.loads((tmp_path / "claims.json").read_text())
+    assert doc["schema"] == 2
+    rows = doc["claims"]
     assert len(rows) == len(claims)
     assert all("verdict" in r and "evidence" in r for r in rows)
 

@@ -76,6 +76,11 @@ def study_cmd(
                   + " and run.json")
 
 
+#: Colour of each verdict in the claims table, by its text; "not assessed" stays plain.
+_STYLE = {"holds": "green", "holds under a stated reading": "yellow",
+          "does not hold": "bold red", "not assessed": "dim"}
+
+
 @commands.command("reproduce")
 def reproduce_cmd(
     quick: Annotated[bool, typer.Option("--quick", help="Coarse resolution (about a "
@@ -87,7 +92,7 @@ def reproduce_cmd(
     """Run every thesis study and write a report (out/index.html)."""
     from rich.text import Text
 
-    from ..plotting.report import reproduce
+    from ..plotting.report import read_claims, reproduce
     from ..sweeps import catalogue
     from ..sweeps.claims import Verdict, count_verdicts
 
@@ -112,18 +117,15 @@ def reproduce_cmd(
                              progress=progress)
         except KeyboardInterrupt:
             stopped(_saved_message(out, quick))
-    import json
-
-    claims = json.loads(path.with_name("claims.json").read_text())
+    with errors():
+        claims = read_claims(path.with_name("claims.json"))
     t = Table(title="thesis claims", box=box.SIMPLE_HEAD, title_justify="left")
     t.add_column("figure")
     t.add_column("claim")
     t.add_column("verdict")
-    style = {Verdict.HOLDS: "green", Verdict.HOLDS_UNDER_READING: "yellow",
-             Verdict.FAILS: "bold red", Verdict.NOT_ASSESSED: "dim"}
     for c in claims:
         v = Verdict(c["verdict"])
-        t.add_row(Text(c["figure"]), Text(c["claim"]), Text(v.value, style=style[v]))
+        t.add_row(Text(c["figure"]), Text(c["claim"]), Text(v.value, style=_STYLE.get(v, "")))
     console.print(t)
     counts = ", ".join(f"{v.value}: {n}" for v, n in count_verdicts(claims).items())
     console.print(f"{len(claims)} claims; {counts}; {time.perf_counter() - t0:.1f} s")

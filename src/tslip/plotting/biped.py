@@ -11,9 +11,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from ..biped.dynamics import controller_references, foot_position, hip_position, leg_phase
+from ..model.units import UNIT
 from .gait import plot_pitch_impulse
+from .notation import axis_label
 
 if TYPE_CHECKING:
     from ..biped.simulate import Trajectory
@@ -37,15 +40,16 @@ def plot_tracking(tr: Trajectory, stride: int = 0, leg: int = 0) -> Figure:
     ref = controller_references(tr.params, leg_phase(tr.params, t, leg))
     fig = Figure(figsize=(7, 7), layout="constrained")
     axs = fig.subplots(3, 1, sharex=True)
-    rows = [(f"l_t{side}", ref[:, 0], "thigh length l_t [L]"),
-            (f"l_s{side}", np.full(t.size, tr.params.l_s0), "shank length l_s [L]"),
-            (f"theta_h{side}", ref[:, 2], "hip angle theta_h [rad]")]
+    rows = [(f"l_t{side}", ref[:, 0], axis_label("thigh length $l_t$", UNIT["length"])),
+            (f"l_s{side}", np.full(t.size, tr.params.l_s0),
+             axis_label("shank length $l_s$", UNIT["length"])),
+            (f"theta_h{side}", ref[:, 2], axis_label(r"hip angle $\theta_h$", UNIT["angle"]))]
     for ax, (col, r, label) in zip(axs, rows, strict=True):
         ax.plot(t, r, "k--", lw=1, label="reference" if col != f"l_s{side}" else "rest length")
         ax.plot(t, tr[col][m], "C0", lw=1.5, label="simulation")
         ax.set_ylabel(label)
         ax.legend(loc="best", fontsize=8)
-    axs[-1].set_xlabel("time [g^-1/2 L^1/2]")
+    axs[-1].set_xlabel(axis_label("time", UNIT["time"]))
     fig.suptitle(f"controller tracking, {'right' if leg == 0 else 'left'} leg, stride {stride}")
     return fig
 
@@ -58,23 +62,26 @@ def plot_foot_path(tr: Trajectory, leg: int = 0, ax: Any = None,
     default every recorded stride.
     """
     p = tr.params
-    if ax is None:
-        fig = Figure(figsize=(6, 5), layout="constrained")
-        ax = fig.subplots()
-    else:
-        fig = ax.figure
     q = tr.data[:, 1:10] if stride is None else tr.data[_window(tr, stride), 1:10]
     rel = foot_position(p, q, leg) - hip_position(p, q)
     rho = np.linspace(0, 1, 400)
     ref = controller_references(p, rho)
     gam = ref[:, 2]  # reference hip angle at zero pitch
     s = ref[:, 0] + p.l_s0
-    ax.plot(-s * np.sin(gam), -s * np.cos(gam), "k--", lw=1, label="reference (theta_b = 0)")
+    ref_x, ref_z = -s * np.sin(gam), -s * np.cos(gam)
+    if ax is None:  # sized to the path at equal aspect, with room for the labels and legend
+        xs, zs = np.r_[ref_x, rel[:, 0]], np.r_[ref_z, rel[:, 1]]
+        ratio = float(np.ptp(zs) / max(np.ptp(xs), 1e-9))
+        fig = Figure(figsize=(6.4, min(6.0, 0.9 + 4.4 * ratio)), layout="constrained")
+        ax = fig.subplots()
+    else:
+        fig = ax.figure
+    ax.plot(ref_x, ref_z, "k--", lw=1, label=r"reference ($\theta_b = 0$)")
     ax.plot(rel[:, 0], rel[:, 1], "C0", lw=1, label="simulation")
     ax.set_aspect("equal")
-    ax.set_xlabel("x - x_hip [L]")
-    ax.set_ylabel("z - z_hip [L]")
-    ax.legend(fontsize=8)
+    ax.set_xlabel(axis_label(r"$x - x_{hip}$", UNIT["length"]))
+    ax.set_ylabel(axis_label(r"$z - z_{hip}$", UNIT["length"]))
+    ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5), frameon=False)
     return fig
 
 
@@ -91,27 +98,34 @@ def plot_metacentric(response: PitchResponse) -> Figure:
     response : PitchResponse
         From :func:`tslip.biped.metacentre.metacentric_test`.
     """
-    fig = Figure(figsize=(10, 4.2), layout="constrained")
+    fig = Figure(figsize=(10, 5.0), layout="constrained")
     ax, ax2 = fig.subplots(1, 2, width_ratios=(1.0, 1.2))
     labels = [rf"$\Delta\theta_b$ = {d:+.1f} rad" for d in response.dphis]
-    for i, (imp, lab) in enumerate(zip(response, labels, strict=True)):
-        ax.plot(imp.time, imp.F_y, f"C{i}", label=lab + ": $F_z$")
-        ax.plot(imp.time, imp.F_x, f"C{i}--", label=lab + ": $F_x$")
-    ax.set_xlabel("time since touch-down [g$^{-1/2}$ L$^{1/2}$]")
-    ax.set_ylabel("ground reaction force [M g]")
+    for i, imp in enumerate(response):
+        ax.plot(imp.time, imp.F_y, f"C{i}")
+        ax.plot(imp.time, imp.F_x, f"C{i}--")
+    ax.set_xlabel(axis_label("time since touch-down", UNIT["time"]))
+    ax.set_ylabel(axis_label("ground reaction force", UNIT["force"]))
     # the ground damper (Table E.3) gives short touch-down and lift-off spikes;
     # scale the axis to the rest of the stance and say how far the spikes go
     f_all = np.concatenate([np.r_[i.F_x, i.F_y] for i in response])
     lo, hi = np.percentile(f_all, [1.0, 99.0])
     if f_all.max() > 1.5 * hi or f_all.min() < lo - 0.5 * (hi - lo):
         ax.set_ylim(min(lo, 0.0) - 0.2 * (hi - lo), 1.3 * hi)
-        ax.set_title(f"spikes clipped: range {f_all.min():.1f} to {f_all.max():.1f} M g",
+        ax.set_title(f"spikes clipped: range {f_all.min():.1f} to {f_all.max():.1f} Mg",
                      fontsize="small")
     ax.axhline(0.0, color="0.7", lw=0.5)
-    ax.legend(fontsize=7)
+    # below the panels, never on the curves: colour = pitch change, line style = component
+    keys = [Line2D([], [], color=f"C{i}", label=lab) for i, lab in enumerate(labels)]
+    keys += [Line2D([], [], color="k", label="$F_z$"), Line2D([], [], color="k", ls="--",
+                                                             label="$F_x$")]
+    ax.legend(handles=keys, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.17),
+              ncols=3, frameon=False)
     plot_pitch_impulse(response, ax=ax2, labels=labels)
-    ax2.set_xlabel(r"$x - x_{CoM}$ [L]")
-    ax2.set_ylabel(r"$z - z_{CoM}$ [L]")
+    ax2.legend(*ax2.get_legend_handles_labels(), fontsize=7, loc="upper center",
+               bbox_to_anchor=(0.5, -0.17), ncols=2, frameon=False)
+    ax2.set_xlabel(axis_label(r"$x - x_{CoM}$", UNIT["length"]))
+    ax2.set_ylabel(axis_label(r"$z - z_{CoM}$", UNIT["length"]))
     fig.suptitle("metacentric test: right stance after a body-pitch change, legs fixed in the "
                  "world (CoM at origin, hip: open circle)", fontsize="medium")
     return fig

@@ -11,6 +11,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from matplotlib.figure import Figure
 
+from ..model.units import UNIT
+from .notation import axis_label
+
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
@@ -19,10 +22,12 @@ if TYPE_CHECKING:
 
 __all__ = ["plot_step_average", "plot_foot_trajectory", "plot_fit_scores"]
 
-_LABELS = {"y": "y_m [L]", "l": "l [L]", "beta": "beta [rad]", "phi": "phi [rad]",
-           "xd": "xdot_m [g^1/2 L^1/2]", "yd": "ydot_m [g^1/2 L^1/2]",
-           "ld": "ldot [g^1/2 L^1/2]", "betad": "betadot [rad g^1/2 L^-1/2]",
-           "phid": "phidot [rad g^1/2 L^-1/2]"}
+_LABELS = {k: axis_label(sym, UNIT[kind]) for k, sym, kind in (
+    ("y", "$y_m$", "length"), ("l", "$l$", "length"), ("beta", r"$\beta$", "angle"),
+    ("phi", r"$\phi$", "angle"), ("xd", r"$\dot{x}_m$", "speed"),
+    ("yd", r"$\dot{y}_m$", "speed"), ("ld", r"$\dot{l}$", "speed"),
+    ("betad", r"$\dot{\beta}$", "angular_velocity"),
+    ("phid", r"$\dot{\phi}$", "angular_velocity"))}
 
 
 def plot_step_average(avg: StepAverage, fit: FitResult | None = None, *,

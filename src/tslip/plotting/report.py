@@ -12,21 +12,24 @@ from __future__ import annotations
 import base64
 import html
 import io
-import math
 from collections.abc import Callable, Mapping, Sequence
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from .. import __version__
 from .._io import atomic_write, write_json
-from ..sweeps.claims import Verdict
+from ..model.units import UNIT
+from ..sweeps.claims import Verdict, count_verdicts
+from .notation import axis_label, key_html, tex_html, unit_html, value
 
-__all__ = ["PLOT_SECONDS", "SECTIONS", "ReportPlots", "compute", "figure_inputs", "figure_png",
-           "plot_task", "render_ready", "reproduce", "write_report"]
+__all__ = ["CLAIMS_SCHEMA", "PLOT_SECONDS", "SECTIONS", "ReportPlots", "claims_json", "compute",
+           "figure_inputs", "figure_png", "plot_task", "read_claims", "render_ready", "reproduce",
+           "write_report"]
 
 
 def figure_png(fig: Figure, dpi: int = 80) -> str:
@@ -57,11 +60,15 @@ def figure_png(fig: Figure, dpi: int = 80) -> str:
 _CONTROLLERS = {"passive": "mass_offset", "global PD": "controller_global_pd",
                 "local velocity": "controller_local_velocity",
                 "constant torque": "controller_constant_torque"}
-#: The studies drawn as a multipliers figure and a robustness figure: (figures, study).
-_STUDY_PAIRS = ((("4.8", "4.9"), "velocity"), (("4.12", "4.13"), "leg_damping"),
-                (("4.14", "4.15"), "hip_damping"), (("4.16", "4.17"), "mass_offset"),
-                (("4.18", "4.19"), "stiffness"), (("4.20", "4.21"), "touchdown_angle"),
-                (("4.22", "4.23"), "retraction"))
+#: The studies drawn as a multipliers figure and a robustness figure: (figures, study,
+#: what varies in the thesis's caption words).
+_STUDY_PAIRS = ((("4.8", "4.9"), "velocity", "velocity"),
+                (("4.12", "4.13"), "leg_damping", "leg damping"),
+                (("4.14", "4.15"), "hip_damping", "hip damping"),
+                (("4.16", "4.17"), "mass_offset", "mass offset"),
+                (("4.18", "4.19"), "stiffness", "leg stiffness"),
+                (("4.20", "4.21"), "touchdown_angle", "initial leg angle"),
+                (("4.22", "4.23"), "retraction", "normalized swing-leg retraction rate"))
 _STRIDE_STUDIES = ("stride_v0", "stride_k", "stride_beta0")
 
 
@@ -75,7 +82,7 @@ def figure_inputs() -> dict[str, tuple[str, ...]]:
     inputs["4.10"] = tuple(f"grid_v{v:g}" for v in GRID_SPEEDS)
     inputs["4.11"] = _STRIDE_STUDIES
     inputs["4.24"] = inputs["4.25"] = tuple(_CONTROLLERS.values())
-    for figs, name in _STUDY_PAIRS:
+    for figs, name, _ in _STUDY_PAIRS:
         inputs.update(dict.fromkeys(figs, (name,)))
     return inputs
 
@@ -87,24 +94,32 @@ def _plots(data: Mapping[str, Any]) -> dict[str, Callable[[], Figure]]:
     from . import gait as g
     from . import studies as s
 
-    def pair(name: str) -> dict[str, Callable[[], Figure]]:
-        return {"eig": lambda: s.plot_study_multipliers(data[name]),
-                "rob": lambda: s.plot_study_robustness(data[name])}
+    def pair(name: str, words: str) -> dict[str, Callable[[], Figure]]:
+        return {"eig": lambda: s.plot_study_multipliers(
+                    data[name], title=f"Eigenvalue magnitudes over varying {words}"),
+                "rob": lambda: s.plot_study_robustness(
+                    data[name], title=f"Robustness over varying {words}")}
 
     def fig44() -> Figure:
         h = data["4.4"]
         fig = Figure(figsize=(8.0, 3.2), layout="constrained")
         axes = fig.subplots(1, 2, sharey=True)
+        dh = np.asarray(h["dh"], float)
         for a, key, title in ((axes[0], "passive", "passive vs eq. 3.8"),
                               (axes[1], "local_velocity", "local velocity control")):
-            a.plot(h["dh"], [r.dv for r in h[key]], "o", label="model")
+            dv = np.array([r.dv for r in h[key]], float)
+            fell = ~np.isfinite(dv)  # a run that falls has no converged speed
+            a.plot(dh[~fell], dv[~fell], "o", label="model")
             if key == "passive":
-                a.plot(h["dh"], [r.dv_expected for r in h[key]], "-", label="eq. 3.8")
+                a.plot(dh, [r.dv_expected for r in h[key]], "-", label="eq. 3.8")
+            if fell.any():
+                a.plot(dh[fell], np.zeros(int(fell.sum())), "X", color="C3", ms=9,
+                       label="falls (no Δv)")
             a.axhline(0, color="k", lw=0.6)
-            a.set_xlabel("Δh [L]")
+            a.set_xlabel(axis_label(r"ground step $\Delta h$", UNIT["length"]))
             a.set_title(title, fontsize=9)
             a.legend(fontsize=7)
-        axes[0].set_ylabel("Δv [g^1/2 L^1/2]")
+        axes[0].set_ylabel(axis_label(r"$\Delta v$", UNIT["speed"]))
         return fig
 
     ctrl = _CONTROLLERS
@@ -126,8 +141,8 @@ def _plots(data: Mapping[str, Any]) -> dict[str, Callable[[], Figure]]:
         "4.24": lambda: s.plot_controllers_multipliers({k: data[v] for k, v in ctrl.items()}),
         "4.25": lambda: s.plot_controllers_robustness({k: data[v] for k, v in ctrl.items()}),
     }
-    for figs, name in _STUDY_PAIRS:
-        p = pair(name)
+    for figs, name, words in _STUDY_PAIRS:
+        p = pair(name, words)
         plots[figs[0]], plots[figs[1]] = p["eig"], p["rob"]
     return plots
 
@@ -163,9 +178,11 @@ table{border-collapse:collapse;margin:.5em 0;font-size:.9em}
 td,th{border:1px solid #ccc;padding:3px 7px;text-align:left;vertical-align:top}
 .verdict{font-weight:bold;white-space:nowrap}.verdict.holds{color:#146c14}
 .verdict.reading{color:#a05a00}.verdict.fails{color:#b00}.failed{color:#b00}
+.verdict.not-assessed{color:#3a5a8c}
 .claim{border-left:4px solid #ccc;padding:.2em .8em;margin:1em 0}
 .claim.holds{border-color:#146c14}.claim.reading{border-color:#d08a1c}
-.claim.fails{border-color:#b00}.claim h3{font-size:1em;margin:.3em 0}
+.claim.fails{border-color:#b00}.claim.not-assessed{border-color:#7f9cc8;border-left-style:dashed}
+.claim h3{font-size:1em;margin:.3em 0}
 .up{float:right;font-size:.8em;font-weight:normal}
 blockquote{margin:.3em 0 .3em 1em;font-style:italic}cite{font-style:normal;color:#555}
 img{max-width:100%;display:block;margin:.4em 0}.note{color:#555;font-size:.9em}
@@ -173,25 +190,21 @@ nav ol{columns:2;font-size:.9em}nav ol ol{columns:1;font-size:.95em}
 code{font-size:.85em}
 """
 
-#: CSS class of each verdict (three colours).
-VERDICT_CLASS: dict[Verdict, str] = {Verdict.HOLDS: "holds",
-                                     Verdict.HOLDS_UNDER_READING: "reading",
-                                     Verdict.FAILS: "fails",
-                                     Verdict.NOT_ASSESSED: "reading"}
+#: CSS class of each verdict, by its text (a :class:`Verdict` is its text): "not assessed"
+#: (too few points for the check's statistic; never a failure) is blue and dashed.
+VERDICT_CLASS: dict[str, str] = {"holds": "holds", "holds under a stated reading": "reading",
+                                 "does not hold": "fails", "not assessed": "not-assessed"}
 
 
 def _e(x: Any) -> str:
     return html.escape(str(x))
 
 
-def _num(v: Any) -> str:
-    if isinstance(v, float):
-        return "–" if not math.isfinite(v) else f"{v:.4g}"
-    if isinstance(v, list | tuple):
-        return "[" + ", ".join(_num(x) for x in v) + "]"
+def _value_html(v: Any, key: str) -> str:
+    """A claim's number as HTML (:func:`.notation.value`), units of nested keys typeset."""
     if isinstance(v, Mapping):
-        return "; ".join(f"{k}: {_num(x)}" for k, x in v.items())
-    return str(v)
+        return "; ".join(f"{key_html(str(k))}: {_value_html(x, str(k))}" for k, x in v.items())
+    return _e(value(v, key))
 
 
 def _verdict(c: Any) -> Verdict:
@@ -212,14 +225,14 @@ def _verdict_span(c: Any) -> str:
 
 
 def _summary_table(claims: Sequence[Any], ids: Sequence[str]) -> str:
-    rows = [f"<tr><td>{_e(c.figure)}</td><td><a href='#{i}'>{_e(c.text)}</a></td>"
+    rows = [f"<tr><td>{_e(c.figure)}</td><td><a href='#{i}'>{tex_html(c.text)}</a></td>"
             f"<td>{_verdict_span(c)}</td></tr>" for c, i in zip(claims, ids, strict=True)]
     return ("<table><tr><th>figure</th><th>thesis claim</th><th>verdict</th></tr>"
             + "".join(rows) + "</table>")
 
 
 def _numbers_table(numbers: Mapping[str, Any]) -> str:
-    return ("<table>" + "".join(f"<tr><td>{_e(k)}</td><td>{_e(_num(v))}</td></tr>"
+    return ("<table>" + "".join(f"<tr><td>{key_html(k)}</td><td>{_value_html(v, k)}</td></tr>"
                                 for k, v in numbers.items()) + "</table>")
 
 
@@ -227,14 +240,14 @@ def _claim_section(c: Any, cid: str) -> str:
     """One claim: thesis sentence and source, our reading, numbers, verdict, evidence, note."""
     v = _verdict(c)
     out = [f"<div class='claim {VERDICT_CLASS[v]}' id='{cid}'>",
-           f"<h3>Figure {_e(c.figure)}: {_e(c.text)}{_UP}</h3>"]
+           f"<h3>Figure {_e(c.figure)}: {tex_html(c.text)}{_UP}</h3>"]
     if c.quote:
         src = f" <cite>({_e(c.source)})</cite>" if c.source else ""
-        out.append(f"<blockquote class='quote'>“{_e(c.quote)}”{src}</blockquote>")
+        out.append(f"<blockquote class='quote'>“{tex_html(c.quote)}”{src}</blockquote>")
     else:
         out.append("<p class='quote note'>Thesis sentence not recorded.</p>")
     if c.reading:
-        out.append(f"<p class='reading-text'><b>Our reading:</b> {_e(c.reading)}</p>")
+        out.append(f"<p class='reading-text'><b>Our reading:</b> {tex_html(c.reading)}</p>")
     out.append("<p><b>Our numbers:</b></p>" + (_numbers_table(c.numbers) if c.numbers
                                                 else "<p class='note'>none</p>"))
     if c.error:
@@ -246,19 +259,14 @@ def _claim_section(c: Any, cid: str) -> str:
     elif v is not Verdict.HOLDS:
         out.append("<p class='evidence note'>No further evidence recorded.</p>")
     if c.note:
-        out.append(f"<p class='note'>{_e(c.note)}</p>")
+        out.append(f"<p class='note'>{tex_html(c.note)}</p>")
     out.append("</div>")
     return "\n".join(out)
 
 
-def _counts(claims: Sequence[Any]) -> dict[Verdict, int]:
-    """Claims per verdict, every verdict present (zero if none)."""
-    return {v: sum(_verdict(c) is v for c in claims) for v in Verdict}
-
-
 def _counts_html(claims: Sequence[Any]) -> str:
     parts = [f"<span class='verdict {VERDICT_CLASS[v]}'>{_e(v.value)}: {n}</span>"
-             for v, n in _counts(claims).items()]
+             for v, n in count_verdicts(claims).items()]
     return (f"<p class='counts'>{len(claims)} claims; " + ", ".join(parts)
             + ". Every figure and claim is listed in the <a href='#contents'>contents</a>.</p>")
 
@@ -271,7 +279,7 @@ def _toc(claims: Sequence[Any], ids: Sequence[str]) -> str:
     """Contents: every figure section and, under it, its claims."""
     items = ["<li><a href='#summary'>Summary</a></li>"]
     for figs, title in SECTIONS:
-        sub = "".join(f"<li><a href='#{i}'>{_e(c.text)}</a> {_verdict_span(c)}</li>"
+        sub = "".join(f"<li><a href='#{i}'>{tex_html(c.text)}</a> {_verdict_span(c)}</li>"
                       for c, i in zip(claims, ids, strict=True) if c.figure in figs)
         items.append(f"<li><a href='#{_sec_id(figs)}'>{_e(title)}</a>"
                      + (f"<ol>{sub}</ol>" if sub else "") + "</li>")
@@ -291,19 +299,23 @@ def _table6(data: Mapping[str, Any]) -> str:
     t = data.get("table6.1")
     if t is None:
         return ""
-    rows6 = [("Stance duration t_s", 0.58, "0.58 ± 0.03", "stance_time"),
-             ("Flight duration t_f", 0.13, "0.13 ± 0.02", "flight_time"),
-             ("Duty factor d", 0.82, "0.81 ± 0.02", "duty_factor"),
-             ("Step frequency f", 1.41, "1.40 ± 0.07", "step_frequency")]
+    time, freq = UNIT["time"], UNIT["frequency"]
+    rows6 = [(f"Stance duration t<sub>s</sub> [{unit_html(time)}]", 0.58, "0.58 ± 0.03",
+              "stance_time"),
+             (f"Flight duration t<sub>f</sub> [{unit_html(time)}]", 0.13, "0.13 ± 0.02",
+              "flight_time"),
+             ("Duty factor d [-]", 0.82, "0.81 ± 0.02", "duty_factor"),
+             (f"Step frequency f [{unit_html(freq)}]", 1.41, "1.40 ± 0.07", "step_frequency")]
     s = ("<h3>Table 6.2: stride of the Table 6.1 model</h3><table><tr><th>quantity</th>"
          "<th>Ell. Runner</th><th>thesis TSLIP</th><th>ours</th></tr>")
     s += "".join(f"<tr><td>{a}</td><td>{c}</td><td>{b}</td><td>{t[k]:.3f}</td></tr>"
                  for a, b, c, k in rows6) + "</table>"
-    rob = [("Largest multiplier |λ|", 0.92, "max_nontrivial"),
-           ("Step-down Δh [L]", -0.12, "step_down"),
-           ("Push Δẋ [g^1/2 L^1/2]", -0.73, "push"),
-           ("Pitch rate Δφ̇ [rad g^1/2 L^-1/2]", -1.50, "pitch_rate"),
-           ("Controller reference α̇_ref (solved)", 2.42, "alphad_ref")]
+    rob = [("Largest multiplier |λ| [-]", 0.92, "max_nontrivial"),
+           (f"Step-down Δh [{UNIT['length']}]", -0.12, "step_down"),
+           (f"Push Δẋ [{unit_html(UNIT['speed'])}]", -0.73, "push"),
+           (f"Pitch rate Δφ̇ [{unit_html(UNIT['angular_velocity'])}]", -1.50, "pitch_rate"),
+           (f"Controller reference α̇<sub>ref</sub> (solved) "
+            f"[{unit_html(UNIT['angular_velocity'])}]", 2.42, "alphad_ref")]
     s += ("<h3>Section 6.1: stability and robustness of the Table 6.1 model</h3><table>"
           "<tr><th>quantity</th><th>thesis</th><th>ours</th></tr>")
     s += "".join(f"<tr><td>{a}</td><td>{b:.2f}</td><td>{t[k]:.3f}</td></tr>"
@@ -454,12 +466,44 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
     text = "\n".join(parts)
     path = Path(path)
     atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
-    claims_json = [{"figure": c.figure, "claim": c.text, "verdict": _verdict(c).value,
-                    "holds": c.verdict is not Verdict.FAILS, "quote": c.quote, "source": c.source,
-                    "reading": c.reading, "numbers": c.numbers, "evidence": c.evidence,
-                    "note": c.note, "error": c.error} for c in claims]
-    write_json(path.with_name("claims.json"), claims_json, indent=1)
+    write_json(path.with_name("claims.json"), claims_json(claims), indent=1)
     return path
+
+
+#: The version of ``claims.json``'s layout (docs/reproducing.md, "claims.json").
+CLAIMS_SCHEMA = 2
+
+
+def claims_json(claims: Sequence[Any]) -> dict[str, Any]:
+    """``claims.json``: ``{"schema": 2, "claims": [...]}``, one object a claim.
+
+    Each claim: ``id`` (stable across releases), ``figure``, ``claim`` (the
+    one-line summary), ``verdict`` (one of :class:`Verdict`'s texts: the one
+    truth, there is no ``holds`` key), ``quote``, ``source``, ``reading``,
+    ``numbers`` and ``evidence`` (number keys end with `` [unit]`` when the
+    number has one), ``note`` and ``error`` (empty unless the check raised).
+    """
+    return {"schema": CLAIMS_SCHEMA, "claims": [
+        {"id": c.id, "figure": c.figure, "claim": c.text, "verdict": _verdict(c).value,
+         "quote": c.quote, "source": c.source, "reading": c.reading, "numbers": c.numbers,
+         "evidence": c.evidence, "note": c.note, "error": c.error} for c in claims]}
+
+
+def read_claims(path: str | Path) -> list[dict[str, Any]]:
+    """The claims of a ``claims.json`` written by ``tslip reproduce`` (schema 2).
+
+    Raises a one-line ``ValueError`` for any other layout, naming the schema
+    found: the bare list of schema 1 (tslip 0.3.0 and before, with a ``holds`` key) is not read;
+    rerun ``tslip reproduce`` (its study caches make that quick).
+    """
+    import json
+
+    doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    schema = doc.get("schema") if isinstance(doc, dict) else 1
+    if schema != CLAIMS_SCHEMA or not isinstance(doc.get("claims"), list):
+        raise ValueError(f"{path}: claims.json schema {schema!r}, this tslip reads schema "
+                         f"{CLAIMS_SCHEMA} only; rerun `tslip reproduce` to rewrite it")
+    return list(doc["claims"])
 
 
 def compute(out_dir: str | Path, *, quick: bool = False, resolution: str | None = None,

@@ -18,6 +18,8 @@ from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
+from ..model.units import UNIT
+from .notation import axis_label
 from .sweeps import _STABLE_GREEN, _runs, param_label
 
 if TYPE_CHECKING:
@@ -28,8 +30,11 @@ __all__ = ["plot_study_multipliers", "plot_study_robustness", "plot_stable_grid"
            "plot_stable_region",
            "plot_stride_times", "plot_controllers_multipliers", "plot_controllers_robustness"]
 
-_ROB = (("step_down", "max step-down Δh [L]"), ("push", "max push Δẋ [g^1/2 L^1/2]"),
-        ("pitch_rate", "max pitch rate Δφ̇ [rad g^1/2 L^-1/2]"))
+_ROB = (("step_down", axis_label(r"max step-down $\Delta h$", UNIT["length"])),
+        ("push", axis_label(r"max push $\Delta\dot{x}$", UNIT["speed"])),
+        ("pitch_rate", axis_label(r"max pitch rate $\Delta\dot{\phi}$",
+                                  UNIT["angular_velocity"])))
+_LAMBDA = r"$|\lambda|$"
 
 
 def _stable(frame) -> np.ndarray:  # noqa: ANN001 - DataFrame
@@ -46,15 +51,22 @@ def _shade(ax: Axes, x: np.ndarray, mask: np.ndarray, color: str = _STABLE_GREEN
         ax.axvspan(lo, hi, color=color, lw=0, zorder=0, alpha=alpha)
 
 
-def _nontrivial(frame) -> np.ndarray:  # noqa: ANN001
-    """|lambda| per point with the ``n_trivial`` values closest to 1 removed."""
+def _split_trivial(frame) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001
+    """|lambda| per point: the non-trivial ones (the ``n_trivial`` values closest to 1
+    removed) and the trivial ones (the removed values, NaN elsewhere)."""
     mags = frame[[f"abs_lambda_{j}" for j in range(1, 6)]].to_numpy(float).copy()
+    trivial = np.full_like(mags, np.nan)
     for i, n in enumerate(frame["n_trivial"].to_numpy(int)):
         for _ in range(n):
             k = np.nanargmin(np.abs(mags[i] - 1.0)) if np.isfinite(mags[i]).any() else None
             if k is not None:
-                mags[i, k] = np.nan
-    return mags
+                trivial[i, k], mags[i, k] = mags[i, k], np.nan
+    return mags, trivial
+
+
+def _nontrivial(frame) -> np.ndarray:  # noqa: ANN001
+    """|lambda| per point with the ``n_trivial`` values closest to 1 removed."""
+    return _split_trivial(frame)[0]
 
 
 def _fig(ax: Axes | None, size: tuple[float, float]) -> tuple[Figure, Axes]:
@@ -64,34 +76,55 @@ def _fig(ax: Axes | None, size: tuple[float, float]) -> tuple[Figure, Axes]:
     return ax.figure, ax  # type: ignore[return-value]
 
 
+def _xlim(ax: Axes, result: StudyResult) -> None:
+    """The study's whole swept range (the same on every panel of a figure pair)."""
+    values = np.asarray(result.spec.axes[-1].values, float)
+    lo, hi = float(values.min()), float(values.max())
+    pad = 0.03 * (hi - lo) if hi > lo else 0.5
+    ax.set_xlim(lo - pad, hi + pad)
+
+
 def plot_study_multipliers(result: StudyResult, ax: Axes | None = None, *,
                            title: str | None = None) -> Figure:
-    """Non-trivial ``|lambda|`` against the swept parameter; stable domain green."""
+    """``|lambda|`` against the swept parameter; the stable domain green.
+
+    The non-trivial multipliers as dots; the trivial ones (the energy
+    multiplier 1 of a conservative gait, :func:`tslip.gait.floquet`) as open
+    grey circles, so that a gait whose energy mode stops being trivial (leg
+    damping, Figure 4.12) is compared with its undamped neighbour's 1.
+    """
     fig, ax = _fig(ax, (6.4, 3.4))
     f = result.frame
     param = result.spec.axes[-1].param
     x = f[param].to_numpy(float)
     _shade(ax, x, _stable(f))
-    mags = _nontrivial(f)
+    mags, trivial = _split_trivial(f)
     for k in range(mags.shape[1]):
-        ax.plot(x, mags[:, k], "o", ms=3, color="C0", label="|λ| (non-trivial)" if k == 0 else None)
+        ax.plot(x, mags[:, k], "o", ms=3, color="C0",
+                label=f"{_LAMBDA} non-trivial" if k == 0 else None)
+    if np.isfinite(trivial).any():
+        ax.plot(np.repeat(x, trivial.shape[1]), trivial.ravel(), "o", ms=7, mfc="none",
+                mec="k", mew=0.8, zorder=3, label=f"{_LAMBDA} trivial (energy)")
     none = ~f["converged"].to_numpy(bool)
     if none.any():
         ax.plot(x[none], np.zeros(none.sum()), "x", color="C3", ms=4, label="no periodic gait")
     ax.axhline(1.0, color="k", ls="--", lw=0.8)
+    ax.fill_between([], [], color=_STABLE_GREEN, label="stable domain")  # legend entry only
     top = np.nanmax(mags) if np.isfinite(mags).any() else 1.5
     ax.set_ylim(0, min(max(1.5, top * 1.05), 3.0))
+    _xlim(ax, result)
     ax.set_xlabel(param_label(param))
-    ax.set_ylabel("|λ| [-]")
-    ax.legend(loc="upper right", fontsize=7)
-    ax.set_title(title or f"{result.spec.name}: Floquet multipliers (green: stable)", fontsize=9)
+    ax.set_ylabel(f"{_LAMBDA} [-]")
+    ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize=7, frameon=False)
+    ax.set_title(title or f"Floquet multipliers: {result.spec.description}", fontsize=9)
     return fig
 
 
 def plot_study_robustness(result: StudyResult, axes: Sequence[Axes] | None = None, *,
                           label: str | None = None, color: str = "C0",
-                          shade: bool = True) -> Figure:
-    """The three robustness limits (step-down, push, pitch rate) against the parameter."""
+                          shade: bool = True, title: str | None = None) -> Figure:
+    """The three robustness limits (step-down, push, pitch rate) against the parameter,
+    over the study's whole swept range (as its multipliers panel)."""
     if axes is None:
         fig = Figure(figsize=(6.4, 6.0), layout="constrained")
         axes = list(fig.subplots(3, 1, sharex=True))
@@ -106,9 +139,13 @@ def plot_study_robustness(result: StudyResult, axes: Sequence[Axes] | None = Non
         a.plot(x, f[col].to_numpy(float) if col in f else np.full(len(x), np.nan), "o-",
                ms=3, lw=1, color=color, label=label)
         a.set_ylabel(ylabel, fontsize=8)
+        _xlim(a, result)
     axes[-1].set_xlabel(param_label(param))
-    if label:
-        axes[0].legend(fontsize=7)
+    if label:  # one of several studies on these axes: a legend above them, no title
+        axes[0].legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), ncols=4, fontsize=7,
+                       frameon=False)
+    else:
+        axes[0].set_title(title or f"Robustness: {result.spec.description}", fontsize=9)
     return fig
 
 
@@ -132,7 +169,7 @@ def plot_stable_grid(results: Mapping[float, StudyResult]) -> Figure:
         grid = code.reshape(res.spec.shape)
         k, b = res.spec.axes[0].values, res.spec.axes[1].values
         a.pcolormesh(b, k, grid, cmap=cmap, vmin=0, vmax=2, shading="nearest")
-        a.set_title(f"v0 = {v:g}: stable {np.mean(grid == 2):.0%}", fontsize=9)
+        a.set_title(f"$v_0$ = {v:g}: stable {np.mean(grid == 2):.0%}", fontsize=9)
         a.set_xlabel(param_label(res.spec.axes[1].param))
         a.set_ylabel(param_label(res.spec.axes[0].param))
     fig.legend(handles=[Patch(facecolor=c, edgecolor="0.4", lw=0.5, label=t)
@@ -156,7 +193,8 @@ def plot_stable_region(region: StableRegion, ax: Axes | None = None) -> Figure:
     a.set(xlabel=param_label(region.names[1]), ylabel=param_label(region.names[0]),
           title=f"energy {region.energy:g} MgL: stable {np.mean(code == 2):.0%}")
     a.legend(handles=[Patch(facecolor=c, edgecolor="0.4", lw=0.5, label=t)
-                      for c, t in GRID_CLASSES], fontsize=7, loc="best")
+                      for c, t in GRID_CLASSES], fontsize=7, loc="center left",
+             bbox_to_anchor=(1.01, 0.5), frameon=False)  # beside the grid, never on it
     return fig
 
 
@@ -169,15 +207,15 @@ def plot_stride_times(results: Mapping[str, StudyResult]) -> Figure:
         f = res.frame
         param = res.spec.axes[-1].param
         x = f[param].to_numpy(float)
-        for i, (col, lab, eq) in enumerate((("stance_time", "t_s", "3.10"),
-                                            ("flight_time", "t_f", "3.11"))):
+        for i, (col, lab, eq) in enumerate((("stance_time", "$t_s$", "3.10"),
+                                            ("flight_time", "$t_f$", "3.11"))):
             a = axes[i, j]
             a.plot(x, f[col], "o", ms=3, label=f"{lab} model")
             pred = f.get(f"{col}_predicted")
             if pred is not None:
                 a.plot(x, pred, "-", color="C1", label=f"{lab} eq. {eq}")
             a.set_xlabel(param_label(param))
-            a.set_ylabel(f"{lab} [g^-1/2 L^1/2]")
+            a.set_ylabel(axis_label(lab, UNIT["time"]))
             a.legend(fontsize=7)
     return fig
 

@@ -17,6 +17,8 @@ from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
+from ..model.units import UNIT
+from .notation import axis_label
 from .sweeps import _STABLE_GREEN, param_label
 
 if TYPE_CHECKING:
@@ -24,8 +26,9 @@ if TYPE_CHECKING:
 
 __all__ = ["plot_viability", "plot_basin"]
 
-_LABELS = {"y": "apex height y [L]", "phi": "apex pitch φ [rad]",
-           "phid": "apex pitch rate φ̇ [rad g^1/2 L^-1/2]"}
+_LABELS = {"y": axis_label("apex height $y$", UNIT["length"]),
+           "phi": axis_label(r"apex pitch $\phi$", UNIT["angle"]),
+           "phid": axis_label(r"apex pitch rate $\dot{\phi}$", UNIT["angular_velocity"])}
 _CELLS = ListedColormap(["#8c8c8c", "#f2d0a4", _STABLE_GREEN])
 
 
@@ -67,7 +70,8 @@ def plot_viability(result: Viability, ax: Axes | None = None) -> Figure:
         ax.set_ylabel(_label(m.names[0]))
         kinds = ("fails at once", "not viable (fails later or leaves the grid)", "viable")
         ax.legend(handles=[Patch(color=_CELLS(i), label=t) for i, t in enumerate(kinds)],
-                  loc="upper right", fontsize=8)
+                  loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=3, fontsize=8,
+                  frameon=False)  # below the cells, never on them
     else:
         share = np.where(result.s, result.q.mean(axis=-1), np.nan)
         mesh = ax.pcolormesh(_edges(m.grid[1]), _edges(m.grid[0]), share, cmap="Greens",
