@@ -54,11 +54,8 @@ def tree(tmp_path, monkeypatch):
 
 
 def _edit(path: Path) -> None:
-    """Change a line of code in place (same number of lines)."""
-    text, n = re.subn(r"^(from .*|import .*)$", r"\1  # an edit", path.read_text(), count=1,
-                      flags=re.MULTILINE)
-    assert n == 1
-    path.write_text(text)
+    """Change the code in place (a statement: comments and docstrings do not count)."""
+    path.write_text(path.read_text() + "\n_AN_EDIT = 1\n")
 
 
 def _keys() -> dict[str, str]:
