@@ -26,12 +26,11 @@ import pytest
 from scipy.optimize import brentq
 
 import tslip
+from simulation.test_reference import ref_stance_end  # tests/ is on pytest's path
 from tslip.gait.section import ApexState, apex_map, apex_map_batch, apex_map_states
 from tslip.gait.viability import state_action_map
 from tslip.simulation.integrate import step_batch
 from tslip.simulation.result import Status
-
-from simulation.test_reference import ref_stance_end  # tests/ is on pytest's path
 
 TIGHT = tslip.IntegratorOptions.tight("dop853")
 EPS = 1e-9  # a state this close to a status boundary is excluded (and counted)
