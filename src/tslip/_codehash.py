@@ -96,10 +96,38 @@ def _provider(package: str, name: str) -> str:
     return f"{package}:self"
 
 
+def _is_docstring(node: ast.stmt) -> bool:
+    return (isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
+            and isinstance(node.value.value, str))
+
+
+def _is_version(node: ast.stmt) -> bool:
+    return (isinstance(node, ast.Assign)
+            and any(isinstance(t, ast.Name) and t.id == "__version__" for t in node.targets))
+
+
+@functools.cache
+def _tree(path: Path) -> ast.Module:
+    """The syntax tree of the source file ``path``, parsed once, without what computes nothing.
+
+    The docstrings of the module, its classes and functions are dropped, and a
+    module-level ``__version__ = ...`` (see the module docstring). The import
+    scans and :func:`module_digest` share this one parse (parsing is most of
+    the hash's cost).
+    """
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    tree.body = [n for n in tree.body if not _is_version(n)]
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+            if node.body and _is_docstring(node.body[0]):
+                node.body = node.body[1:]
+    return tree
+
+
 @functools.cache
 def _nodes(path: Path) -> tuple[ast.AST, ...]:
-    """Every node of the source file ``path``'s syntax tree (``ast.walk`` order), parsed once."""
-    return tuple(ast.walk(ast.parse(path.read_text(encoding="utf-8"))))
+    """Every node of :func:`_tree` of ``path`` (``ast.walk`` order)."""
+    return tuple(ast.walk(_tree(path)))
 
 
 def _plot_imports(nodes: tuple[ast.AST, ...]) -> set[int]:
@@ -189,16 +217,6 @@ def _version(lib: str) -> str:
         return "absent"
 
 
-def _is_docstring(node: ast.stmt) -> bool:
-    return (isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
-            and isinstance(node.value.value, str))
-
-
-def _is_version(node: ast.stmt) -> bool:
-    return (isinstance(node, ast.Assign)
-            and any(isinstance(t, ast.Name) and t.id == "__version__" for t in node.targets))
-
-
 @functools.cache
 def module_digest(module: str) -> str:
     """SHA-256 (hex) of a ``tslip`` module's code: its syntax tree without docstrings.
@@ -212,13 +230,7 @@ def module_digest(module: str) -> str:
     path = _file(module.removesuffix(":self"))
     if path is None:
         raise ValueError(f"not a tslip module: {module}")
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    tree.body = [n for n in tree.body if not _is_version(n)]
-    for node in ast.walk(tree):
-        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
-            if node.body and _is_docstring(node.body[0]):
-                node.body = node.body[1:]
-    return hashlib.sha256(ast.dump(tree).encode()).hexdigest()
+    return hashlib.sha256(ast.dump(_tree(path)).encode()).hexdigest()
 
 
 @functools.cache
@@ -240,5 +252,5 @@ def code_hash(*modules: str) -> str:
 
 def cache_clear() -> None:
     """Forget every scan and hash of this process (for a caller that edits sources)."""
-    for f in (_nodes, _provider, _imports, module_closure, module_digest, code_hash):
+    for f in (_tree, _nodes, _provider, _imports, module_closure, module_digest, code_hash):
         f.cache_clear()
