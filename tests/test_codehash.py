@@ -2,6 +2,7 @@
 
 import shutil
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
@@ -49,18 +50,18 @@ def test_an_edit_changes_exactly_the_hashes_that_depend_on_it(tmp_path, monkeypa
 
     before = hashes()
     f = root / "gait" / "robustness.py"
-    f.write_text(f.read_text() + "\n# an edit\n")
+    f.write_text(f.read_text() + "\n_EDIT = 1\n")
     after = hashes()
     assert after["tslip.gait.robustness"] != before["tslip.gait.robustness"]
     assert after["tslip.gait.stability"] == before["tslip.gait.stability"]
     assert after["tslip.biped.simulate"] == before["tslip.biped.simulate"]
     k = root / "simulation" / "_kernels.py"
-    k.write_text(k.read_text() + "\n# a kernel edit\n")
+    k.write_text(k.read_text() + "\n_EDIT = 1\n")
     again = hashes()
     assert again["tslip.gait.stability"] != after["tslip.gait.stability"]
     assert again["tslip.biped.simulate"] == after["tslip.biped.simulate"]
     k = root / "simulation" / "_rk.py"  # the integrator core every kernel shares
-    k.write_text(k.read_text() + "\n# a kernel edit\n")
+    k.write_text(k.read_text() + "\n_EDIT = 1\n")
     core = hashes()
     assert all(core[m] != again[m] for m in core)
     # an added import is followed once the scans are forgotten (they are kept a process)
@@ -93,3 +94,74 @@ def test_a_plot_method_importing_plotting_is_not_followed(tmp_path, monkeypatch)
         assert {"tslip.gait.b", "tslip.plotting.fig"} <= set(ch.module_closure("tslip.gait.c"))
     finally:
         ch.cache_clear()
+
+
+_MODULE = '''"""A module docstring."""
+
+# a comment
+RATE = 1.5
+
+
+class Law:
+    """A class docstring."""
+
+    def f(self, x):
+        """A method docstring."""
+        return RATE * x  # why
+'''
+
+
+@pytest.mark.parametrize("edit, rekeys", [
+    (lambda s: s.replace("# a comment", "# another comment"), False),
+    (lambda s: s.replace("# why", ""), False),
+    (lambda s: s.replace("A module docstring.", "Reworded."), False),
+    (lambda s: s.replace('    """A class docstring."""\n\n', ""), False),
+    (lambda s: s.replace('"""A method docstring."""', ""), False),
+    (lambda s: s.replace("RATE = 1.5", "\n\nRATE = (\n    1.5)"), False),  # layout only
+    (lambda s: s.replace("RATE = 1.5", "RATE = 1.25"), True),  # a changed constant
+    (lambda s: s.replace("RATE * x", "x * RATE"), True),
+    (lambda s: s.replace("A method docstring.", "Reworded,\n        over two lines."), False),
+    (lambda s: s + "\nSTRING = 'a string constant, not a docstring'\n", True),
+])
+def test_only_what_can_change_a_number_rekeys(tmp_path, monkeypatch, edit, rekeys):
+    """A comment, a docstring or layout keeps the hash; a changed constant or statement does not."""
+    root = tmp_path / "tslip"
+    (root / "gait").mkdir(parents=True)
+    (root / "__init__.py").write_text('__version__ = "0.1.0"\n')
+    (root / "gait" / "__init__.py").write_text("")
+    (root / "gait" / "b.py").write_text(_MODULE)
+    (root / "gait" / "a.py").write_text("from .b import Law\n")  # b reached through the closure
+    monkeypatch.setattr(ch, "_ROOT", root)
+
+    def key():
+        ch.cache_clear()
+        return ch.code_hash("tslip.gait.a")
+
+    try:
+        before = key()
+        edited = edit(_MODULE)
+        assert edited != _MODULE
+        (root / "gait" / "b.py").write_text(edited)
+        assert (key() != before) is rekeys
+    finally:
+        ch.cache_clear()
+
+
+def test_the_key_holds_python_and_each_numerical_library(monkeypatch):
+    """Python's version (the trees' dump differs between versions) and each library's re-key."""
+    ch.cache_clear()
+    before = ch.code_hash("tslip.gait.stability")
+    real = ch._version
+    # listed here, not read from ch.LIBRARIES: dropping one from the hash must fail
+    for lib in ("numpy", "scipy", "numba", "llvmlite", "cma"):
+        monkeypatch.setattr(ch, "_version", lambda name, lib=lib: "0.0" if name == lib
+                            else real(name))
+        ch.cache_clear()
+        assert ch.code_hash("tslip.gait.stability") != before, lib
+    monkeypatch.setattr(ch, "_version", real)
+    monkeypatch.setattr(ch, "sys", SimpleNamespace(version_info=(3, 99, 0)))
+    ch.cache_clear()
+    assert ch.code_hash("tslip.gait.stability") != before, "python"
+    monkeypatch.undo()
+    ch.cache_clear()
+    assert ch.code_hash("tslip.gait.stability") == before

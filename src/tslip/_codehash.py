@@ -4,18 +4,25 @@ A cached result is valid while the code that produced it is unchanged. That
 code is a module and everything it imports from ``tslip``, found here by
 reading the import statements of the sources (``ast``, nothing is
 imported): :func:`module_closure` follows them transitively, and
-:func:`code_hash` hashes those files together with the versions of the
-numerical libraries they call. So an edit to :mod:`tslip.gait.robustness`
-invalidates the cached points that ran a robustness analysis and no others,
-and an edit to the biped leaves every TSLIP study cached.
+:func:`code_hash` hashes those modules' code together with the versions of
+Python and of the numerical libraries they call. So an edit to
+:mod:`tslip.gait.robustness` invalidates the cached points that ran a
+robustness analysis and no others, and an edit to the biped leaves every
+TSLIP study cached.
+
+What is hashed is what can change a number: each module's syntax tree
+without its docstrings (:func:`module_digest`), so a comment, a docstring or
+a reformatted line keeps every cached result, while a changed constant or
+statement recomputes them. The tree's dump differs between Python versions,
+and so may results: Python's major.minor version is in the key.
 
 Imports inside functions count too (they run when the function does). A
 ``from package import name`` counts ``package/name.py`` when that file
 exists, else the module the package's ``__init__`` takes ``name`` from, else
 the ``__init__``'s own source (for a name it defines, like ``__version__``).
 
-The version string is a label, not code: a ``__version__ = ...`` line is
-left out of the hashed sources, so a release that only bumps the version
+The version string is a label, not code: a module-level ``__version__ = ...``
+is left out of the hashed trees, so a release that only bumps the version
 keeps every cached result, while any other edit (the same file's included)
 recomputes them.
 """
@@ -25,17 +32,14 @@ from __future__ import annotations
 import ast
 import functools
 import hashlib
-import re
+import sys
 from importlib import metadata
 from pathlib import Path
 
-__all__ = ["module_closure", "code_hash", "cache_clear"]
+__all__ = ["module_closure", "module_digest", "code_hash", "cache_clear"]
 
 _ROOT = Path(__file__).parent
 _PKG = "tslip"
-
-#: A module-level ``__version__ = ...`` line: not part of the hashed source.
-_VERSION_LINE = re.compile(rb"^__version__\s*=.*$", re.MULTILINE)
 
 #: Third-party libraries whose version can change a computed number.
 LIBRARIES: tuple[str, ...] = ("numpy", "scipy", "numba", "llvmlite", "cma")
@@ -92,10 +96,38 @@ def _provider(package: str, name: str) -> str:
     return f"{package}:self"
 
 
+def _is_docstring(node: ast.stmt) -> bool:
+    return (isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
+            and isinstance(node.value.value, str))
+
+
+def _is_version(node: ast.stmt) -> bool:
+    return (isinstance(node, ast.Assign)
+            and any(isinstance(t, ast.Name) and t.id == "__version__" for t in node.targets))
+
+
+@functools.cache
+def _tree(path: Path) -> ast.Module:
+    """The syntax tree of the source file ``path``, parsed once, without what computes nothing.
+
+    The docstrings of the module, its classes and functions are dropped, and a
+    module-level ``__version__ = ...`` (see the module docstring). The import
+    scans and :func:`module_digest` share this one parse (parsing is most of
+    the hash's cost).
+    """
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    tree.body = [n for n in tree.body if not _is_version(n)]
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+            if node.body and _is_docstring(node.body[0]):
+                node.body = node.body[1:]
+    return tree
+
+
 @functools.cache
 def _nodes(path: Path) -> tuple[ast.AST, ...]:
-    """Every node of the source file ``path``'s syntax tree (``ast.walk`` order), parsed once."""
-    return tuple(ast.walk(ast.parse(path.read_text(encoding="utf-8"))))
+    """Every node of :func:`_tree` of ``path`` (``ast.walk`` order)."""
+    return tuple(ast.walk(_tree(path)))
 
 
 def _plot_imports(nodes: tuple[ast.AST, ...]) -> set[int]:
@@ -186,23 +218,39 @@ def _version(lib: str) -> str:
 
 
 @functools.cache
-def code_hash(*modules: str) -> str:
-    """SHA-256 (hex, 24 characters) of the sources of ``module_closure(*modules)``.
+def module_digest(module: str) -> str:
+    """SHA-256 (hex) of a ``tslip`` module's code: its syntax tree without docstrings.
 
-    The versions of :data:`LIBRARIES` are part of the hash. Computed once a
-    process per set of modules.
+    Comments and layout never reach the tree; the docstrings of the module,
+    its classes and functions are dropped from it, and so is a module-level
+    ``__version__ = ...``. ``ast.dump`` leaves out line and column numbers, so
+    moving code by a line changes nothing. A leaf ``"<package>:self"`` is
+    its ``__init__``'s code.
     """
-    h = hashlib.sha256()
+    path = _file(module.removesuffix(":self"))
+    if path is None:
+        raise ValueError(f"not a tslip module: {module}")
+    return hashlib.sha256(ast.dump(_tree(path)).encode()).hexdigest()
+
+
+@functools.cache
+def code_hash(*modules: str) -> str:
+    """SHA-256 (hex, 24 characters) of the code of ``module_closure(*modules)``.
+
+    Each module by :func:`module_digest`; Python's major.minor version (the
+    trees' dump differs between versions) and the versions of
+    :data:`LIBRARIES` are part of the hash. Computed once a process per set
+    of modules.
+    """
+    h = hashlib.sha256(f"python={sys.version_info[0]}.{sys.version_info[1]}\n".encode())
     for lib in LIBRARIES:
         h.update(f"{lib}={_version(lib)}\n".encode())
     for m in module_closure(*modules):
-        h.update(m.encode() + b"\n")
-        source = _file(m.removesuffix(":self")).read_bytes()  # type: ignore[union-attr]
-        h.update(_VERSION_LINE.sub(b"", source))
+        h.update(f"{m}\n{module_digest(m)}\n".encode())
     return h.hexdigest()[:24]
 
 
 def cache_clear() -> None:
     """Forget every scan and hash of this process (for a caller that edits sources)."""
-    for f in (_nodes, _provider, _imports, module_closure, code_hash):
+    for f in (_tree, _nodes, _provider, _imports, module_closure, module_digest, code_hash):
         f.cache_clear()

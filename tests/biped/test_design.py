@@ -96,8 +96,9 @@ def test_optimised_gait_outlasts_the_tslip_limits(kind, tslip_limit):
     past the limits of the Table 6.1 TSLIP (Section 6.1: step-down -0.12 L, push
     -0.73, pitch rate -1.50; this package measures -0.119, -0.725, -0.733). The
     limit the file records (bisection by `tslip biped report --robustness`:
-    -0.1625, -0.8237, -3.2556) is recomputed to 3 %: the gait survives 0.97 of it
-    and falls at 1.03 of it."""
+    -0.1625, -0.8237, -3.2556; regression pins, this package's own output) is
+    recomputed to 3 %: the gait survives 0.97 of it and falls at 1.03 of it. The
+    independent source is the thesis's TSLIP limit, which the biped must exceed."""
     from tslip.biped.gait import survives_disturbance
 
     data, p, z = _load("optimised")

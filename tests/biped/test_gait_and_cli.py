@@ -84,8 +84,9 @@ def test_cli_report_loads_a_gait_file(tmp_path):
                                  str(tmp_path), "-n", "3"])
     assert r.exit_code == 0, r.output
     assert "strides until fall: 3" in r.output
-    # the multiplier the file records (0.1007, from the optimiser's integration) to the
-    # 3 decimals printed; the events-based integrator gives 0.10047 at 1e-11 to 1e-13
+    # regression pin: the multiplier the file records (0.1007, the optimiser's own
+    # integration; no independent source) to the 3 decimals printed; the events-based
+    # integrator gives 0.10047 at 1e-11 to 1e-13
     printed = float(re.search(r"largest multiplier (\d+\.\d+)", r.output).group(1))
     recorded = json.loads(Path(gait).read_text())["largest_multiplier"]
     assert printed == pytest.approx(recorded, abs=1.5e-3)
@@ -119,7 +120,9 @@ def test_stored_gaits_load_by_name_and_bad_sources_are_one_line(tmp_path):
 def test_cli_report_robustness_finds_the_limits_the_gait_file_records(tmp_path):
     """`--robustness` searches with the shared robustness_report; the optimised gait's
     file records the limits an earlier bisection found (-0.1625, -0.8237, -3.2556), which
-    the search must find again to the 3 % of test_design (the integrator changed since)."""
+    the search must find again to the 3 % of test_design (the integrator changed since).
+    Regression pins: the file's values are this package's own output; test_design checks
+    them against the independent bound, the thesis's TSLIP limits (Section 6.1)."""
     gait = str(gait_path("optimised"))
     r = CliRunner().invoke(app, ["biped", "report", "--gait", gait, "--out-dir",
                                  str(tmp_path), "-n", "2", "--robustness"])

@@ -67,6 +67,8 @@ def test_floquet_stays_on_the_section():
     z_off[0] += 1e-3  # off the section: floquet puts it back first
     fr = floquet(p, z_off, eps=1e-4)
     assert fr.z[0] == pytest.approx(z[0], abs=1e-9)
+    # regression pin (this package's value at the stored gait; no independent source:
+    # the thesis prints no multiplier for it). The section check above is the point.
     assert fr.max_nontrivial == pytest.approx(0.788, abs=2e-3)
 
 

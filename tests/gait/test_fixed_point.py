@@ -59,3 +59,25 @@ def test_overrides_and_bad_guess():
     assert g.converged and g.params.v0 == 4.0 and g.state.beta == 1.1
     with pytest.raises(ValueError, match="guess must have 4 entries"):
         tslip.find_gait(tslip.preset("table2.1"), guess=np.zeros(3))
+
+
+@pytest.mark.parametrize("preset", ["slip", "slip-human"])
+def test_the_old_full_guess_at_r0_warns_and_finds_the_same_gait(preset):
+    """At r = 0 the pitch is held (docs/conventions.md, 'Held pitch'): the guess is
+    (delta, alpha_r). The form before 0.4, (delta, phi, phid, alpha_r), still works for
+    one release, naming the new form in a DeprecationWarning."""
+    p = tslip.preset(preset)
+    g = tslip.find_gait(p)
+    assert g.converged
+    new = np.array([g.state.delta, g.params.alpha_r]) + [0.01, -0.01]
+    old = np.array([new[0], 0.0, 0.0, new[1]])
+    with pytest.warns(DeprecationWarning, match=r"at r = 0 the guess is \(delta, alpha_r\); "
+                      r"phi and phid are held \(docs/conventions.md, 'Held pitch'\)"):
+        from_old = tslip.find_gait(p, guess=old)
+    from_new = tslip.find_gait(p, guess=new)
+    assert from_old.converged and from_new.converged
+    assert from_old.state == from_new.state and from_old.params == from_new.params
+    assert from_new.state.delta == pytest.approx(g.state.delta, abs=1e-9)
+    # neither form is the wrong length: a 3-entry guess is still refused, in one line
+    with pytest.raises(ValueError, match=r"guess must have 2 entries \['delta', 'alpha_r'\]"):
+        tslip.find_gait(p, guess=old[:3])

@@ -318,8 +318,10 @@ def test_apex_clock_stability_boundaries_are_twice_the_liftoff_ones():
 def test_default_liftoff_clock_is_bit_identical_to_main():
     """A Table 6.1 stride and its exact Jacobian, as computed by main at 0285a37.
 
-    The pins are that revision's output (float.hex), so any change to the
+    Regression pins: that revision's output (float.hex), so any change to the
     default arithmetic shows; a deliberate numerical change must re-pin them.
+    The independent check of the same map is beside it:
+    tests/simulation/test_reference.py (scipy DOP853 at 1e-12, to 1e-8).
     """
     p = tslip.preset("table6.1")
     assert p.retraction == "liftoff"

@@ -41,6 +41,7 @@ import dataclasses
 import itertools
 import math
 import time
+import warnings
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal
@@ -438,6 +439,26 @@ def _cma_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float, seed:
                       report)
 
 
+def _held_pitch_guess(prob: GaitProblem, z0: np.ndarray) -> np.ndarray:
+    """A guess of the form before the pitch was held at ``r = 0``, without the held entries.
+
+    Until 0.3 a guess was always ``(delta, phi, phid, alpha_r[, reference])``;
+    at ``r = 0`` the search now holds ``phi`` (and ``phid`` without hip torque;
+    docs/conventions.md, "Held pitch"). The old form is accepted, with a
+    ``DeprecationWarning``, until 0.5.
+    """
+    full = ("delta", "phi", "phid", *prob.names[prob.names.index("alpha_r"):])
+    if z0.ndim != 1 or z0.size == prob.size or z0.size != len(full):
+        return z0
+    held = [n for n in full if n not in prob.names]
+    warnings.warn(
+        f"at r = 0 the guess is ({', '.join(prob.names)}); {' and '.join(held)} "
+        f"{'is' if len(held) == 1 else 'are'} held (docs/conventions.md, 'Held pitch'). "
+        f"A guess of {len(full)} entries ({', '.join(full)}) is deprecated and refused "
+        "from 0.5", DeprecationWarning, stacklevel=3)
+    return np.array([v for n, v in zip(full, z0) if n in prob.names])
+
+
 def find_gait(
     params: Params,
     *,
@@ -475,8 +496,11 @@ def find_gait(
         With ``fix="speed"``, ``v0`` is the touch-down speed or the apex's
         forward speed. Also the default section of the gait's Floquet multipliers.
     guess : ndarray, optional
-        Starting unknowns ``(delta, phi, phid, alpha_r[, alphad_ref | tau_c])``;
-        by default the automatic guesses of :meth:`GaitProblem.guesses`.
+        Starting unknowns ``(delta, phi, phid, alpha_r[, alphad_ref | tau_c])``
+        (``GaitProblem.names``: at ``r = 0`` without ``phi``, and without
+        ``phid`` when no hip torque acts, docs/conventions.md "Held pitch";
+        the full form still works there, with a ``DeprecationWarning``, until
+        0.5); by default the automatic guesses of :meth:`GaitProblem.guesses`.
     tol : float
         Max-norm residual for ``converged``.
     options : IntegratorOptions, optional
@@ -536,7 +560,7 @@ def find_gait(
         )
     prob = GaitProblem.from_params(params, options, fix=fix, section=section, energy=energy)
     if guess is not None:
-        z0 = np.asarray(guess, dtype=float)
+        z0 = _held_pitch_guess(prob, np.asarray(guess, dtype=float))
         if z0.shape != (prob.size,):
             raise ValueError(f"guess must have {prob.size} entries {list(prob.names)}, "
                              f"got {z0.size}")

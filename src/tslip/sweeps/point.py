@@ -35,19 +35,17 @@ analysis, and only those.
 from __future__ import annotations
 
 import functools
-import hashlib
 import json
 import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 
-from .._codehash import code_hash
+from .._codehash import code_hash, module_digest
 from ..gait.continuation import _solve_point, get_param
 from ..gait.fixed_point import Gait, GaitProblem, find_gait
 from ..gait.robustness import KINDS, robustness_report
@@ -57,7 +55,7 @@ from ..model.parameters import Params
 from .spec import StudySpec
 
 __all__ = ["CODE", "MAX_FAILURES", "Pending", "Solved", "analyse_point", "code_version",
-           "seeds_from_records", "solve_gaits", "solve_line"]
+           "floquet_tol", "gait_tol", "seeds_from_records", "solve_gaits", "solve_line"]
 
 #: The modules whose code computes a point, by analysis (``None``: every
 #: point). Their import closures are hashed by :func:`code_version`; a test
@@ -79,15 +77,24 @@ UNKNOWNS = ("delta", "phi", "phid", "alpha_r", "alphad_ref", "tau_c")
 Emit = Callable[[int, dict[str, Any]], None]
 
 
-@functools.cache
-def _own_source() -> str:
-    return hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:24]
-
-
 def code_version(analyses: Sequence[str]) -> str:
     """Hash of the code computing a point with ``analyses`` (this module included)."""
     mods = CODE[None] + tuple(m for a in sorted(set(analyses)) for m in CODE[a])
-    return f"{code_hash(*mods)}-{_own_source()}"
+    return f"{code_hash(*mods)}-{module_digest(__name__)[:24]}"
+
+
+def gait_tol(spec: StudySpec) -> float:
+    """The gait search's tolerance of a study: ``spec.meta["tol"]``, else 1e-10.
+
+    The global PD controller has no exact fixed point (docs/conventions.md),
+    so its studies accept a larger residual.
+    """
+    return float(spec.meta.get("tol", 1e-10))
+
+
+def floquet_tol(spec: StudySpec) -> float:
+    """The band around 1 of a study's trivial Floquet multipliers: ``spec.meta``'s, else 1e-6."""
+    return float(spec.meta.get("neutral_tol", 1e-6))
 
 
 def _num(x: Any) -> float:
@@ -133,8 +140,8 @@ class _Line:
         self.params = spec.params_at(assignment)
         self.values = np.sort(np.asarray(values, dtype=float))
         n = len(self.values)
-        self.tol = float(spec.meta.get("tol", 1e-10))  # global PD has no exact fixed point
-        self.neutral_tol = float(spec.meta.get("neutral_tol", 1e-6))
+        self.tol = gait_tol(spec)
+        self.neutral_tol = floquet_tol(spec)
         self.emit = emit
         self.cached = {i: cached[float(v)] for i, v in enumerate(self.values)
                        if float(v) in cached}
@@ -339,7 +346,7 @@ def analyse_point(spec: StudySpec, item: Pending, neutral_tol: float | None = No
                   ) -> dict[str, Any]:
     """The record of one solved point (exactly what the cache holds)."""
     if neutral_tol is None:
-        neutral_tol = float(spec.meta.get("neutral_tol", 1e-6))
+        neutral_tol = floquet_tol(spec)
     t0 = time.perf_counter()
     rec = _analyse(spec, item.point, item.gait, item.residual, item.message, neutral_tol)
     rec["seconds"] = item.seconds + time.perf_counter() - t0

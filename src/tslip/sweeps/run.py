@@ -9,9 +9,12 @@ processes (:mod:`tslip.sweeps._pool`; as many as the work pays for, up to
 all cores, unless ``workers`` is given), or on a Dask cluster given its
 address. Each point is written to ``cache/`` the moment it is final,
 atomically, by the process that computed it, and the progress callback
-advances with it. The cache key is a hash of the study's
-base parameters, the point's axis values, the analyses and the code that
-computes them (:func:`tslip.sweeps.point.code_version`), so
+advances with it. The cache key is a hash of everything that can change a
+point's numbers: the study's base parameters, its axes (every value: the
+resolution), the point's axis values, the analyses, the gait and Floquet
+tolerances, the strides of a robustness run, and the code that computes
+them with the versions of Python and the numerical libraries
+(:func:`tslip.sweeps.point.code_version`), so
 
 * an interrupted study resumes with only the missing points, and ends
   bit-identical to an uninterrupted run (a line replays its cached points),
@@ -49,7 +52,16 @@ from ..model.units import COLUMN_UNITS, UNIT, param_unit
 from . import _pool
 from ._lock import folder_lock
 from ._schedule import Task, choose_workers, run_tasks
-from .point import Pending, Solved, analyse_point, code_version, seeds_from_records, solve_gaits
+from .point import (
+    Pending,
+    Solved,
+    analyse_point,
+    code_version,
+    floquet_tol,
+    gait_tol,
+    seeds_from_records,
+    solve_gaits,
+)
 from .spec import StudySpec
 
 if TYPE_CHECKING:
@@ -78,14 +90,14 @@ def _key_prefix(spec: StudySpec) -> Any:
     payload: dict[str, Any] = {
         "code": code_version(spec.analyses),
         "base": spec.base.to_dict(),
-        "axes": [a.param for a in spec.axes],
+        # every axis's values, not only the point's: the continuation seeds a point
+        # from its neighbours, so another resolution can converge elsewhere within tol
+        "axes": [[a.param, sorted(a.values)] for a in spec.axes],
         "analyses": sorted(spec.analyses),
         "n_steps": spec.n_steps if "robustness" in spec.analyses else None,
+        "tol": gait_tol(spec),
+        "neutral_tol": floquet_tol(spec),
     }
-    if "tol" in spec.meta:  # a non-default gait tolerance (e.g. global PD) changes results
-        payload["tol"] = float(spec.meta["tol"])
-    if "neutral_tol" in spec.meta:
-        payload["neutral_tol"] = float(spec.meta["neutral_tol"])
     return hashlib.sha256(json.dumps(payload, sort_keys=True, default=float).encode())
 
 
@@ -458,7 +470,7 @@ class StudyJob:
             "study": spec.to_dict(), "points": self.n_total,
             "computed": self.n_total - self.n_cached, "cached": self.n_cached,
             "seconds": time.perf_counter() - self.t_start, "workers": workers,
-            "scheduler": scheduler, "tol": float(spec.meta.get("tol", 1e-10)),
+            "scheduler": scheduler, "tol": gait_tol(spec),
         }
         if out is not None:
             write_table(frame, out / "results.parquet")
