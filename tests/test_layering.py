@@ -1,4 +1,5 @@
-"""Dependencies run one way: model -> simulation -> gait -> sweeps; plotting and cli on top."""
+"""Dependencies run one way: model -> simulation -> gait -> biped -> sweeps and experiment;
+plotting and cli on top."""
 
 import ast
 from pathlib import Path
