@@ -372,7 +372,7 @@ def find_periodic_gait(
     best = float(np.linalg.norm(residual(x0)))
     history.append(best)
     if cma_evals > 0:
-        finite = np.isfinite(lo) & np.isfinite(hi)  # cma bounds a coordinate on both sides
+        finite = np.isfinite(lo) & np.isfinite(hi)  # one open side: CMA-ES leaves it free
         xb, _, _, _, _ = ask_tell(
             lambda X: [cost(x) for x in X], x0, sigma0, seed=seed, max_evals=cma_evals,
             tolerances={"tolfun": 1e-14},
