@@ -1,4 +1,5 @@
-"""Dependencies run one way: model -> simulation -> gait -> sweeps; plotting and cli on top."""
+"""Dependencies run one way: model -> simulation -> gait -> biped -> sweeps and experiment;
+plotting and cli on top."""
 
 import ast
 from pathlib import Path
@@ -20,8 +21,21 @@ TOP = {"_io", "_results", "_checks", "_kernel_cache", "_nrt", "_codehash", "_ren
        "__init__", "__main__", "_typing", "__version__"}
 
 
+def _top_level(name: str) -> str:
+    """Where a name imported from the package itself (``from tslip import X``) lives.
+
+    A public name re-exported by ``tslip/__init__.py`` counts as an import of
+    the subpackage it comes from (``find_gait`` -> ``gait``); a subpackage or
+    top-level module counts as itself.
+    """
+    return tslip._SUBPACKAGE.get(name, name)
+
+
 def _imports(path: Path, plot_methods: bool = True) -> set[str]:
     """tslip subpackages a module imports (absolute or relative).
+
+    ``from tslip import X`` and ``import tslip`` (then ``tslip.X``) count as
+    imports of the subpackage ``X`` lives in (:func:`_top_level`).
 
     With ``plot_methods=False``, an import of ``tslip.plotting`` inside a
     function named ``plot`` (a result's ``.plot`` method) is not counted:
@@ -42,6 +56,11 @@ def _imports(path: Path, plot_methods: bool = True) -> set[str]:
     for node in ast.walk(tree):
         if id(node) not in skip:
             out |= _imports_of(node, rel)
+    aliases = {a.asname or "tslip" for node in ast.walk(tree) if isinstance(node, ast.Import)
+               for a in node.names
+               if a.name == "tslip" or (a.name.startswith("tslip.") and not a.asname)}
+    out |= {_top_level(node.attr) for node in ast.walk(tree) if isinstance(node, ast.Attribute)
+            and isinstance(node.value, ast.Name) and node.value.id in aliases}
     return {m.removesuffix(".py") for m in out}
 
 
@@ -49,15 +68,17 @@ def _imports_of(node: ast.AST, rel: tuple[str, ...]) -> set[str]:
     """tslip subpackages one import statement reads from."""
     out = set()
     if isinstance(node, ast.ImportFrom):
-        if node.level == 0 and node.module and node.module.startswith("tslip."):
+        if node.level == 0 and node.module == "tslip":
+            out.update(_top_level(a.name) for a in node.names)
+        elif node.level == 0 and node.module and node.module.startswith("tslip."):
             out.add(node.module.split(".")[1])
         elif node.level > 0:
             base = list(rel[: len(rel) - node.level])
             parts = base + (node.module.split(".") if node.module else [])
             if parts:
                 out.add(parts[0])
-            else:  # "from .. import x"
-                out.update(a.name for a in node.names)
+            else:  # "from .. import x", as "from tslip import x"
+                out.update(_top_level(a.name) for a in node.names)
     elif isinstance(node, ast.Import):
         out.update(a.name.split(".")[1] for a in node.names if a.name.startswith("tslip."))
     return out
@@ -98,5 +119,32 @@ def test_plotting_is_imported_upwards_only_inside_plot_methods(tmp_path):
         src.write_text("def plot(self):\n    from ..plotting import f\n")
         assert _imports(src, plot_methods=False) == set()
         assert _imports(src) == {"plotting"}
+    finally:
+        ROOT = old
+
+
+def test_imports_through_the_top_level_package_count(tmp_path):
+    """``from tslip import X``, ``from .. import X`` and ``import tslip`` then ``tslip.X``
+    are imports of the layer ``X`` lives in, so a lower layer cannot reach a higher one
+    through the package's re-exports."""
+    global ROOT
+    old, ROOT = ROOT, tmp_path
+    cases = {
+        "from tslip import find_gait, Params\n": {"gait", "model"},
+        "def f():\n    from tslip import gait, __version__\n": {"gait", "__version__"},
+        "from .. import simulate, biped\n": {"simulation", "biped"},
+        "import tslip as t\nimport numpy as np\nx = t.robustness(np.pi)\n": {"gait"},
+        "import tslip\n\ndef f():\n    return tslip.sweeps.run, tslip.load\n": {"sweeps",
+                                                                                  "_results"},
+        "import tslip.plotting\n": {"plotting"},
+        "import tslip.model\nf = tslip.find_gait\n": {"model", "gait"},
+        "import tslip.model as m\nt = m.Params\ntslip = 1\n": {"model"},
+    }
+    try:
+        for i, (code, expected) in enumerate(cases.items()):
+            src = tmp_path / "model" / f"x{i}.py"
+            src.parent.mkdir(exist_ok=True)
+            src.write_text(code)
+            assert _imports(src) == expected, code
     finally:
         ROOT = old

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import tslip
+from tslip.gait._cma import ask_tell
 from tslip.gait.fixed_point import (
     C1_OFFSET,
     C1_THRESHOLD,
@@ -123,6 +124,52 @@ def test_cma_minimize_on_a_known_quadratic():
                                    np.zeros(2), sigma0=0.5, seed=0, max_evals=2000)
     np.testing.assert_allclose(x, [1.0, -2.0], atol=1e-6)
     assert f < 1e-12 and nev <= 2000 + 10
+
+
+
+def test_ask_tell_keeps_the_best_of_every_generation_and_stops_on_the_callers_rule():
+    """The one CMA-ES loop (gait search, biped gait and design searches): the best it
+    returns is the lowest finite cost the caller saw, a NaN cost (a failed point)
+    does not hide the rest of its generation, and ``proceed`` ends the run."""
+    seen: list[tuple[float, np.ndarray]] = []
+
+    def costs(X):
+        F = [float(np.sum((x - 0.3) ** 2)) for x in X]
+        seen.extend(zip(F[1:], X[1:], strict=True))
+        return [math.nan] + F[1:]  # the first point of every generation fails
+
+    x, f, nev, nit, stop = ask_tell(costs, np.zeros(3), 0.5, seed=7, popsize=6,
+                                    proceed=lambda: len(seen) < 4 * 5)
+    f_min, x_min = min(seen, key=lambda s: s[0])
+    assert (nit, nev, stop) == (4, 24, "")
+    assert f == f_min and np.array_equal(x, x_min)
+
+
+
+def test_ask_tell_never_returns_a_failed_point():
+    """cma replaces NaN costs by the generation's median in place; on a flat cost that
+    median ties with the best, and a failed point must still not be returned."""
+    failed: list[np.ndarray] = []
+
+    def costs(X):
+        failed.extend(X[::3])
+        return [math.nan if i % 3 == 0 else 1.0 for i in range(len(X))]
+
+    x, f, _, _, _ = ask_tell(costs, np.zeros(3), 0.5, seed=7, popsize=9)
+    assert f == 1.0 and not any(np.array_equal(x, y) for y in failed)
+
+
+def test_ask_tell_puts_the_global_numpy_random_state_back_after_an_interrupt():
+    np.random.seed(5)  # noqa: NPY002
+    expected = np.random.random(3)  # noqa: NPY002
+    np.random.seed(5)  # noqa: NPY002
+
+    def costs(X):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        ask_tell(costs, np.zeros(2), 0.5, seed=3, lower=-1.0, upper=1.0)
+    np.testing.assert_array_equal(np.random.random(3), expected)  # noqa: NPY002
 
 
 def test_bad_method_and_budget():

@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 
 from .._checks import check_number
 from .._results import Result, frame
+from ..gait._cma import ask_tell
 from .gait import refine_periodic_gait, section_multipliers
 from .parameters import BipedParams
 
@@ -215,8 +216,6 @@ def stable_gait_search(base: BipedParams, z0: NDArray[np.float64], *,
         ``evaluations``, ``history`` (best score per generation), ``seconds``,
         ``interrupted``.
     """
-    import cma
-
     check_search_settings(budget_s=budget_s, max_evals=max_evals, popsize=popsize,
                           sigma0=sigma0, seed=seed, processes=processes)
     unknown = sorted(set(names) - set(DESIGN_BOUNDS))
@@ -240,33 +239,38 @@ def stable_gait_search(base: BipedParams, z0: NDArray[np.float64], *,
     n_ev = 1
     if log:
         log(f"start: score {best['score']:.4f} residual {best['residual']:.1e}")
-    es = cma.CMAEvolutionStrategy(u0, sigma0, {"seed": seed, "popsize": popsize,
-                                              "bounds": [0.0, 1.0], "verbose": -9})
     pool = None
     if processes > 1:
         import multiprocessing as mp
 
         pool = mp.get_context("fork").Pool(processes)
+
+    def generation(us: list[NDArray[np.float64]]) -> list[float]:
+        """Score the designs ``us`` and keep the best so far (the caller's record)."""
+        nonlocal best, z_warm, n_ev
+        jobs = [(base, z_warm, values(u)) for u in us]
+        outs = pool.map(_eval, jobs) if pool else [_eval(j) for j in jobs]
+        n_ev += len(outs)
+        k = int(np.argmin([o["score"] for o in outs]))
+        if outs[k]["score"] < best["score"]:
+            best = {**outs[k], "design": jobs[k][2]}
+            z_warm = np.asarray(best["z"], dtype=np.float64)
+            if on_improve:
+                on_improve({**best, "evaluations": n_ev})
+        history.append(best["score"])
+        if log:
+            ok = sum(o["score"] < 10 for o in outs)
+            log(f"{n_ev} designs, {time.perf_counter() - t_start:.0f} s: generation best "
+                f"{outs[k]['score']:.4f} ({ok}/{len(outs)} periodic), best {best['score']:.4f}")
+        return [o["score"] for o in outs]
+
+    def proceed() -> bool:
+        return time.perf_counter() - t_start < budget_s and n_ev + popsize <= max_evals
+
     interrupted = False
     try:
-        while (time.perf_counter() - t_start < budget_s and n_ev + popsize <= max_evals
-               and not es.stop()):
-            us = es.ask()
-            jobs = [(base, z_warm, values(u)) for u in us]
-            outs = pool.map(_eval, jobs) if pool else [_eval(j) for j in jobs]
-            n_ev += len(outs)
-            es.tell(us, [o["score"] for o in outs])
-            k = int(np.argmin([o["score"] for o in outs]))
-            if outs[k]["score"] < best["score"]:
-                best = {**outs[k], "design": jobs[k][2]}
-                z_warm = np.asarray(best["z"], dtype=np.float64)
-                if on_improve:
-                    on_improve({**best, "evaluations": n_ev})
-            history.append(best["score"])
-            if log:
-                ok = sum(o["score"] < 10 for o in outs)
-                log(f"{n_ev} designs, {time.perf_counter() - t_start:.0f} s: generation best "
-                    f"{outs[k]['score']:.4f} ({ok}/{len(outs)} periodic), best {best['score']:.4f}")
+        ask_tell(generation, u0, sigma0, seed=seed, lower=0.0, upper=1.0, popsize=popsize,
+                 proceed=proceed)
     except KeyboardInterrupt:
         interrupted = True
         if log:

@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 
 from .._renamed import accepts_n_strides, module_getattr, warn_renamed
 from .._results import Result, frame
+from ..gait._cma import ask_tell
 from ..gait.stability import Floquet as _TslipFloquet
 from ..gait.stability import TrivialKind, classify_stability
 from ..simulation.result import Status
@@ -321,7 +322,6 @@ def find_periodic_gait(
     Gait
         With ``converged=False`` and the best residual when the search stalls.
     """
-    import cma
     from scipy.optimize import least_squares
 
     names = list(free_state) + list(free_params)
@@ -372,15 +372,12 @@ def find_periodic_gait(
     best = float(np.linalg.norm(residual(x0)))
     history.append(best)
     if cma_evals > 0:
-        finite = np.isfinite(lo) & np.isfinite(hi)
-        opts: dict[str, Any] = {"seed": seed, "maxfevals": cma_evals, "verbose": -9,
-                                "tolfun": 1e-14}
-        if finite.any():
-            opts["bounds"] = [np.where(finite, lo, -np.inf).tolist(),
-                              np.where(finite, hi, np.inf).tolist()]
-        es = cma.CMAEvolutionStrategy(x0, sigma0, opts)
-        es.optimize(cost)
-        xb = es.result.xbest
+        finite = np.isfinite(lo) & np.isfinite(hi)  # one open side: CMA-ES leaves it free
+        xb, _, _, _, _ = ask_tell(
+            lambda X: [cost(x) for x in X], x0, sigma0, seed=seed, max_evals=cma_evals,
+            tolerances={"tolfun": 1e-14},
+            lower=np.where(finite, lo, -np.inf) if finite.any() else None,
+            upper=np.where(finite, hi, np.inf) if finite.any() else None)
         rb = float(np.linalg.norm(residual(xb)))
         if rb < best:
             best, best_x = rb, xb

@@ -1,20 +1,24 @@
-"""CMA-ES for the thesis's gait search (Section 2.8, eq. 2.22): the minimiser and its report.
+"""CMA-ES: the package's one ask/tell loop, the gait search's minimiser and its report.
 
-Split from :mod:`tslip.gait.fixed_point`, which runs it on the two-stage cost
-(``method="cma"``) and re-exports both names.
+:func:`ask_tell` is the loop every CMA-ES search runs: the gait search of
+Section 2.8 (eq. 2.22) through :func:`cma_minimize` (which
+:mod:`tslip.gait.fixed_point` runs on the two-stage cost, ``method="cma"``, and
+re-exports with :class:`CMAReport`), and the biped's gait and design searches
+(:mod:`tslip.biped.gait`, :mod:`tslip.biped.design`) with their own bounds,
+seeds and stopping rules.
 """
 
 from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-__all__ = ["CMAReport", "cma_minimize"]
+__all__ = ["CMAReport", "ask_tell", "cma_minimize"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -64,6 +68,110 @@ def _cma_seed(seed: int) -> int:
     return s or 1
 
 
+#: Termination tolerances of the gait search (``cma`` option names).
+_GAIT_TOLERANCES = {"tolfun": 1e-13, "tolfunhist": 1e-14, "tolx": 1e-14, "tolflatfitness": 20}
+
+_Bound = float | Sequence[float] | np.ndarray | None
+
+
+def _bound(b: _Bound) -> float | list[float] | None:
+    """One side of ``cma``'s ``bounds`` option: None, one value for all coordinates, or a list."""
+    if b is None:
+        return None
+    a = np.asarray(b, dtype=float)
+    return float(a) if a.ndim == 0 else [float(v) for v in a]
+
+
+def ask_tell(
+    costs: Callable[[list[np.ndarray]], Sequence[float]],
+    x0: Sequence[float] | np.ndarray,
+    sigma0: float,
+    *,
+    seed: int,
+    lower: _Bound = None,
+    upper: _Bound = None,
+    stds: Sequence[float] | np.ndarray | None = None,
+    popsize: int | None = None,
+    max_evals: int | None = None,
+    tolerances: Mapping[str, float] | None = None,
+    proceed: Callable[[], bool] | None = None,
+) -> tuple[np.ndarray, float, int, int, str]:
+    """The package's one CMA-ES loop: ask a generation, cost it, tell, until a stop.
+
+    Every CMA-ES search (the gait search's :func:`cma_minimize`, the biped's
+    :func:`~tslip.biped.gait.find_periodic_gait` and
+    :func:`~tslip.biped.design.stable_gait_search`) runs this loop, quietly,
+    with ``cma``'s own warnings silenced and NumPy's global random state (which
+    ``cma`` seeds and draws from) restored afterwards, even after an interrupt.
+
+    Parameters
+    ----------
+    costs : callable
+        ``costs(X)``: the costs of one generation ``X`` (a list of points), in
+        order. It may record what its caller needs (best design, history, log).
+    x0 : array_like, shape (n,)
+        Initial mean.
+    sigma0 : float
+        Initial step size, multiplied per coordinate by ``stds``.
+    seed : int
+        ``cma``'s seed, passed as is (``cma`` reads 0 as "seed from the clock").
+    lower, upper : float or array_like, optional
+        Box bounds, one value for every coordinate or one per coordinate.
+    stds : array_like, optional
+        Per-coordinate scaling of ``sigma0``.
+    popsize : int, optional
+        Population size (``cma``'s default ``4 + 3 ln n``).
+    max_evals : int, optional
+        ``cma``'s budget of cost evaluations (``maxfevals``).
+    tolerances : mapping, optional
+        Further ``cma`` termination options, e.g. ``{"tolfun": 1e-14}``.
+    proceed : callable, optional
+        The caller's own stopping rule, asked before every generation
+        (e.g. a wall-time budget); the loop stops when it returns False.
+
+    Returns
+    -------
+    x : ndarray
+        Best point evaluated (``x0`` when none had a finite cost; ties go to
+        the earliest, as ``cma``'s own ``result.xbest``).
+    f : float
+        Its cost (inf when none was finite).
+    evaluations, iterations : int
+        Cost evaluations and generations told to ``cma``.
+    stop : str
+        ``cma``'s termination criteria that fired (empty when ``proceed`` stopped it).
+    """
+    import cma
+
+    opts: dict[str, Any] = {"seed": int(seed), "verbose": -9, **(tolerances or {})}
+    if max_evals is not None:
+        opts["maxfevals"] = int(max_evals)
+    if stds is not None:
+        opts["CMA_stds"] = [float(s) for s in stds]
+    if lower is not None or upper is not None:
+        opts["bounds"] = [_bound(lower), _bound(upper)]
+    if popsize is not None:
+        opts["popsize"] = int(popsize)
+    x0 = np.asarray(x0, dtype=float)
+    best_x, best_f = x0.copy(), math.inf
+    state = np.random.get_state()  # noqa: NPY002
+    try:
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", module=r"cma(\.|$)")
+            es = cma.CMAEvolutionStrategy(x0, sigma0, opts)
+            while (proceed is None or proceed()) and not es.stop():
+                X = es.ask()
+                F = [float(f) for f in costs(X)]
+                es.tell(X, list(F))  # a copy: cma sets NaN costs to the median in place
+                i = int(np.argmin([math.inf if math.isnan(f) else f for f in F]))
+                if F[i] < best_f:
+                    best_x, best_f = np.array(X[i], dtype=float), F[i]
+            stop = ", ".join(f"{k}={v}" for k, v in es.stop().items())
+            return best_x, best_f, int(es.countevals), int(es.countiter), stop
+    finally:
+        np.random.set_state(state)  # noqa: NPY002
+
+
 def cma_minimize(
     cost: Callable[[np.ndarray], float],
     x0: np.ndarray,
@@ -77,6 +185,9 @@ def cma_minimize(
     popsize: int | None = None,
 ) -> tuple[np.ndarray, float, int, int, str]:
     """Minimise ``cost`` with CMA-ES (``cma`` package, ask/tell), quietly.
+
+    The gait search's settings of :func:`ask_tell`: tight tolerances, so that
+    the budget ``max_evals`` usually ends the run.
 
     Parameters
     ----------
@@ -112,37 +223,6 @@ def cma_minimize(
     ----------
     N. Hansen, "The CMA Evolution Strategy: A Tutorial", arXiv:1604.00772.
     """
-    import cma
-
-    x0 = np.asarray(x0, dtype=float)
-    opts: dict[str, Any] = {
-        "seed": _cma_seed(seed), "verbose": -9, "verb_disp": 0, "verb_log": 0,
-        "maxfevals": int(max_evals), "tolfun": 1e-13, "tolfunhist": 1e-14, "tolx": 1e-14,
-        "tolflatfitness": 20,
-    }
-    if stds is not None:
-        opts["CMA_stds"] = list(map(float, stds))
-    if lower is not None or upper is not None:
-        lo = None if lower is None else list(map(float, lower))
-        hi = None if upper is None else list(map(float, upper))
-        opts["bounds"] = [lo, hi]
-    if popsize is not None:
-        opts["popsize"] = int(popsize)
-    # cma seeds and draws from NumPy's legacy global generator: put it back after
-    state = np.random.get_state()  # noqa: NPY002
-    try:
-        with warnings.catch_warnings():
-            warnings.filterwarnings("ignore", module=r"cma(\.|$)")
-            es = cma.CMAEvolutionStrategy(x0, sigma0, opts)
-            best_x, best_f = x0.copy(), math.inf
-            while not es.stop():
-                X = es.ask()
-                F = [float(cost(np.asarray(x))) for x in X]
-                es.tell(X, F)
-                i = int(np.argmin(F))
-                if F[i] < best_f:
-                    best_x, best_f = np.array(X[i], dtype=float), F[i]
-            stop = ", ".join(f"{k}={v}" for k, v in es.stop().items())
-            return best_x, best_f, int(es.countevals), int(es.countiter), stop
-    finally:
-        np.random.set_state(state)  # noqa: NPY002
+    return ask_tell(lambda X: [cost(np.asarray(x)) for x in X], x0, sigma0,
+                    seed=_cma_seed(seed), lower=lower, upper=upper, stds=stds,
+                    popsize=popsize, max_evals=max_evals, tolerances=_GAIT_TOLERANCES)

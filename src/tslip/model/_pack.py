@@ -9,7 +9,6 @@ from __future__ import annotations
 import numpy as np
 
 from .parameters import Params
-from .state import TouchdownState
 
 # -- parameter vector P ------------------------------------------------------
 P_M, P_J, P_R, P_K, P_L0, P_G, P_CL, P_OMEGA, P_ALPHA, P_GLOBAL, P_CTRL = range(11)
@@ -94,8 +93,3 @@ def pack_params(p: Params) -> np.ndarray:
     out[P_CTRL] = p.controller.code
     out[P_C0 : P_C0 + 4] = p.controller.torque_coefficients()
     return out
-
-
-def pack_state(s: TouchdownState) -> np.ndarray:
-    """``TouchdownState`` -> TD vector."""
-    return s.as_array()

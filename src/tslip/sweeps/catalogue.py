@@ -28,7 +28,6 @@ Choices the thesis leaves open
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -244,8 +243,3 @@ def fig_appendix_e(*args: Any, **kwargs: Any) -> dict[str, Any]:
     from .appendix_e import fig_appendix_e as appendix_e
 
     return appendix_e(*args, **kwargs)
-
-
-def replace_spec(spec: StudySpec, **changes: Any) -> StudySpec:
-    """A copy of a spec with fields changed (keeps its meta)."""
-    return dataclasses.replace(spec, **changes)
