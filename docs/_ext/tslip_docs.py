@@ -193,10 +193,15 @@ def figure_scraper(block: Any, block_vars: dict[str, Any], gallery_conf: dict[st
     ``tslip.plotting`` builds figures without pyplot (so they are safe in worker
     processes and never open a window), which sphinx-gallery's matplotlib scraper
     does not see; an example binds the returned figure to a name instead.
+
+    It runs before the matplotlib scraper, which saves (and closes) every figure pyplot
+    holds: those are marked as seen and left to it, so no figure is saved twice.
     """
+    import matplotlib.pyplot as plt
     from matplotlib.figure import Figure
     from sphinx_gallery.scrapers import figure_rst
 
+    _SCRAPED.update(id(plt.figure(num)) for num in plt.get_fignums())
     paths = []
     for value in list(block_vars["example_globals"].values()):
         if isinstance(value, Figure) and id(value) not in _SCRAPED:
