@@ -36,7 +36,6 @@ import math
 import pickle
 import time
 from collections.abc import Callable, Mapping
-from contextlib import ExitStack
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -51,7 +50,7 @@ from ..model.controllers import LocalVelocity
 from ..model.parameters import preset
 from ..simulation.options import IntegratorOptions
 from . import _pool, catalogue
-from ._lock import folder_lock
+from ._lock import folder_locks
 from ._schedule import Task, Timing, choose_workers, own_seconds, run_tasks
 from .claims import ClaimResult, evaluate
 from .run import StudyJob
@@ -439,7 +438,7 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
                   info: dict[str, Any] | None = None) -> dict[str, Any]:
     """Every study and single-gait figure as tasks of one scheduler; results by key.
 
-    Each study folder is locked (:func:`tslip.sweeps._lock.folder_lock`)
+    Each study folder is locked (:func:`tslip.sweeps._lock.folder_locks`)
     for the run. ``timing`` receives each task's CPU and wall seconds and
     the task that made it ready (:func:`tslip.sweeps._schedule.run_tasks`);
     ``on_result(data so far)`` is called after each study and figure, and
@@ -454,12 +453,9 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
     preload = ["tslip.sweeps.run", __name__, *(extra.modules if extra is not None else ())]
     if scheduler is None and workers != 1:  # likely parallel: the workers' imports start now
         _pool.prestart(preload)
-    with ExitStack() as locks:
-        jobs: dict[str, StudyJob] = {}
-        for name, spec in specs.items():
-            folder = out / "studies" / name
-            locks.enter_context(folder_lock(folder))
-            jobs[name] = StudyJob(spec, folder, writes=scheduler is None)
+    with folder_locks(out / "studies" / name for name in specs):
+        jobs = {name: StudyJob(spec, out / "studies" / name, writes=scheduler is None)
+                for name, spec in specs.items()}
 
         follow: list[Task] = []  # extra's tasks made ready by the last arrival
 
