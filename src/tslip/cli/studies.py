@@ -58,6 +58,10 @@ def study_cmd(
         spec = StudySpec.from_toml(spec_path)
         out_dir = out if out is not None else Path("studies") / spec.name
         check_output(out_dir / "run.json", "--out")  # before any work, naming the user's path
+        from ..sweeps._lock import folder_lock
+
+        with folder_lock(out_dir, wait=wait):  # refused (or waited for) before the bar is drawn
+            pass
         t0 = time.perf_counter()
         with progress_bar("pt") as bar:
             task = bar.add_task(f"study {spec.name}", total=spec.n_points)
