@@ -151,8 +151,11 @@ def _report_dir() -> tuple[Path, str]:
     from tslip.plotting.report import write_report
     from tslip.sweeps.reproduce import run_all
 
-    data, claims, seconds = run_all(out, resolution=res, workers=1 if res == "tiny" else None)
-    write_report(out / "index.html", data, claims, quick=res != "full", seconds=seconds)
+    info: dict[str, Any] = {}
+    data, claims, seconds = run_all(out, resolution=res, workers=1 if res == "tiny" else None,
+                                    info=info)
+    write_report(out / "index.html", data, claims, quick=res != "full", seconds=seconds,
+                 workers=info["workers"])
     return out, res
 
 
