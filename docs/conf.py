@@ -57,6 +57,6 @@ sphinx_gallery_conf = {
     "download_all_examples": False,
     "remove_config_comments": True,
     "show_memory": False,
-    # pyplot figures, and the Figures tslip.plotting returns (bound to a name)
-    "image_scrapers": ("matplotlib", "tslip_docs.figure_scraper"),
+    # the Figures tslip.plotting returns (bound to a name), then pyplot's figures
+    "image_scrapers": ("tslip_docs.figure_scraper", "matplotlib"),
 }

@@ -150,8 +150,11 @@ def _report_dir() -> tuple[Path, str]:
     from tslip.plotting.report import write_report
     from tslip.sweeps.reproduce import run_all
 
-    data, claims, seconds = run_all(out, resolution=res, workers=1 if res == "tiny" else None)
-    write_report(out / "index.html", data, claims, quick=res != "full", seconds=seconds)
+    info: dict[str, Any] = {}
+    data, claims, seconds = run_all(out, resolution=res, workers=1 if res == "tiny" else None,
+                                    info=info)
+    write_report(out / "index.html", data, claims, quick=res != "full", seconds=seconds,
+                 workers=info["workers"])
     return out, res
 
 
@@ -198,10 +201,15 @@ def figure_scraper(block: Any, block_vars: dict[str, Any], gallery_conf: dict[st
     ``tslip.plotting`` builds figures without pyplot (so they are safe in worker
     processes and never open a window), which sphinx-gallery's matplotlib scraper
     does not see; an example binds the returned figure to a name instead.
+
+    It runs before the matplotlib scraper, which saves (and closes) every figure pyplot
+    holds: those are marked as seen and left to it, so no figure is saved twice.
     """
+    import matplotlib.pyplot as plt
     from matplotlib.figure import Figure
     from sphinx_gallery.scrapers import figure_rst
 
+    _SCRAPED.update(id(plt.figure(num)) for num in plt.get_fignums())
     paths = []
     for value in list(block_vars["example_globals"].values()):
         if isinstance(value, Figure) and id(value) not in _SCRAPED:

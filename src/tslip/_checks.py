@@ -8,7 +8,8 @@ names the field and what is allowed:
 * :func:`check_fields` - every numeric field of a parameter dataclass, by its metadata;
 * :func:`parse_number` - the same for text from the command line (``--set``);
 * :func:`check_fits` - a size against the memory available, before the work;
-* :func:`check_output` - an output path: suffix allowed, directory writable.
+* :func:`check_output` - an output path: suffix allowed, directory writable;
+* :func:`check_name` - a name that becomes a folder name (a study's, a viability map's).
 """
 
 from __future__ import annotations
@@ -17,12 +18,17 @@ import dataclasses
 import math
 import numbers
 import os
+import re
 import tempfile
 from pathlib import Path
 from typing import Any
 
 __all__ = ["check_number", "check_fields", "parse_number", "check_fits", "available_memory",
-           "check_output"]
+           "check_output", "check_name"]
+
+#: What a name that becomes a folder name may be: no path separators, and no leading
+#: dot (so neither "." nor "..", which would write into the current folder or its parent).
+NAME_RULE = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"
 
 
 def _range(lower: float, upper: float, lower_open: bool, upper_open: bool) -> str:
@@ -181,3 +187,11 @@ def check_output(path: str | os.PathLike[str], option: str,
         raise ValueError(f"{option} {str(path)!r}: cannot write in {str(parent)!r} "
                          f"({exc.strerror or exc})") from None
     return path
+
+
+def check_name(value: object, field: str) -> str:
+    """``value`` as a name that becomes a folder name: it must match :data:`NAME_RULE`."""
+    if not isinstance(value, str) or not re.fullmatch(NAME_RULE[1:-1], value):
+        raise ValueError(f"{field} must match {NAME_RULE} (a letter or digit, then up to 63 "
+                         f"letters, digits, '_', '.' or '-'), got {value!r}")
+    return value

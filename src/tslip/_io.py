@@ -69,11 +69,11 @@ def write_table(df, path: str | Path) -> Path:  # noqa: ANN001 - pandas.DataFram
 def read_toml(path: str | Path, what: str) -> dict:
     """Parse a TOML file; a missing or malformed file is a one-line ``ValueError``.
 
-    ``what`` names the file in the message, e.g. ``"parameter file"``.
+    ``what`` names the file in the message, e.g. ``"parameter file"``. A UTF-8
+    byte-order mark (some Windows editors write one) is accepted.
     """
     try:
-        with open(path, "rb") as fh:
-            return tomllib.load(fh)
+        return tomllib.loads(Path(path).read_text(encoding="utf-8-sig"))
     except FileNotFoundError:
         raise ValueError(f"{what} {str(path)!r} does not exist") from None
     except IsADirectoryError:

@@ -116,6 +116,8 @@ def test_two_workers_give_the_bytes_of_one(spec, tmp_path):
     ("points = 20", "points = 0", r"\[action\] alpha_r: points must be an integer"),
     ('name = "alpha_r"', 'name = "stiffness"', "unknown parameter 'stiffness'"),
     ("preset = \"slip\"", "preset = \"slip\"\nwarp = 1", "unknown key 'warp'"),
+    ('name = "tiny"', 'name = ".."', r"viability name must match \^\[A-Za-z0-9\]"),
+    ('name = "tiny"', 'name = "a/b"', r"viability name must match \^\[A-Za-z0-9\]"),
 ])
 def test_a_bad_spec_value_is_one_line_naming_the_field(tmp_path, old, new, match):
     path = tmp_path / "bad.toml"
@@ -156,3 +158,17 @@ def test_a_bad_rule_option_is_one_line(spec, tmp_path):
     lines = res.stderr.strip().splitlines()
     assert lines == ["error: rule must be one of ['bracket', 'nearest', 'vibly'], got 'closest'"]
     assert not (tmp_path / "out" / "run.json").exists()
+
+
+def test_a_dot_dot_name_writes_nothing_without_out(tmp_path, monkeypatch):
+    """Without --out the map goes to viability/<name>: ".." would be the current folder."""
+    work = tmp_path / "work"
+    work.mkdir()
+    path = tmp_path / "spec.toml"
+    path.write_text(SPEC.format(rule="bracket").replace('name = "tiny"', 'name = ".."'))
+    monkeypatch.chdir(work)
+    res = _run(path)
+    assert res.exit_code == 2, res.output
+    assert res.stderr.strip().startswith("error: viability name must match")
+    assert list(work.iterdir()) == [] and sorted(p.name for p in tmp_path.iterdir()) == \
+        ["spec.toml", "work"]

@@ -60,6 +60,38 @@ def test_every_page_is_built(site: Path) -> None:
     assert (site / "report" / "index.html").is_file()
 
 
+def _figures_made(script: Path) -> int:
+    """The figures an example makes, read from its source: each ``plt.figure`` or
+    ``plt.subplots`` call, and each call of a ``tslip.plotting`` function whose result
+    (a Figure) is bound to a name; a plotting function given ``ax=`` draws into a figure
+    already counted."""
+    import ast
+
+    tree = ast.parse(script.read_text())
+    plotting = {a.asname or a.name for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)
+                and (node.module or "").startswith("tslip.plotting") for a in node.names}
+    n = 0
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) \
+                and isinstance(node.func.value, ast.Name) and node.func.value.id == "plt":
+            n += node.func.attr in ("figure", "subplots")
+        elif isinstance(node, ast.Assign) and isinstance(node.value, ast.Call) \
+                and isinstance(node.value.func, ast.Name):
+            n += node.value.func.id in plotting
+    return n
+
+
+def test_each_gallery_page_shows_each_figure_once(site: Path) -> None:
+    """A page has one image per figure its script makes: none missing, none saved twice
+    (by both the matplotlib scraper and ``tslip_docs.figure_scraper``)."""
+    for example in EXAMPLES:
+        page = (site / "gallery" / f"{example.stem}.html").read_text()
+        images = re.findall(r'<img [^>]*class\s*=\s*"sphx-glr-(?:single|multi)-img"', page)
+        made = _figures_made(example)
+        assert made >= 1, example.name
+        assert len(images) == made, f"{example.name}: {len(images)} images, {made} figures"
+
+
 def test_generated_pages_follow_the_code(site: Path) -> None:
     """The CLI reference lists every command; the parameter table every field."""
     import dataclasses

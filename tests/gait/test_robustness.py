@@ -4,7 +4,6 @@ The search alone, on constructed survival curves: test_robustness_search.py.
 """
 
 import dataclasses
-import math
 
 import numpy as np
 import pytest

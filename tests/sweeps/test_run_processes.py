@@ -15,7 +15,7 @@ import pytest
 
 import tslip
 from tslip.sweeps import Axis, StudySpec, run_study
-from tslip.sweeps._lock import FolderLocked, folder_lock
+from tslip.sweeps._lock import FolderLocked, folder_lock, folder_locks
 
 # a 2-D study of 5 lines of 13 points: the line at the base value v0 = 5 first, then
 # two continuation chains (v0 = 4.5; v0 = 5.5, 6, 6.5) in two workers, one soon idle
@@ -138,6 +138,7 @@ def test_ctrl_c_prints_one_resume_line_and_exits_130(tmp_path):
             os.killpg(proc.pid, signal.SIGKILL)
     assert proc.returncode == 130, err
     assert "Traceback" not in err
+    assert "leaked" not in err  # the terminated workers left no named semaphore behind
     m = re.search(r"^(\d+) of 65 points saved; rerun the same command to resume$", err,
                   re.MULTILINE)
     assert m, err
@@ -170,6 +171,23 @@ def test_lock_of_a_killed_run_is_stale_and_taken_over(tmp_path, caplog):
     with caplog.at_level("WARNING", logger="tslip"), folder_lock(tmp_path):
         pass  # released cleanly last time: nothing to report
     assert len(caplog.records) == 1
+
+
+def test_the_stale_locks_of_a_killed_run_of_many_studies_are_one_line(tmp_path, caplog):
+    folders = [tmp_path / "studies" / f"s{i}" for i in range(18)]
+    code = ("import os, sys\nfrom tslip.sweeps._lock import folder_locks\n"
+            "with folder_locks(sys.argv[1:]):\n    os.kill(os.getpid(), 9)\n")
+    proc = subprocess.run([sys.executable, "-c", code, *map(str, folders)], env=_env(),
+                          timeout=60)
+    assert proc.returncode == -9
+    dead = int(re.search(r'"pid": (\d+)', (folders[-1] / ".lock").read_text()).group(1))
+    with caplog.at_level("WARNING", logger="tslip"), folder_locks(folders):
+        pass
+    msgs = [r.getMessage() for r in caplog.records]
+    assert len(msgs) == 1, msgs
+    assert msgs[0].startswith(f"taking over the stale locks on 18 folders under "
+                              f"{tmp_path / 'studies'} from pid {dead} on "), msgs[0]
+    assert len(re.findall(r"pid \d+", msgs[0])) == 1  # one holder, named once
 
 
 def test_idle_workers_ignore_sigint_and_the_parent_stops_them():

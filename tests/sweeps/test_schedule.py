@@ -135,11 +135,62 @@ def _claims(claims):
 
 @pytest.fixture(scope="module")
 def serial_tiny(tmp_path_factory):
+    """The tiny reproduction, serial: data, claims, its wall seconds, what it reported."""
     from tslip.sweeps.reproduce import run_all
 
     out = tmp_path_factory.mktemp("serial")
-    data, claims, _ = run_all(out, resolution="tiny", workers=1)
-    return data, claims
+    reported: list[tuple[str, str, float]] = []
+    data, claims, seconds = run_all(out, resolution="tiny", workers=1,
+                                    progress=lambda *args: reported.append(args))
+    return data, claims, seconds, reported
+
+
+def test_each_study_and_figure_reports_its_own_time(serial_tiny):
+    """Run one after the other, the studies' and figures' own times add up to at most the
+    run's wall time; times counted from the start of the run would add up to many times it."""
+    data, _, wall, reported = serial_tiny
+    studies = {name: s for stage, name, s in reported if stage == "study"}
+    assert set(studies) == set(catalogue.studies("tiny"))
+    assert all(s == data[name].meta["seconds"] > 0 for name, s in studies.items())
+    assert sum(s for _, _, s in reported) <= wall
+
+
+def test_two_interleaved_studies_report_their_own_time(monkeypatch):
+    """A fake clock on which a task takes one second per point: a 1-point study and a
+    4-point one, their tasks interleaved on one run, report 2 s and 8 s (a solve and an
+    analysis per point), which add up to the run's 10 s (counted from the start of the
+    run, each would report up to 10 s)."""
+    from tslip.model.parameters import preset
+    from tslip.sweeps import Axis, StudySpec
+
+    clock = [0.0]
+    fake = type("FakeTime", (), {"perf_counter": staticmethod(lambda: clock[0]),
+                                 "process_time": staticmethod(lambda: clock[0])})
+    monkeypatch.setattr(_schedule, "time", fake)
+
+    def costing(real, points):
+        def task(*args):
+            clock[0] += len(args[points])
+            return real(*args)
+        return task
+
+    monkeypatch.setattr(run_mod, "_solve_task", costing(run_mod._solve_task, 2))
+    monkeypatch.setattr(run_mod, "_analyse_task", costing(run_mod._analyse_task, 1))
+    base = preset("table2.1")
+    jobs = {name: run_mod.StudyJob(StudySpec(name, base, axes=(Axis("k", values),),
+                                             analyses=("floquet",)), None)
+            for name, values in (("one", (20.0,)), ("four", (18.0, 19.0, 20.0, 21.0)))}
+
+    def on_done(task, result):
+        return jobs[task.key[0]].on_done(task, result)
+
+    timing: dict = {}
+    run_tasks([t for j in jobs.values() for t in j.start()], on_done, 1, timing=timing)
+    # own time: the tasks' seconds, and (real seconds) the keys made and the cache read here
+    own = {name: j.result(1, timing=timing).meta["seconds"] - j.load_seconds
+           for name, j in jobs.items()}
+    assert own == pytest.approx({"one": 2.0, "four": 8.0})
+    assert clock[0] == 10.0
 
 
 def test_parallel_reproduction_equals_serial_bit_for_bit(serial_tiny, tmp_path):

@@ -37,6 +37,20 @@ __all__ = [
     "fail", "file_size", "interruptible", "make_console", "progress_bar", "run", "stopped",
 ]
 
+
+def _flag_shows_no_type(display: Any) -> Any:
+    """Typer lists a flag's type as ``<bool>`` in ``--help`` (``--help`` itself too); a flag
+    takes no value, so its type column is left empty (every command imports this module)."""
+    def display_type_rich(self: Any, ctx: Any) -> str | None:
+        return "" if getattr(self, "is_flag", False) else display(self, ctx)
+    display_type_rich._tslip = True  # type: ignore[attr-defined]
+    return display_type_rich
+
+
+if not getattr(typer.core.TyperOption.display_type_rich, "_tslip", False):
+    typer.core.TyperOption.display_type_rich = _flag_shows_no_type(  # type: ignore[method-assign]
+        typer.core.TyperOption.display_type_rich)
+
 #: Table files the commands read and write.
 DATA_SUFFIXES = (".csv", ".parquet")
 
@@ -125,7 +139,7 @@ def interruptible() -> Iterator[None]:
 
 
 class _Rate(TextColumn):
-    """Items per second, e.g. ``12.0 pt/s``."""
+    """Items per second, e.g. ``12.0 pt/s``; nothing until rich has an estimate."""
 
     def __init__(self, unit: str) -> None:
         super().__init__("")
@@ -135,7 +149,7 @@ class _Rate(TextColumn):
         from rich.text import Text
 
         speed = task.finished_speed or task.speed
-        return Text(f"{speed:5.1f} {self.unit}/s" if speed else f"   -- {self.unit}/s")
+        return Text(f"{speed:5.1f} {self.unit}/s" if speed else "")
 
 
 def progress_bar(unit: str) -> Progress:

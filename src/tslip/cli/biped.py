@@ -150,12 +150,13 @@ def search_cmd(
         "T, theta_f, theta_s, Kp_h, Kd_h).")] = None,
     cma_evals: Annotated[int, typer.Option(
         "--cma-evals", help="CMA-ES strides before the refinement (0: refine only).")] = 0,
-    sigma0: Annotated[float, typer.Option("--sigma0")] = 0.05,
-    seed: Annotated[int, typer.Option("--seed")] = 1,
+    sigma0: Annotated[float, typer.Option("--sigma0", help="CMA-ES initial step size.")] = 0.05,
+    seed: Annotated[int, typer.Option("--seed", help="CMA-ES random seed.")] = 1,
     max_iter: Annotated[int, typer.Option(
         "--max-iter", help="Levenberg-Marquardt iterations of the refinement.")] = 30,
     tol: Annotated[float, typer.Option("--tol", help="Periodicity residual target.")] = 1e-8,
-    multipliers: Annotated[bool, typer.Option("--multipliers/--no-multipliers")] = True,
+    multipliers: Annotated[bool, typer.Option(
+        "--multipliers/--no-multipliers", help="Compute the gait's Floquet multipliers.")] = True,
     strides: Annotated[int, typer.Option(
         "--strides", "-n", help="Strides run from the result (strides until fall).")] = 50,
 ) -> None:
@@ -206,7 +207,7 @@ def animate_cmd(
     gait: GaitOpt = None,
     from_tslip: TslipOpt = None,
     strides: StridesOpt = 5,
-    fps: Annotated[int, typer.Option("--fps")] = 25,
+    fps: Annotated[int, typer.Option("--fps", help="Frames per second of the animation.")] = 25,
 ) -> None:
     """Animate the runner with both legs."""
     from ..plotting.biped import animate_biped
@@ -284,12 +285,13 @@ def optimise_cmd(
         "--gait", metavar="FILE.json|NAME",
         help="Converged gait to start from (warm start), a file or a stored name.")],
     budget: Annotated[float, typer.Option("--budget", help="Wall-clock seconds.")] = 600.0,
-    max_evals: Annotated[int, typer.Option("--max-evals")] = 400,
-    popsize: Annotated[int, typer.Option("--popsize")] = 8,
+    max_evals: Annotated[int, typer.Option("--max-evals", help="Designs scored at most.")] = 400,
+    popsize: Annotated[int, typer.Option("--popsize", help="CMA-ES designs per generation.")] = 8,
     sigma0: Annotated[float, typer.Option("--sigma0", help="CMA-ES step (bounds scaled "
                                           "to [0, 1]).")] = 0.08,
-    seed: Annotated[int, typer.Option("--seed")] = 3,
-    processes: Annotated[int, typer.Option("--processes", "-j")] = 1,
+    seed: Annotated[int, typer.Option("--seed", help="CMA-ES random seed.")] = 3,
+    processes: Annotated[int, typer.Option(
+        "--processes", "-j", help="Processes scoring a generation (1: this one).")] = 1,
 ) -> None:
     """Beyond the thesis: minimise the largest multiplier over gains, sweep, duty, masses.
 

@@ -209,7 +209,8 @@ def track_cmd(
     scale: Annotated[float | None, typer.Option("--scale", help="Image scale \\[px/m] (default: "
                                                 "measured from the disc spacing).")] = None,
     ground: Annotated[float | None, typer.Option("--ground", help="Ground row \\[px].")] = None,
-    max_frames: Annotated[int | None, typer.Option("--max-frames")] = None,
+    max_frames: Annotated[int | None, typer.Option(
+        "--max-frames", help="Track only the first N frames (default: all).")] = None,
 ) -> None:
     """Track body discs and feet in a video; write per-frame positions."""
     with errors():
@@ -307,7 +308,9 @@ def fit_cmd(
 @commands.command("experiment")
 def experiment_cmd(
     video: Annotated[Path, typer.Argument(help="Video (.mp4) or folder of frames.")],
-    out_dir: Annotated[Path, typer.Option("--out-dir", "-o")] = Path("experiment"),
+    out_dir: Annotated[Path, typer.Option(
+        "--out-dir", "-o", help="Folder for tracks.csv, steps.csv and the fit's tables, "
+        "figures and fit.json.")] = Path("experiment"),
     fps: Annotated[float | None, typer.Option("--fps", help="Frame rate \\[Hz].")] = None,
     scale: Annotated[float | None, typer.Option("--scale", help="\\[px/m]")] = None,
     ground: Annotated[float | None, typer.Option("--ground", help="Ground row \\[px].")] = None,

@@ -58,6 +58,11 @@ def study_cmd(
         spec = StudySpec.from_toml(spec_path)
         out_dir = out if out is not None else Path("studies") / spec.name
         check_output(out_dir / "run.json", "--out")  # before any work, naming the user's path
+        from ..sweeps._lock import folder_lock
+
+        with folder_lock(out_dir, wait=wait):  # refused (or waited for) before the bar is drawn
+            pass
+        t0 = time.perf_counter()
         with progress_bar("pt") as bar:
             task = bar.add_task(f"study {spec.name}", total=spec.n_points)
             try:
@@ -71,7 +76,7 @@ def study_cmd(
     n_stable = int(f["stability"].isin(["asymptotic", "neutral"]).sum())
     console.print(f"{spec.name}: {len(f)} points ({res.meta['cached']} cached), "
                   f"{int(f['converged'].sum())} with a periodic gait, {n_stable} stable or "
-                  f"neutral, {res.meta['seconds']:.1f} s")
+                  f"neutral, {time.perf_counter() - t0:.1f} s")
     console.print(f"wrote {out_dir / 'results.parquet'}" + (" and results.csv" if csv else "")
                   + " and run.json")
 

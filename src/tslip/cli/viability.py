@@ -35,6 +35,14 @@ def viability_cmd(
 ) -> None:
     """Compute (or resume) the viable state-action set of a grid at fixed energy.
 
+    The spec (TOML): name; preset; energy \\[MgL] of every cell; rule ("bracket" or
+    "nearest"); optional \\[params] overrides and \\[options] (IntegratorOptions);
+    one or two \\[\\[state]] apex variables (the height "y", and "phi" or "phid"; each
+    a name with from/to/points or values) and one \\[action] (a parameter, e.g.
+    name = "alpha_r", with its values).
+    Example and meaning: the documentation page "Viability and basins of
+    attraction" (docs/analyses/viability.md).
+
     Each chunk of cells is saved as it finishes: after Ctrl-C (or a crash)
     the same command resumes with the missing ones.
     """
@@ -48,6 +56,10 @@ def viability_cmd(
             spec = dataclasses.replace(spec, rule=rule)
         out_dir = out if out is not None else Path("viability") / spec.name
         check_output(out_dir / "run.json", "--out")  # before any work, naming the user's path
+        from ..sweeps._lock import folder_lock
+
+        with folder_lock(out_dir, wait=wait):  # refused (or waited for) before the bar is drawn
+            pass
         with progress_bar("cells") as bar:
             task = bar.add_task(f"viability {spec.name}", total=spec.n_cells)
             try:

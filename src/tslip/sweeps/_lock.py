@@ -3,10 +3,10 @@
 The lock is an advisory ``flock`` on ``folder/.lock``; the file holds the
 holder's pid, host and start time. The kernel releases the lock when its
 process ends, however it ends, so a crashed or killed run never blocks the
-next one: its lock is stale, and the next run takes it over (and says so,
-naming the old pid). A run that ends normally empties the file. The file is
-never deleted: deleting a locked file lets two later runs lock two
-different files.
+next one: its lock is stale, and the next run takes it over (and says so
+in one line for all the folders it locks, naming the old pid). A run that
+ends normally empties the file. The file is never deleted: deleting a
+locked file lets two later runs lock two different files.
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ import logging
 import os
 import socket
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
+from collections.abc import Iterable, Iterator
+from contextlib import AbstractContextManager, ExitStack, contextmanager
 from pathlib import Path
 
 try:
@@ -25,7 +25,7 @@ try:
 except ImportError:  # pragma: no cover - Windows: no locking
     fcntl = None  # type: ignore[assignment]
 
-__all__ = ["FolderLocked", "folder_lock"]
+__all__ = ["FolderLocked", "folder_lock", "folder_locks"]
 
 log = logging.getLogger("tslip")
 
@@ -47,8 +47,7 @@ def _describe(h: dict) -> str:
     return f"pid {h.get('pid', '?')} on {h.get('host', '?')} (started {h.get('started', '?')})"
 
 
-@contextmanager
-def folder_lock(folder: str | Path, *, wait: bool = False) -> Iterator[None]:
+def folder_lock(folder: str | Path, *, wait: bool = False) -> AbstractContextManager[None]:
     """Hold ``folder/.lock`` for the block.
 
     Raises
@@ -57,7 +56,29 @@ def folder_lock(folder: str | Path, *, wait: bool = False) -> Iterator[None]:
         If another live process holds it and ``wait`` is false; with ``wait``
         the call blocks until that process ends.
     """
-    folder = Path(folder)
+    return folder_locks([folder], wait=wait)
+
+
+@contextmanager
+def folder_locks(folders: Iterable[str | Path], *, wait: bool = False) -> Iterator[None]:
+    """Hold every folder's lock for the block (:func:`folder_lock`); one warning line
+    names the stale locks taken over (a killed run of many studies left one in each)."""
+    stale: list[tuple[Path, str]] = []
+    with ExitStack() as stack:
+        for folder in folders:
+            stack.enter_context(_lock(Path(folder), wait, stale))
+        if stale:
+            holders = sorted({who for _, who in stale})
+            where = (str(stale[0][0]) if len(stale) == 1 else
+                     f"{len(stale)} folders under {os.path.commonpath([f for f, _ in stale])}")
+            log.warning("taking over the stale lock%s on %s from %s, which is no longer "
+                        "running", "s" if len(stale) > 1 else "", where, " and ".join(holders))
+        yield
+
+
+@contextmanager
+def _lock(folder: Path, wait: bool, stale: list[tuple[Path, str]]) -> Iterator[None]:
+    """Hold ``folder/.lock``; a stale holder is added to ``stale``."""
     folder.mkdir(parents=True, exist_ok=True)
     fd = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
     try:
@@ -73,8 +94,7 @@ def folder_lock(folder: str | Path, *, wait: bool = False) -> Iterator[None]:
                 fcntl.flock(fd, fcntl.LOCK_EX)
         old = _holder(fd)
         if old:  # the last holder ended without releasing: crashed or killed
-            log.warning("taking over the stale lock on %s from %s, which is no longer "
-                        "running", folder, _describe(old))
+            stale.append((folder, _describe(old)))
         info = {"pid": os.getpid(), "host": socket.gethostname(),
                 "started": time.strftime("%Y-%m-%d %H:%M:%S")}
         os.ftruncate(fd, 0)

@@ -115,6 +115,10 @@ def _init_worker(parent: int, queue: Any) -> None:  # pragma: no cover - in work
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # already inherited when submit started us
     _die_with_parent(parent)
     _queue = queue
+    # A worker starts no processes. Under a "fork" start method numba guards its threading
+    # layer's start with a named semaphore (multiprocessing.RLock), which a terminated
+    # worker (Ctrl-C: stop_workers) never unlinks: "leaked semaphore objects" at exit.
+    mp.set_start_method("spawn", force=True)
     import numba
 
     numba.set_num_threads(1)  # one process per core; no nested threads

@@ -36,14 +36,14 @@ import itertools
 import os
 import queue as queue_mod
 import time
-from collections.abc import Callable, Hashable, Iterable, Iterator
+from collections.abc import Callable, Hashable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
 from . import _pool
 
-__all__ = ["STARTUP_SECONDS", "Task", "choose_workers", "run_tasks"]
+__all__ = ["STARTUP_SECONDS", "Task", "choose_workers", "own_seconds", "run_tasks"]
 
 #: Seconds to start the workers (the fork server importing the task modules,
 #: each worker loading the compiled kernels it uses) on the project's 2-core
@@ -119,6 +119,21 @@ def _timed(fn: Callable[..., Any], args: tuple[Any, ...],
     c0, w0 = time.process_time(), time.perf_counter()
     out = fn(*args, tick)
     return out, time.process_time() - c0, time.perf_counter() - w0
+
+
+#: ``key -> (cpu_seconds, wall_seconds, parent)`` of each task run (:func:`run_tasks`).
+Timing = Mapping[Hashable, tuple[float, float, Hashable]]
+
+
+def own_seconds(timing: Timing, prefix: tuple[Any, ...]) -> float:
+    """Wall seconds of the tasks whose key starts with ``prefix``.
+
+    The time spent on one study or figure, however its tasks interleaved with
+    others' on the pool (not the time since the pool started).
+    """
+    n = len(prefix)
+    return sum(wall for key, (_, wall, _) in timing.items()
+               if isinstance(key, tuple) and key[:n] == prefix)
 
 
 def run_tasks(tasks: Iterable[Task], on_done: OnDone, workers: int = 1,

@@ -37,7 +37,6 @@ import logging
 import math
 import time
 from collections.abc import Callable, Mapping
-from contextlib import ExitStack
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -50,8 +49,8 @@ from ..model.controllers import LocalVelocity
 from ..model.parameters import preset
 from ..simulation.options import IntegratorOptions
 from . import _pool, catalogue
-from ._lock import folder_lock
-from ._schedule import Task, choose_workers, run_tasks
+from ._lock import folder_locks
+from ._schedule import Task, Timing, choose_workers, own_seconds, run_tasks
 from .claims import ClaimResult, evaluate
 from .run import StudyJob
 
@@ -75,7 +74,8 @@ APPENDIX_E_SETTINGS: dict[str, dict[str, Any]] = {
     "full": {"n_random": 0, "one_at_a_time": True},
 }
 
-#: ``progress(stage, name, seconds)`` after each study or figure.
+#: ``progress(stage, name, seconds)`` after each study or figure, ``seconds`` its own time
+#: (the wall seconds of its tasks: :func:`tslip.sweeps._schedule.own_seconds`).
 Progress = Callable[[str, str, float], None]
 
 
@@ -360,10 +360,10 @@ class _Figures:
     """
 
     def __init__(self, res: str, out: Path, progress: Progress | None,
-                 arrived: Callable[[], None]) -> None:
+                 arrived: Callable[[], None], timing: Timing) -> None:
         from . import appendix_e
 
-        self.res, self.progress, self.t0 = res, progress, time.perf_counter()
+        self.res, self.progress, self.timing = res, progress, timing
         self.arrived: Callable[[], None] = lambda: None
         self.data: dict[str, Any] = {}
         self.tasks = [Task(("figure", k), _figure_task, (res, k), FIGURE_SECONDS[k])
@@ -392,7 +392,7 @@ class _Figures:
     def _done(self, key: str, value: Any) -> None:
         self.data[key] = value
         if self.progress:
-            self.progress("figure", key, time.perf_counter() - self.t0)
+            self.progress("figure", key, own_seconds(self.timing, ("figure", key)))
         self.arrived()
 
     def on_done(self, task: Task, result: Any) -> list[Task]:
@@ -485,7 +485,7 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
                   info: dict[str, Any] | None = None) -> dict[str, Any]:
     """Every study and single-gait figure as tasks of one scheduler; results by key.
 
-    Each study folder is locked (:func:`tslip.sweeps._lock.folder_lock`)
+    Each study folder is locked (:func:`tslip.sweeps._lock.folder_locks`)
     for the run. ``timing`` receives each task's CPU and wall seconds and
     the task that made it ready (:func:`tslip.sweeps._schedule.run_tasks`);
     ``on_result(data so far)`` is called after each study and figure, and
@@ -496,15 +496,13 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
     out = Path(out_dir)
     specs = catalogue.studies(res)
     results: dict[str, Any] = {}
+    timing = {} if timing is None else timing
     preload = ["tslip.sweeps.run", __name__, *(extra.modules if extra is not None else ())]
     if scheduler is None and workers != 1:  # likely parallel: the workers' imports start now
         _pool.prestart(preload)
-    with ExitStack() as locks:
-        jobs: dict[str, StudyJob] = {}
-        for name, spec in specs.items():
-            folder = out / "studies" / name
-            locks.enter_context(folder_lock(folder))
-            jobs[name] = StudyJob(spec, folder, writes=scheduler is None)
+    with folder_locks(out / "studies" / name for name in specs):
+        jobs = {name: StudyJob(spec, out / "studies" / name, writes=scheduler is None)
+                for name, spec in specs.items()}
 
         follow: list[Task] = []  # extra's tasks made ready by the last arrival
 
@@ -521,18 +519,17 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
             follow.clear()
             return out
 
-        figures = _Figures(res, out, progress, arrived)
+        figures = _Figures(res, out, progress, arrived, timing)
         cost = sum(j.cost for j in jobs.values()) + figures.cost
         cost += extra.cost if extra is not None else 0.0
         n = 1 if scheduler is not None else choose_workers(cost, workers)
         if info is not None:
             info["workers"] = n
-        t0 = time.perf_counter()
 
         def study_done(name: str) -> None:
-            results[name] = jobs.pop(name).result(n, scheduler)
+            results[name] = jobs.pop(name).result(n, scheduler, timing=timing)
             if progress:
-                progress("study", name, time.perf_counter() - t0)
+                progress("study", name, results[name].meta["seconds"])
             arrived()
 
         def on_done(task: Task, result: Any) -> list[Task]:

@@ -35,7 +35,7 @@ import hashlib
 import json
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -51,7 +51,7 @@ from ..gait.robustness import UNITS as ROBUSTNESS_UNITS
 from ..model.units import COLUMN_UNITS, UNIT, param_unit
 from . import _pool
 from ._lock import folder_lock
-from ._schedule import Task, choose_workers, run_tasks
+from ._schedule import Task, Timing, choose_workers, own_seconds, run_tasks
 from .point import (
     Pending,
     Solved,
@@ -292,8 +292,10 @@ def _run(spec: StudySpec, out: Path | None, n_workers: int | None, scheduler: st
          progress: Progress | None, csv: bool) -> StudyResult:
     job = StudyJob(spec, out, progress, writes=scheduler is None)
     workers = 1 if scheduler is not None else choose_workers(job.cost, n_workers)
-    run_tasks(job.start(), job.on_done, workers, tick=job.tick, scheduler=scheduler)
-    return job.result(workers, scheduler, csv)
+    timing: dict[Hashable, tuple[float, float, Hashable]] = {}
+    run_tasks(job.start(), job.on_done, workers, tick=job.tick, timing=timing,
+              scheduler=scheduler)
+    return job.result(workers, scheduler, csv, timing)
 
 
 #: Estimated seconds per point (warm compile cache, one core): its gait
@@ -323,7 +325,7 @@ class StudyJob:
 
     def __init__(self, spec: StudySpec, out: Path | None, progress: Progress | None = None,
                  writes: bool = True) -> None:
-        self.t_start = time.perf_counter()
+        t0 = time.perf_counter()
         self.spec, self.out, self.writes = spec, out, writes
         self.cache = out / "cache" if out is not None else None
         self.plan = study_keys(spec)
@@ -356,6 +358,7 @@ class StudyJob:
         self.depth = [0] * len(self.plan)
         for i in sorted(range(len(self.plan)), key=self._chain_index, reverse=True):
             self.depth[i] = 1 + max((self.depth[j] for j in self.succ[i]), default=0)
+        self.load_seconds = time.perf_counter() - t0  # reading the cache
 
     def _chain_index(self, i: int) -> int:
         """Distance of line ``i`` from its chain's root."""
@@ -455,9 +458,13 @@ class StudyJob:
                              self._cache_arg()), cost))
         return out
 
-    def result(self, workers: int, scheduler: str | None = None,
-               csv: bool = False) -> StudyResult:
-        """The study's table (written to its folder, with ``run.json``)."""
+    def result(self, workers: int, scheduler: str | None = None, csv: bool = False,
+               timing: Timing | None = None) -> StudyResult:
+        """The study's table (written to its folder, with ``run.json``).
+
+        ``meta["seconds"]`` is the study's own time: reading its cache and the wall
+        seconds of its tasks in ``timing`` (:func:`tslip.sweeps._schedule.run_tasks`).
+        """
         spec, out = self.spec, self.out
         if self.progress:
             self.progress(self.n_total, self.n_total)
@@ -469,7 +476,8 @@ class StudyJob:
             "tslip_version": __version__, "code": code_version(spec.analyses), "git": git_hash(),
             "study": spec.to_dict(), "points": self.n_total,
             "computed": self.n_total - self.n_cached, "cached": self.n_cached,
-            "seconds": time.perf_counter() - self.t_start, "workers": workers,
+            "seconds": self.load_seconds + own_seconds(timing or {}, (spec.name,)),
+            "workers": workers,
             "scheduler": scheduler, "tol": gait_tol(spec),
         }
         if out is not None:

@@ -4,7 +4,7 @@ A study is a frozen :class:`StudySpec`. Its points are the grid of its axes
 (one axis: a line; two axes: a grid, computed as one continuation line along
 the last axis per value of the first). Specs come from code or from TOML::
 
-    name = "mass offset"
+    name = "mass-offset"           # the results' folder name
     preset = "table2.1"            # base parameters
     analyses = ["floquet", "robustness"]
     n_steps = 25                   # strides a disturbed run must survive
@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import check_fits, check_number
+from .._checks import check_fits, check_name, check_number
 from .._io import read_toml
 from ..gait.continuation import get_param, set_param
 from ..model.parameters import Params, preset
@@ -94,7 +94,8 @@ class StudySpec:
     Parameters
     ----------
     name : str
-        Identifier; also the folder name of its results.
+        Identifier; also the folder name of its results: a letter or digit, then up to 63
+        letters, digits, "_", "." or "-" (:data:`tslip._checks.NAME_RULE`).
     base : Params
         Parameters at every point except the swept ones.
     axes : tuple of Axis
@@ -116,9 +117,7 @@ class StudySpec:
     meta: dict[str, Any] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
-        if not self.name or not isinstance(self.name, str) or "/" in self.name:
-            raise ValueError(f"study name must be a non-empty string without '/', got "
-                             f"{self.name!r}")
+        check_name(self.name, "study name")
         if not 1 <= len(self.axes) <= 2:
             raise ValueError(f"study {self.name}: needs one or two axes, got {len(self.axes)}")
         names = [a.param for a in self.axes]

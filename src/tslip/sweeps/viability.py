@@ -59,7 +59,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
-from .._checks import check_number
+from .._checks import check_name, check_number
 from .._codehash import code_hash
 from .._io import atomic_write, git_hash, read_toml, write_json
 from ..gait._viable import RULES
@@ -118,8 +118,7 @@ class ViabilitySpec:
     description: str = ""
 
     def __post_init__(self) -> None:
-        if not self.name or not isinstance(self.name, str) or "/" in self.name:
-            raise ValueError(f"name must be a non-empty string without '/', got {self.name!r}")
+        check_name(self.name, "viability name")
         if self.rule not in RULES:
             raise ValueError(f"rule must be one of {list(RULES)}, got {self.rule!r}")
         check_number(self.energy, "energy [MgL]", lower=0.0, lower_open=True)
