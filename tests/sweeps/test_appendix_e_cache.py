@@ -207,12 +207,12 @@ def test_the_parallel_reproduction_ignores_a_crafted_pickle(tiny, tmp_path) -> N
     """``run_all``'s figures (:class:`_Figures`) schedule Appendix E over a crafted file."""
     marker = tmp_path / "marker"
     _, new = _plant(tmp_path / "report", marker)
-    figs = reproduce._Figures("tiny", tmp_path / "report", None, lambda: None)
+    figs = reproduce._Figures("tiny", tmp_path / "report", None, lambda: None, {})
     assert not marker.exists()
     assert "E" not in figs.data and set(figs.e_pieces) == set(appendix_e.pieces(**SETTINGS))
     _, key = reproduce._appendix_e_entry(tmp_path, "tiny")
     reproduce._appendix_e_store(new, key, tiny)
-    figs = reproduce._Figures("tiny", tmp_path / "report", None, lambda: None)
+    figs = reproduce._Figures("tiny", tmp_path / "report", None, lambda: None, {})
     assert figs.e_pieces == {}
     same(tiny, figs.data["E"], "E")
 
