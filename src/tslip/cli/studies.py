@@ -51,6 +51,7 @@ def study_cmd(
     command resumes with the missing points.
     """
     from ..sweeps import StudySpec, run_study
+    from ..sweeps._warmup import announce
     from ..sweeps.run import StudyInterrupted
 
     console = make_console()
@@ -58,7 +59,7 @@ def study_cmd(
         spec = StudySpec.from_toml(spec_path)
         out_dir = out if out is not None else Path("studies") / spec.name
         check_output(out_dir / "run.json", "--out")  # before any work, naming the user's path
-        with progress_bar("pt") as bar:
+        with progress_bar("pt") as bar, announce(bar.console.print, ("simulation",)):
             task = bar.add_task(f"study {spec.name}", total=spec.n_points)
             try:
                 res = run_study(spec, out_dir, workers=workers, scheduler=scheduler, csv=csv,
@@ -85,13 +86,22 @@ def reproduce_cmd(
     scheduler: SchedulerOpt = None,
 ) -> None:
     """Run every thesis study and write a report (out/index.html)."""
+    from contextlib import ExitStack
+
     from rich.text import Text
 
+    from ..sweeps._warmup import announce
+
+    console = make_console()
+    with errors():
+        check_output(out / "index.html", "--out")  # before any work, naming the user's path
+    # before the slower imports: a first run says at once that it compiles
+    compiling = ExitStack()
+    compiling.enter_context(announce(console.print))
     from ..plotting.report import reproduce
     from ..sweeps import catalogue
     from ..sweeps.claims import Verdict
 
-    console = make_console()
     n_studies = len(catalogue.STUDIES)
     t0 = time.perf_counter()
     state = {"studies": 0}
@@ -105,8 +115,7 @@ def reproduce_cmd(
         elif stage == "figure":
             console.print(f"[{el:6.1f} s] figure {name} ({seconds:.1f} s)")
 
-    with errors(), interruptible():
-        check_output(out / "index.html", "--out")  # before any work, naming the user's path
+    with errors(), interruptible(), compiling:
         try:
             path = reproduce(out, quick=quick, workers=workers, scheduler=scheduler,
                              progress=progress)
