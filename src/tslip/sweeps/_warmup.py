@@ -33,19 +33,28 @@ POLL_SECONDS = 0.5
 
 
 def _study_point() -> None:
-    """A tiny study, serially: gait solves by continuation and every point analysis."""
+    """A tiny study's tasks, here: gait solves by continuation and every point analysis.
+
+    Not :func:`tslip.sweeps.run.run_study`: its serial path sets numba's
+    thread count, which starts numba's thread pool, and a fork server must
+    not hold threads when it forks.
+    """
     import dataclasses
 
     from . import catalogue
-    from .run import run_study
+    from .run import StudyJob
 
     spec = catalogue.study("leg_damping", "tiny")
-    run_study(dataclasses.replace(spec, analyses=("floquet", "robustness", "stride")),
-              workers=1)
+    job = StudyJob(dataclasses.replace(spec, analyses=("floquet", "robustness", "stride")),
+                   None, writes=False)
+    ready = job.start()
+    while ready:
+        task = ready.pop()
+        ready.extend(job.on_done(task, task.fn(*task.args, None)))
 
 
 def _recorded() -> None:
-    """The single-gait figures' computations (recorded runs, step-downs, pushes)."""
+    """The single-gait figures' and Table 6.1's computations (recorded runs, disturbances)."""
     from . import catalogue
 
     catalogue.fig_impulse_linearisation()
@@ -53,6 +62,9 @@ def _recorded() -> None:
     catalogue.fig_step_down()
     catalogue.fig_velocity_angle()
     catalogue.fig_friction()
+    from .reproduce import _table61_gait, pitch_rate_variants
+
+    pitch_rate_variants(_table61_gait())  # disturbances in flight: batches of runs
 
 
 def _biped(method: str) -> Callable[[], None]:
@@ -77,6 +89,8 @@ def warm(families: list[str]) -> None:
     """Compile or load the kernels of ``families`` by running each one's workload.
 
     Never raises: a family that fails here is compiled where it is first used.
+    Starts no threads (no workload runs a parallel kernel): it runs in the
+    fork server.
     """
     for name in families:
         try:

@@ -473,7 +473,8 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
     out = Path(out_dir)
     specs = catalogue.studies(res)
     results: dict[str, Any] = {}
-    preload = ["tslip.sweeps.run", __name__, *(extra.modules if extra is not None else ())]
+    preload = ["tslip.sweeps.run", __name__, *(extra.modules if extra is not None else ()),
+               "tslip.sweeps._prewarm"]  # last: compiles what the modules above use, once
     if scheduler is None and workers != 1:  # likely parallel: the workers' imports start now
         _pool.prestart(preload)
     with ExitStack() as locks:

@@ -280,7 +280,8 @@ def _run(spec: StudySpec, out: Path | None, n_workers: int | None, scheduler: st
          progress: Progress | None, csv: bool) -> StudyResult:
     job = StudyJob(spec, out, progress, writes=scheduler is None)
     workers = 1 if scheduler is not None else choose_workers(job.cost, n_workers)
-    run_tasks(job.start(), job.on_done, workers, tick=job.tick, scheduler=scheduler)
+    run_tasks(job.start(), job.on_done, workers, tick=job.tick, scheduler=scheduler,
+              preload=["tslip.sweeps._prewarm"])  # compiles missing kernels once, pre-fork
     return job.result(workers, scheduler, csv)
 
 
