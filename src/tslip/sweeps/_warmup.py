@@ -26,7 +26,7 @@ from contextlib import contextmanager
 
 from .. import _kernel_cache
 
-__all__ = ["WORKLOADS", "announce", "warm", "warm_missing"]
+__all__ = ["WORKLOADS", "announce", "warm", "warm_in_background", "warm_missing"]
 
 #: Seconds between two looks at the cache folders while compiling.
 POLL_SECONDS = 0.5
@@ -108,6 +108,20 @@ def warm_missing(packages: tuple[str, ...] = ("simulation", "biped")) -> list[st
         return []
     warm(missing)
     return missing
+
+
+def warm_in_background(packages: tuple[str, ...]) -> threading.Thread:
+    """:func:`warm_missing` of ``packages`` in a daemon thread of this process.
+
+    ``tslip reproduce`` compiles the biped's families here while the fork
+    server compiles the TSLIP's (first in :data:`tslip._kernel_cache.FAMILIES`):
+    the two share no cached kernel, so the fork server then loads the biped's
+    from disk instead of compiling them after the TSLIP's, on the second core.
+    """
+    thread = threading.Thread(target=warm_missing, args=(packages,), daemon=True,
+                              name="tslip-warm")
+    thread.start()
+    return thread
 
 
 @contextmanager

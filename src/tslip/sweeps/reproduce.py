@@ -54,6 +54,7 @@ from ..simulation.options import IntegratorOptions
 from . import _pool, catalogue
 from ._lock import folder_lock
 from ._schedule import Task, choose_workers, run_tasks
+from ._warmup import warm_in_background
 from .claims import ClaimResult, evaluate
 from .run import StudyJob
 
@@ -477,6 +478,7 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
                "tslip.sweeps._prewarm"]  # last: compiles what the modules above use, once
     if scheduler is None and workers != 1:  # likely parallel: the workers' imports start now
         _pool.prestart(preload)
+        warm_in_background(("biped",))  # on the other core, while the fork server warms
     with ExitStack() as locks:
         jobs: dict[str, StudyJob] = {}
         for name, spec in specs.items():
