@@ -86,3 +86,48 @@ def test_a_kernel_compiled_without_cache_is_left_alone(tmp_path):
     kc.check(f, str(tmp_path / "x.py"))
     assert not list(tmp_path.iterdir())
 
+
+
+def _fabricate(dirs, families, digest, skip=()):
+    """numba's index files (and the markers) of every kernel of ``families`` but ``skip``."""
+    for package, kernels in families.values():
+        folder = dirs[package]
+        folder.mkdir(exist_ok=True)
+        for kernel in kernels:
+            stem = kernel.split(".")[0]
+            (folder / f"{stem}.tslip-sources").write_text(digest)
+            if kernel not in skip:
+                (folder / f"{kernel}-12.py311.nbi").write_text("x")
+                (folder / f"{kernel}-12.py311.1.nbc").write_text("x")
+
+
+def test_missing_families_read_from_the_cache_folders(tmp_path):
+    dirs = {"simulation": tmp_path / "sim", "biped": tmp_path / "biped"}
+    for d in dirs.values():
+        d.mkdir()
+    assert kc.missing_families(dirs, "h") == list(kc.FAMILIES)  # empty: every family
+    _fabricate(dirs, kc.FAMILIES, "h")
+    assert kc.missing_families(dirs, "h") == []  # warm: none
+    assert kc.missing_families({"simulation": dirs["simulation"]}, "h") == []
+    # one kernel of one family gone: that family alone
+    name, (package, kernels) = next(iter(kc.FAMILIES.items()))
+    for f in dirs[package].glob(f"{kernels[-1]}-*"):
+        f.unlink()
+    assert kc.missing_families(dirs, "h") == [name]
+    # entries under another sources hash are stale (check() deletes them at import)
+    _fabricate(dirs, kc.FAMILIES, "h")
+    assert kc.missing_families(dirs, "other") == list(kc.FAMILIES)
+    assert kc.missing_families(dirs) == []  # without a digest the entries count
+
+
+def test_families_name_kernels_that_exist():
+    import importlib
+
+    for package, kernels in kc.FAMILIES.values():
+        for kernel in kernels:
+            module, name = kernel.split(".")
+            mod = importlib.import_module(f"tslip.{package}.{module}")
+            assert any(getattr(mod, n, None) is not None and getattr(
+                getattr(mod, n), "__name__", n) == name for n in dir(mod)) or any(
+                getattr(k, "__name__", "") == name for v in vars(mod).values()
+                if isinstance(v, tuple) for k in v), kernel

@@ -14,6 +14,12 @@ runs: the cache directory of the module carries a marker with a hash of all
 kernel sources (:data:`SOURCES`), and entries written under another hash
 are deleted (they are recompiled on first use). Concurrent imports (spawned
 workers) at worst delete each other's fresh entries, which costs a compile.
+
+A first run waits for numba to compile the kernels. :data:`FAMILIES` names
+the groups a user waits for, each by the numba index files of its kernels,
+and :func:`missing_families` tells from a cache folder (the kernels'
+:func:`cache_dirs`) which have no entry yet, so that a run can say so before
+it starts compiling.
 """
 
 from __future__ import annotations
@@ -21,9 +27,10 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
+from collections.abc import Mapping
 from pathlib import Path
 
-__all__ = ["SOURCES", "sources_hash", "check"]
+__all__ = ["FAMILIES", "SOURCES", "cache_dirs", "check", "missing_families", "sources_hash"]
 
 _ROOT = Path(__file__).parent
 
@@ -73,3 +80,54 @@ def check(dispatcher: object, module_file: str) -> None:
         os.replace(tmp, marker)
     except (OSError, AttributeError, TypeError):  # TypeError: a kernel without cache=True
         return
+
+
+#: The kernel families a first run compiles, as a user would name them: each
+#: its subpackage and the kernels (``module.function`` as numba names their
+#: index files ``module.function-LINE.pyXY.nbi``) that must all be cached.
+#: Measured: the kernels each workload of :mod:`tslip.sweeps._warmup` compiles
+#: that no other family compiles (their callees are cached with them).
+FAMILIES: dict[str, tuple[str, tuple[str, ...]]] = {
+    "TSLIP gait search and analyses": ("simulation", (
+        "_stride.stride_dopri5", "_stride.stride_dop853", "_variational.stride_jacobian_dop853",
+        "_stride.run_row_dopri5")),
+    "TSLIP recorded runs": ("simulation", (
+        "_record.record_run_dopri5", "_stride.run_batch_serial_dopri5", "_flight.flight_state")),
+    "biped (dopri5)": ("biped", ("_stride._integrate_dopri5",)),
+    "biped (dop853)": ("biped", ("_stride._integrate_dop853",)),
+}
+
+
+def cache_dirs() -> dict[str, Path]:
+    """numba's cache folder of each subpackage's kernels (imports them; compiles nothing)."""
+    from .biped import _stride as biped_stride
+    from .simulation import _stride
+
+    return {"simulation": Path(_stride.STRIDE[0]._cache.cache_path),
+            "biped": Path(biped_stride._integrate_dopri5._cache.cache_path)}
+
+
+def missing_families(dirs: Mapping[str, Path], digest: str | None = None,
+                     families: Mapping[str, tuple[str, tuple[str, ...]]] | None = None,
+                     ) -> list[str]:
+    """The ``families`` (default :data:`FAMILIES`) with a kernel not cached in ``dirs``.
+
+    ``dirs`` maps subpackages to their cache folders (:func:`cache_dirs`);
+    families of other subpackages are left out.
+    With ``digest`` (:func:`sources_hash`), a kernel counts as cached only if
+    its module's marker holds that digest (else :func:`check` deletes it).
+    Reads file names only: a pure function of the folders' contents.
+    """
+    out = []
+    for name, (package, kernels) in (FAMILIES if families is None else families).items():
+        if package not in dirs:
+            continue
+        folder = Path(dirs[package])
+        for kernel in kernels:
+            stem = kernel.split(".")[0]
+            marker = folder / f"{stem}.tslip-sources"
+            stale = digest is not None and (not marker.is_file() or marker.read_text() != digest)
+            if stale or not any(folder.glob(f"{kernel}-*.nbi")):
+                out.append(name)
+                break
+    return out

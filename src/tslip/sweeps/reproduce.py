@@ -51,6 +51,7 @@ from ..simulation.options import IntegratorOptions
 from . import _pool, catalogue
 from ._lock import folder_locks
 from ._schedule import Task, Timing, choose_workers, own_seconds, run_tasks
+from ._warmup import warm_in_background
 from .claims import ClaimResult, evaluate
 from .run import StudyJob
 
@@ -497,9 +498,11 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
     specs = catalogue.studies(res)
     results: dict[str, Any] = {}
     timing = {} if timing is None else timing
-    preload = ["tslip.sweeps.run", __name__, *(extra.modules if extra is not None else ())]
+    preload = ["tslip.sweeps.run", __name__, *(extra.modules if extra is not None else ()),
+               "tslip.sweeps._prewarm"]  # last: compiles what the modules above use, once
     if scheduler is None and workers != 1:  # likely parallel: the workers' imports start now
         _pool.prestart(preload)
+        warm_in_background(("biped",))  # on the other core, while the fork server warms
     with folder_locks(out / "studies" / name for name in specs):
         jobs = {name: StudyJob(spec, out / "studies" / name, writes=scheduler is None)
                 for name, spec in specs.items()}

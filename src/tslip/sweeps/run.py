@@ -294,7 +294,8 @@ def _run(spec: StudySpec, out: Path | None, n_workers: int | None, scheduler: st
     workers = 1 if scheduler is not None else choose_workers(job.cost, n_workers)
     timing: dict[Hashable, tuple[float, float, Hashable]] = {}
     run_tasks(job.start(), job.on_done, workers, tick=job.tick, timing=timing,
-              scheduler=scheduler)
+              scheduler=scheduler,
+              preload=["tslip.sweeps._prewarm"])  # compiles missing kernels once, pre-fork
     return job.result(workers, scheduler, csv, timing)
 
 

@@ -1,0 +1,164 @@
+"""The first run: compile each kernel family once, and say so while it happens.
+
+From an empty numba cache, a study or reproduction spends most of its first
+minute compiling. Two things make that bearable:
+
+* :func:`warm` compiles (or loads from numba's cache) every kernel family a
+  study's tasks use, by running a tiny computation of each through the
+  public code path, so each kernel is compiled with the very signatures the
+  tasks call it with. The fork server runs it before it forks the workers
+  (it imports :mod:`._prewarm`, which calls it): each kernel is then
+  compiled in one process only, and every worker starts with all kernels in
+  memory.
+* :func:`announce`, in the process the user watches, names the families
+  that are not cached yet (from the cache folders alone:
+  :func:`tslip._kernel_cache.missing_families`) and reports each as its
+  cache entries appear, whichever process compiles it. A warm run says
+  nothing.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+
+from .. import _kernel_cache
+
+__all__ = ["WORKLOADS", "announce", "warm", "warm_in_background", "warm_missing"]
+
+#: Seconds between two looks at the cache folders while compiling.
+POLL_SECONDS = 0.5
+
+
+def _study_point() -> None:
+    """A tiny study's tasks, here: gait solves by continuation and every point analysis.
+
+    Not :func:`tslip.sweeps.run.run_study`: its serial path sets numba's
+    thread count, which starts numba's thread pool, and a fork server must
+    not hold threads when it forks.
+    """
+    import dataclasses
+
+    from . import catalogue
+    from .run import StudyJob
+
+    spec = catalogue.study("leg_damping", "tiny")
+    job = StudyJob(dataclasses.replace(spec, analyses=("floquet", "robustness", "stride")),
+                   None, writes=False)
+    ready = job.start()
+    while ready:
+        task = ready.pop()
+        ready.extend(job.on_done(task, task.fn(*task.args, None)))
+
+
+def _recorded() -> None:
+    """The single-gait figures' and Table 6.1's computations (recorded runs, disturbances)."""
+    from . import catalogue
+
+    catalogue.fig_impulse_linearisation()
+    catalogue.fig_pitch_disturbance("table2.1")
+    catalogue.fig_step_down()
+    catalogue.fig_velocity_angle()
+    catalogue.fig_friction()
+    from .reproduce import _table61_gait, pitch_rate_variants
+
+    pitch_rate_variants(_table61_gait())  # disturbances in flight: batches of runs
+
+
+def _biped(method: str) -> Callable[[], None]:
+    def run() -> None:
+        from ..biped import BipedParams, BipedState, simulate
+        from ..biped.simulate import BipedOptions
+
+        simulate(BipedParams(), BipedState.thesis(), 1, options=BipedOptions(method=method))
+    return run
+
+
+#: How to compile each family of :data:`tslip._kernel_cache.FAMILIES`: a tiny run of it.
+WORKLOADS: dict[str, Callable[[], None]] = {
+    "TSLIP gait search and analyses": _study_point,
+    "TSLIP recorded runs": _recorded,
+    "biped (dopri5)": _biped("dopri5"),
+    "biped (dop853)": _biped("dop853"),
+}
+
+
+def warm(families: list[str]) -> None:
+    """Compile or load the kernels of ``families`` by running each one's workload.
+
+    Never raises: a family that fails here is compiled where it is first used.
+    Starts no threads (no workload runs a parallel kernel): it runs in the
+    fork server.
+    """
+    for name in families:
+        try:
+            WORKLOADS[name]()
+        except Exception:  # noqa: BLE001, S110 - the task that needs it will say why
+            pass
+
+
+def warm_missing(packages: tuple[str, ...] = ("simulation", "biped")) -> list[str]:
+    """:func:`warm` the families of ``packages`` not in numba's cache yet; those families."""
+    try:
+        dirs = {k: v for k, v in _kernel_cache.cache_dirs().items() if k in packages}
+        missing = _kernel_cache.missing_families(dirs, _kernel_cache.sources_hash())
+    except (OSError, AttributeError, ImportError):
+        return []
+    warm(missing)
+    return missing
+
+
+def warm_in_background(packages: tuple[str, ...]) -> threading.Thread:
+    """:func:`warm_missing` of ``packages`` in a daemon thread of this process.
+
+    ``tslip reproduce`` compiles the biped's families here while the fork
+    server compiles the TSLIP's (first in :data:`tslip._kernel_cache.FAMILIES`):
+    the two share no cached kernel, so the fork server then loads the biped's
+    from disk instead of compiling them after the TSLIP's, on the second core.
+    """
+    thread = threading.Thread(target=warm_missing, args=(packages,), daemon=True,
+                              name="tslip-warm")
+    thread.start()
+    return thread
+
+
+@contextmanager
+def announce(echo: Callable[[str], None], packages: tuple[str, ...] = ("simulation", "biped"),
+             ) -> Iterator[list[str]]:
+    """Say which kernel families of ``packages`` are not compiled yet, and each as it gets cached.
+
+    Prints nothing when every family is cached. Yields the missing families.
+    """
+    try:
+        dirs = {k: v for k, v in _kernel_cache.cache_dirs().items() if k in packages}
+        digest = _kernel_cache.sources_hash()
+        missing = _kernel_cache.missing_families(dirs, digest)
+    except (OSError, AttributeError, ImportError):
+        missing = []
+    if not missing:
+        yield []
+        return
+    echo(f"first run: compiling {len(missing)} kernel families not in numba's cache yet "
+         f"({', '.join(missing)}); later runs load them")
+    t0 = time.perf_counter()
+    stop = threading.Event()
+    families = {k: _kernel_cache.FAMILIES[k] for k in missing}
+
+    def watch() -> None:
+        left = list(missing)
+        while left and not stop.wait(POLL_SECONDS):
+            now = _kernel_cache.missing_families(dirs, digest, families)
+            for name in [f for f in left if f not in now]:
+                left.remove(name)
+                echo(f"  compiled {name} ({len(missing) - len(left)}/{len(missing)}, "
+                     f"{time.perf_counter() - t0:.0f} s)")
+
+    thread = threading.Thread(target=watch, daemon=True, name="tslip-compile-watch")
+    thread.start()
+    try:
+        yield missing
+    finally:
+        stop.set()
+        thread.join(timeout=2 * POLL_SECONDS)

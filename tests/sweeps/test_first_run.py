@@ -1,0 +1,137 @@
+"""The first run: it says which kernel families it compiles, and compiles each once."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from tslip import _kernel_cache as kc
+
+_ANNOUNCE = textwrap.dedent("""
+    import json, sys, time
+    from tslip import _kernel_cache as kc
+    from tslip.sweeps._warmup import announce
+    print(json.dumps({k: str(v) for k, v in kc.cache_dirs().items()}), flush=True)
+    if sys.argv[1] == "fabricate":
+        sys.exit(0)
+    with announce(lambda s: print("SAID " + s, flush=True)) as missing:
+        pass
+""")
+
+
+def _run(cache: Path, mode: str) -> list[str]:
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(cache)}
+    out = subprocess.run([sys.executable, "-c", _ANNOUNCE, mode], env=env, text=True,
+                         capture_output=True, timeout=120, check=True).stdout
+    return out.splitlines()
+
+
+def test_a_cold_cache_is_announced_and_a_warm_one_is_not(tmp_path):
+    cold = _run(tmp_path, "announce")
+    said = [s for s in cold if s.startswith("SAID ")]
+    assert len(said) == 1 and "compiling 4 kernel families" in said[0]
+    for name in kc.FAMILIES:
+        assert name in said[0]
+    # the same folders, as a warm cache (index files of every family's kernels)
+    dirs = {k: Path(v) for k, v in json.loads(_run(tmp_path, "fabricate")[0]).items()}
+    for package, kernels in kc.FAMILIES.values():
+        dirs[package].mkdir(parents=True, exist_ok=True)
+        for kernel in kernels:
+            stem = kernel.split(".")[0]
+            (dirs[package] / f"{stem}.tslip-sources").write_text(kc.sources_hash())
+            (dirs[package] / f"{kernel}-12.py311.nbi").write_text("x")
+    warm = _run(tmp_path, "announce")
+    assert not [s for s in warm if s.startswith("SAID ")]
+
+
+_RECORDER = textwrap.dedent("""
+    import os
+    from numba.core import event
+
+    class _Log(event.Listener):
+        def on_start(self, e):
+            pass
+
+        def on_end(self, e):
+            d = e.data["dispatcher"]
+            with open(os.environ["TSLIP_TEST_COMPILE_LOG"], "a") as f:
+                f.write(f"{os.getpid()}\\t{d.py_func.__module__}.{d.py_func.__qualname__}"
+                        f"\\t{e.data['args']}\\n")
+
+    event.register("numba:compile", _Log())
+""")
+
+_RUN = textwrap.dedent("""
+    import sys
+    import tslip.simulation  # noqa: F401 - the fork server warms the TSLIP's families
+    from tslip.sweeps._schedule import Task, run_tasks
+
+    def gait(name, tick):
+        from tslip.sweeps import catalogue
+        return catalogue._gait(name).converged
+
+    if __name__ == "__main__":
+        tasks = [Task(("a",), gait, ("table2.1",)), Task(("b",), gait, ("table6.1",))]
+        run_tasks(tasks, lambda task, result: [], workers=2, preload=sys.argv[1:])
+""")
+
+
+@pytest.mark.slow
+def test_no_kernel_is_compiled_in_two_processes(tmp_path):
+    """Two gait searches at once on 2 workers from an empty cache, as a study's pool runs
+    them: every kernel signature compiles in one process (here, the fork server).
+
+    Without ``tslip.sweeps._prewarm`` in the preload, both workers compile the
+    stride kernels at the same moment (the break check of this test).
+    """
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "sitecustomize.py").write_text(_RECORDER)  # runs in every process (fork server too)
+    (tmp_path / "run.py").write_text(_RUN)
+    log = tmp_path / "compiles.tsv"
+    src = str(Path(kc.__file__).parents[1])
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
+           "TSLIP_TEST_COMPILE_LOG": str(log),
+           "PYTHONPATH": os.pathsep.join([str(site), src])}
+    subprocess.run([sys.executable, str(tmp_path / "run.py"), "tslip.sweeps._prewarm"],
+                   env=env, check=True, timeout=1800, cwd=tmp_path, capture_output=True)
+    where: dict[tuple[str, str], set[str]] = {}
+    for line in log.read_text().splitlines():
+        pid, fn, args = line.split("\t")
+        where.setdefault((fn, args), set()).add(pid)
+    assert any(fn.endswith("stride_dopri5") for fn, _ in where)  # it did compile
+    twice = {k: v for k, v in where.items() if len(v) > 1}
+    assert not twice, twice
+
+
+def test_study_and_reproduce_pools_warm_their_kernels_before_forking(monkeypatch, tmp_path):
+    """The wiring: both pools' fork servers import ``_prewarm``, last (after the task modules)."""
+    from tslip.sweeps import _pool, catalogue, reproduce, run
+
+    seen = {}
+
+    class Stop(Exception):
+        pass
+
+    def run_tasks(*args, preload=(), **kwargs):
+        seen["study"] = list(preload)
+        raise Stop
+
+    def prestart(preload):
+        seen["reproduce"] = list(preload)
+        raise Stop
+
+    monkeypatch.setattr(run, "run_tasks", run_tasks)
+    with pytest.raises(Stop):
+        run.run_study(catalogue.study("leg_damping", "tiny"), workers=2)
+    assert seen["study"] == ["tslip.sweeps._prewarm"]
+    monkeypatch.setattr(_pool, "prestart", prestart)
+    with pytest.raises(Stop):
+        reproduce.run_catalogue(tmp_path, "tiny", workers=2)
+    assert seen["reproduce"][-1] == "tslip.sweeps._prewarm"
