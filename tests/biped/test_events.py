@@ -21,6 +21,8 @@ from tslip.biped.dynamics import mass_matrix
 from tslip.biped.simulate import to_status
 from tslip.sweeps.appendix_e import table_e2_perturbations
 
+from ._foot import foot
+
 
 def _opts(tol, method="dopri5"):
     return BipedOptions(rtol=tol, atol=tol, method=method)
@@ -55,13 +57,7 @@ def _scipy_stride(p, y0, tol):
         return out
 
     def foot_z(y, leg):
-        gam = y[2] + y[5 + 3 * leg]
-        s = y[3 + 3 * leg] + y[4 + 3 * leg]
-        sd = y[12 + 3 * leg] + y[13 + 3 * leg]
-        z = y[1] + p.r_1 * np.cos(y[2]) - s * np.cos(gam)
-        zd = (y[10] - p.r_1 * np.sin(y[2]) * y[11] - sd * np.cos(gam)
-              + s * np.sin(gam) * (y[11] + y[14 + 3 * leg]))
-        return z, zd
+        return foot(p, y, leg)
 
     def contact(leg):
         def g(t, y):

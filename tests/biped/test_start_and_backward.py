@@ -8,23 +8,18 @@ a contact), and eq. 2.10's fall rule (the body moving backward, ``xd_b < 0``).
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from tslip.biped import BipedParams, BipedState, Status, simulate
+
+from ._foot import foot
 
 P = BipedParams()
 
 
 def _foot(y, leg):
     """Height and vertical speed of a foot (eq. E.8)."""
-    gam = y[2] + y[5 + 3 * leg]
-    s = y[3 + 3 * leg] + y[4 + 3 * leg]
-    sd = y[12 + 3 * leg] + y[13 + 3 * leg]
-    z = y[1] + P.r_1 * np.cos(y[2]) - s * np.cos(gam)
-    zd = (y[10] - P.r_1 * np.sin(y[2]) * y[11] - sd * np.cos(gam)
-          + s * np.sin(gam) * (y[11] + y[14 + 3 * leg]))
-    return z, zd
+    return foot(P, y, leg)
 
 
 @pytest.mark.parametrize("zd", [-0.44, -0.1, 0.3, 1.0])
