@@ -7,11 +7,10 @@ import tomllib
 from importlib.metadata import packages_distributions
 from pathlib import Path
 
-import tslip
-
-ROOT = Path(tslip.__file__).parent
-TESTS = Path(__file__).parent
-PYPROJECT = ROOT.parents[1] / "pyproject.toml"
+#: The checkout's files, not the installed package's (CI installs a copy in site-packages).
+TESTS = Path(__file__).resolve().parent
+ROOT = TESTS.parent / "src" / "tslip"
+PYPROJECT = TESTS.parent / "pyproject.toml"
 
 
 def _name(requirement: str) -> str:

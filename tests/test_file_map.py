@@ -3,10 +3,9 @@
 import re
 from pathlib import Path
 
-import tslip
-
-ROOT = Path(tslip.__file__).parent
-REPO = ROOT.parents[1]
+#: The checkout's files, not the installed package's (CI installs a copy in site-packages).
+REPO = Path(__file__).resolve().parents[1]
+ROOT = REPO / "src" / "tslip"
 
 
 def _map_paths(text: str) -> set[str]:

@@ -30,7 +30,7 @@ import os
 from collections.abc import Mapping
 from pathlib import Path
 
-__all__ = ["FAMILIES", "SOURCES", "cache_dirs", "check", "missing_families", "sources_hash"]
+__all__ = ["FAMILIES", "SOURCES", "check", "missing_families", "sources_hash"]
 
 _ROOT = Path(__file__).parent
 
@@ -98,21 +98,13 @@ FAMILIES: dict[str, tuple[str, tuple[str, ...]]] = {
 }
 
 
-def cache_dirs() -> dict[str, Path]:
-    """numba's cache folder of each subpackage's kernels (imports them; compiles nothing)."""
-    from .biped import _stride as biped_stride
-    from .simulation import _stride
-
-    return {"simulation": Path(_stride.STRIDE[0]._cache.cache_path),
-            "biped": Path(biped_stride._integrate_dopri5._cache.cache_path)}
-
-
 def missing_families(dirs: Mapping[str, Path], digest: str | None = None,
                      families: Mapping[str, tuple[str, tuple[str, ...]]] | None = None,
                      ) -> list[str]:
     """The ``families`` (default :data:`FAMILIES`) with a kernel not cached in ``dirs``.
 
-    ``dirs`` maps subpackages to their cache folders (:func:`cache_dirs`);
+    ``dirs`` maps subpackages to their cache folders
+    (:func:`tslip.sweeps._warmup.cache_dirs`);
     families of other subpackages are left out.
     With ``digest`` (:func:`sources_hash`), a kernel counts as cached only if
     its module's marker holds that digest (else :func:`check` deletes it).

@@ -15,9 +15,8 @@ from tslip import _kernel_cache as kc
 
 _ANNOUNCE = textwrap.dedent("""
     import json, sys, time
-    from tslip import _kernel_cache as kc
-    from tslip.sweeps._warmup import announce
-    print(json.dumps({k: str(v) for k, v in kc.cache_dirs().items()}), flush=True)
+    from tslip.sweeps._warmup import announce, cache_dirs
+    print(json.dumps({k: str(v) for k, v in cache_dirs().items()}), flush=True)
     if sys.argv[1] == "fabricate":
         sys.exit(0)
     with announce(lambda s: print("SAID " + s, flush=True)) as missing:

@@ -23,6 +23,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from pathlib import Path
 
 from .. import _kernel_cache
 
@@ -76,6 +77,20 @@ def _biped(method: str) -> Callable[[], None]:
     return run
 
 
+def cache_dirs() -> dict[str, Path]:
+    """numba's cache folder of each subpackage's kernels (imports them; compiles nothing).
+
+    Here, not in :mod:`tslip._kernel_cache`, which every kernel module imports:
+    the code hash follows imports, so a kernel module importing both models'
+    kernels would key every TSLIP result on the biped's code too.
+    """
+    from ..biped import _stride as biped_stride
+    from ..simulation import _stride
+
+    return {"simulation": Path(_stride.STRIDE[0]._cache.cache_path),
+            "biped": Path(biped_stride._integrate_dopri5._cache.cache_path)}
+
+
 #: How to compile each family of :data:`tslip._kernel_cache.FAMILIES`: a tiny run of it.
 WORKLOADS: dict[str, Callable[[], None]] = {
     "TSLIP gait search and analyses": _study_point,
@@ -102,7 +117,7 @@ def warm(families: list[str]) -> None:
 def warm_missing(packages: tuple[str, ...] = ("simulation", "biped")) -> list[str]:
     """:func:`warm` the families of ``packages`` not in numba's cache yet; those families."""
     try:
-        dirs = {k: v for k, v in _kernel_cache.cache_dirs().items() if k in packages}
+        dirs = {k: v for k, v in cache_dirs().items() if k in packages}
         missing = _kernel_cache.missing_families(dirs, _kernel_cache.sources_hash())
     except (OSError, AttributeError, ImportError):
         return []
@@ -132,7 +147,7 @@ def announce(echo: Callable[[str], None], packages: tuple[str, ...] = ("simulati
     Prints nothing when every family is cached. Yields the missing families.
     """
     try:
-        dirs = {k: v for k, v in _kernel_cache.cache_dirs().items() if k in packages}
+        dirs = {k: v for k, v in cache_dirs().items() if k in packages}
         digest = _kernel_cache.sources_hash()
         missing = _kernel_cache.missing_families(dirs, digest)
     except (OSError, AttributeError, ImportError):
