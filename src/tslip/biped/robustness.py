@@ -23,6 +23,7 @@ from ..gait.robustness import (
     RobustnessLimits,
     _deprecated_start,
     _grid_step,
+    _grid_steps,
     search_limit,
 )
 from .gait import DISTURBANCES, REFINE_OPTIONS, Gait, disturbed_outcome, floquet
@@ -140,13 +141,7 @@ def robustness_report(gait: Gait, *, n_steps: int = 25, kinds: Sequence[str] = D
     for kind in kinds:
         if kind not in DISTURBANCES:
             raise ValueError(f"kind must be one of {DISTURBANCES}, got {kind!r}")
-    given = dict(h or {})
-    if not set(given) <= set(DISTURBANCES):
-        raise ValueError(f"h must map kinds among {DISTURBANCES} to grid steps, "
-                         f"got keys {sorted(given)}")
-    old = _deprecated_start(start)
-    steps = {kind: _grid_step(given.get(kind), old) if kind in given or old is not None
-             else GRID_STEPS[kind] for kind in kinds}
+    steps = _grid_steps(kinds, h, start, GRID_STEPS)
     signs = tuple(signs) if signs is not None else (-1, 1) if both_signs else (-1,)
     if check:
         check_gait(gait)

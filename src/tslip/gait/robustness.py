@@ -311,12 +311,29 @@ def limit_search(
     return _done(lo, hi, mags, oks)
 
 
-def _deprecated_start(start: float | None) -> float | None:
+def _deprecated_start(start: float | None, stacklevel: int = 4) -> float | None:
     """The public functions' old ``start`` (the ladder's first rung), now ``h``: warns."""
     if start is not None:
         warn_renamed("start= (the first rung of the old doubling ladder)",
-                     "h= (the grid step, tslip.gait.robustness.GRID_STEPS)", stacklevel=4)
+                     "h= (the grid step, tslip.gait.robustness.GRID_STEPS)",
+                     stacklevel=stacklevel)
     return start
+
+
+def _grid_steps(kinds: Sequence[str], h: Mapping[str, float] | None, start: float | None,
+                defaults: Mapping[str, float]) -> dict[str, float]:
+    """Each kind's grid step: ``h[kind]``, else the old ``start`` (warns), else ``defaults``.
+
+    The one resolution of a report's ``h`` for both models (``defaults`` is
+    :data:`GRID_STEPS` or the biped's); ``h`` may name only kinds of ``defaults``.
+    """
+    given = dict(h or {})
+    if not set(given) <= set(defaults):
+        raise ValueError(f"h must map kinds among {tuple(defaults)} to grid steps, "
+                         f"got keys {sorted(given)}")
+    old = _deprecated_start(start, stacklevel=6)
+    return {kind: _grid_step(given.get(kind), old) if kind in given or old is not None
+            else defaults[kind] for kind in kinds}
 
 
 def _grid_step(h: float | None, start: float | None) -> float:
@@ -761,12 +778,7 @@ def robustness_report(
         _check_kind(kind)
         if kind != "step_down":
             _check_placement(kind, placement)
-    given = dict(h or {})
-    if not set(given) <= set(KINDS):
-        raise ValueError(f"h must map kinds among {KINDS} to grid steps, got keys {sorted(given)}")
-    old = _deprecated_start(start)
-    steps = {kind: _grid_step(given.get(kind), old) if kind in given or old is not None
-             else GRID_STEPS[kind] for kind in kinds}
+    steps = _grid_steps(kinds, h, start, GRID_STEPS)
     if check:
         check_gait(gait)
     signs = (-1, 1) if both_signs else (-1,)
