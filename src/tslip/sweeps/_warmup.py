@@ -77,18 +77,37 @@ def _biped(method: str) -> Callable[[], None]:
     return run
 
 
-def cache_dirs() -> dict[str, Path]:
-    """numba's cache folder of each subpackage's kernels (imports them; compiles nothing).
+def cache_dirs(packages: tuple[str, ...] = ("simulation", "biped")) -> dict[str, Path]:
+    """numba's cache folder of the kernels of ``packages`` (imports them; compiles nothing).
 
     Here, not in :mod:`tslip._kernel_cache`, which every kernel module imports:
     the code hash follows imports, so a kernel module importing both models'
     kernels would key every TSLIP result on the biped's code too.
     """
-    from ..biped import _stride as biped_stride
-    from ..simulation import _stride
+    dirs = {}
+    if "simulation" in packages:
+        from ..simulation import _stride
 
-    return {"simulation": Path(_stride.STRIDE[0]._cache.cache_path),
-            "biped": Path(biped_stride._integrate_dopri5._cache.cache_path)}
+        dirs["simulation"] = Path(_stride.STRIDE[0]._cache.cache_path)
+    if "biped" in packages:
+        from ..biped import _stride as biped_stride
+
+        dirs["biped"] = Path(biped_stride._integrate_dopri5._cache.cache_path)
+    return dirs
+
+
+def _missing(packages: tuple[str, ...]) -> tuple[dict[str, Path], str, list[str]]:
+    """The cache folders of ``packages``, the sources' digest and the families not cached.
+
+    No family is missing when the folders cannot be read (numba then compiles
+    where a kernel is first used, as without this module).
+    """
+    try:
+        dirs = cache_dirs(packages)
+        digest = _kernel_cache.sources_hash()
+        return dirs, digest, _kernel_cache.missing_families(dirs, digest)
+    except (OSError, AttributeError, ImportError):
+        return {}, "", []
 
 
 #: How to compile each family of :data:`tslip._kernel_cache.FAMILIES`: a tiny run of it.
@@ -116,11 +135,7 @@ def warm(families: list[str]) -> None:
 
 def warm_missing(packages: tuple[str, ...] = ("simulation", "biped")) -> list[str]:
     """:func:`warm` the families of ``packages`` not in numba's cache yet; those families."""
-    try:
-        dirs = {k: v for k, v in cache_dirs().items() if k in packages}
-        missing = _kernel_cache.missing_families(dirs, _kernel_cache.sources_hash())
-    except (OSError, AttributeError, ImportError):
-        return []
+    missing = _missing(packages)[2]
     warm(missing)
     return missing
 
@@ -146,12 +161,7 @@ def announce(echo: Callable[[str], None], packages: tuple[str, ...] = ("simulati
 
     Prints nothing when every family is cached. Yields the missing families.
     """
-    try:
-        dirs = {k: v for k, v in cache_dirs().items() if k in packages}
-        digest = _kernel_cache.sources_hash()
-        missing = _kernel_cache.missing_families(dirs, digest)
-    except (OSError, AttributeError, ImportError):
-        missing = []
+    dirs, digest, missing = _missing(packages)
     if not missing:
         yield []
         return
