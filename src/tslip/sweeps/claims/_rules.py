@@ -150,14 +150,6 @@ def _rank_corr(x: np.ndarray, y: np.ndarray) -> float:
     return _corr(pd.Series(x[ok]).rank().to_numpy(), pd.Series(y[ok]).rank().to_numpy())
 
 
-def _ends(f: pd.DataFrame, col: str) -> tuple[float, float]:
-    """|col| at the first and the last stable point with a finite value."""
-    s = _stable(f)
-    v = _abs(s, col)
-    v = v[np.isfinite(v)]
-    return (float(v[0]), float(v[-1])) if v.size else (math.nan, math.nan)
-
-
 def _r(x: float, d: int = 3) -> float:
     return round(float(x), d) if math.isfinite(float(x)) else math.nan
 
