@@ -82,28 +82,44 @@ they count as failures of the disturbance, and the result records the reason.
 The biped (:mod:`tslip.biped.robustness`) searches its limits with the same
 :func:`search_limit` and reports them in the same :class:`RobustnessLimit`
 and :class:`RobustnessLimits`.
+
+The parts live beside this module, which re-exports their names: the
+disturbances and the runs that start from them in
+:mod:`tslip.gait._disturbances`, the search in :mod:`tslip.gait._first_failure`;
+here are the grid steps, the results and the searches of a gait.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Literal
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._renamed import warn_renamed
 from .._results import Result, frame
-from ..model import _pack as pk
 from ..model.parameters import Params
 from ..model.state import TouchdownState
-from ..model.terrain import Terrain
-from ..simulation import _kernels as kn
-from ..simulation import _packed
-from ..simulation.integrate import BatchRun, run_batch, step
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status
+from ._disturbances import (
+    KINDS,
+    PLACEMENTS,
+    UNITS,
+    Kind,
+    Placement,
+    _check_kind,
+    _check_placement,
+    _touchdown_runner,
+    run_disturbed,
+)
+from ._first_failure import (
+    LimitSearch,
+    _deprecated_start,
+    _grid_step,
+    _grid_steps,
+    limit_search,
+)
 from .fixed_point import Gait
 
 if TYPE_CHECKING:
@@ -127,22 +143,8 @@ __all__ = [
     "run_disturbed",
 ]
 
-Kind = Literal["step_down", "push", "pitch_rate"]
-
-#: The three disturbances of thesis Section 3.1.3, in the thesis's order.
-KINDS: tuple[Kind, ...] = ("step_down", "push", "pitch_rate")
-
-Placement = Literal["touchdown", "touchdown_hip", "liftoff", "apex"]
-
-#: Where a push or pitch-rate disturbance can be applied (see the module notes).
-PLACEMENTS: tuple[Placement, ...] = ("touchdown", "touchdown_hip", "liftoff", "apex")
-
-#: Unit of each disturbance (Table 3.1, dimensionless units).
-UNITS: dict[str, str] = {
-    "step_down": "L",
-    "push": "g^1/2 L^1/2",
-    "pitch_rate": "rad g^1/2 L^-1/2",
-}
+#: ``limit_search``'s example runs with this module's (``tests/test_api.py``).
+__test__ = {"limit_search": limit_search}
 
 #: Grid step ``h`` of the first-failure scan per disturbance kind, in its
 #: unit (:data:`UNITS`; module notes). About 1/30 of the kind's typical limit,
@@ -157,319 +159,6 @@ UNITS: dict[str, str] = {
 #: push and 0.005-0.095 for the pitch rate: narrower ones can fall between
 #: grid points (module notes).
 GRID_STEPS: dict[str, float] = {"step_down": 0.005, "push": 0.02, "pitch_rate": 0.02}
-
-_SECTION_COLUMN = {"push": 2, "pitch_rate": 4}  # xd, phid in TouchdownState.as_array()
-_FLIGHT_COLUMN = {"push": 2, "pitch_rate": 5}  # xd, phid in the lift-off (x, y, xd, yd, phi, phid)
-_DEFAULT_OPTIONS = IntegratorOptions()  # the thesis's 1e-8, built (and checked) once
-
-
-# ---------------------------------------------------------------------------
-# The search: a grid scan for the first failure, then k-section (pure)
-# ---------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, slots=True)
-class LimitSearch:
-    """Outcome of :func:`limit_search` (magnitudes, all >= 0).
-
-    Attributes
-    ----------
-    lo : float
-        The limit: every grid magnitude up to it survives, as does every
-        k-section point below it; in ``[0, h)`` if the first grid point
-        failed, ``inf`` if nothing failed up to ``max_magnitude``.
-    hi : float
-        The first failure found, ``hi - lo <= tol`` (``inf`` if none).
-    n_calls : int
-        Calls of the predicate (batches).
-    n_evals : int
-        Magnitudes evaluated in all calls.
-    magnitudes, survived : ndarray, shape (n_evals,)
-        Every evaluated magnitude and its outcome, in evaluation order.
-    """
-
-    lo: float
-    hi: float
-    n_calls: int
-    n_evals: int
-    magnitudes: np.ndarray = field(repr=False)
-    survived: np.ndarray = field(repr=False)
-
-    @property
-    def bounded(self) -> bool:
-        """True if a failing magnitude was found."""
-        return math.isfinite(self.hi)
-
-
-def limit_search(
-    survives: Callable[[np.ndarray], np.ndarray],
-    *,
-    h: float | None = None,
-    tol: float = 1e-4,
-    ladder: int = 8,
-    k: int = 3,
-    max_magnitude: float = 100.0,
-    start: float | None = None,
-) -> LimitSearch:
-    """The first failure: a grid scan of step ``h``, then k-section (module notes).
-
-    Parameters
-    ----------
-    survives : callable
-        ``survives(m)`` with ``m`` an ndarray of ascending magnitudes (> 0)
-        returns a bool array of the same shape: True where the disturbance of
-        that magnitude is survived. Called once per batch.
-    h : float
-        Grid step (> 0), in the magnitude's unit; the grid is ``h, 2h, ...``
-        (:data:`GRID_STEPS` for the three disturbances).
-    tol : float
-        Final bracket width ``hi - lo`` (> 0), in the magnitude's unit.
-    ladder : int
-        Grid points evaluated per scan call (>= 1); if all survive, the next
-        call continues the grid.
-    k : int
-        Interior points per k-section call (>= 1; 1 is bisection). Each call
-        shrinks the bracket ``k + 1`` times.
-    max_magnitude : float
-        End of the grid (the last point is clipped to it); the scan costs up
-        to ``max_magnitude / h`` evaluations when nothing fails.
-    start : float, optional
-        The old name of ``h`` (the doubling ladder's first rung, as ``h`` is
-        the grid's); give one of the two.
-
-    Returns
-    -------
-    LimitSearch
-        ``lo`` survives and ``hi`` fails, with ``hi - lo <= tol``; no grid
-        point at or below ``lo`` and no k-section point below ``lo`` fails.
-
-    Raises
-    ------
-    ValueError
-        For no or a non-positive ``h``, non-positive ``tol``/``max_magnitude``,
-        ``ladder < 1``, ``k < 1``, or a predicate answer of the wrong shape.
-
-    Examples
-    --------
-    Survival on [0, 0.3) and on an island [0.5, 0.6): the limit is 0.3.
-
-    >>> s = limit_search(lambda m: (m < 0.3) | ((m >= 0.5) & (m < 0.6)), h=0.01, tol=1e-3)
-    >>> s.lo < 0.3 <= s.hi, s.hi - s.lo <= 1e-3, s.n_calls
-    (True, True, 6)
-    """
-    h = _grid_step(h, start)
-    for name, v in (("tol", tol), ("max_magnitude", max_magnitude)):
-        if not (math.isfinite(v) and v > 0):
-            raise ValueError(f"{name} must be in (0, inf), got {v!r}")
-    if h > max_magnitude:
-        raise ValueError(f"h ({h!r}) must not exceed max_magnitude ({max_magnitude!r})")
-    for name, n in (("ladder", ladder), ("k", k)):
-        if not isinstance(n, (int, np.integer)) or n < 1:
-            raise ValueError(f"{name} must be an integer >= 1, got {n!r}")
-    mags: list[np.ndarray] = []
-    oks: list[np.ndarray] = []
-
-    def ask(m: np.ndarray) -> np.ndarray:
-        ok = np.asarray(survives(m), dtype=bool)
-        if ok.shape != m.shape:
-            raise ValueError(f"survives must return shape {m.shape}, got {ok.shape}")
-        mags.append(m)
-        oks.append(ok)
-        return ok
-
-    lo, hi = 0.0, math.inf
-    j = 0  # grid points asked so far
-    while not math.isfinite(hi):  # grid scan: ``ladder`` points j*h per call
-        rungs = h * np.arange(j + 1, j + int(ladder) + 1)
-        j += int(ladder)
-        rungs = rungs[rungs < max_magnitude]
-        if len(rungs) < ladder:
-            rungs = np.append(rungs, max_magnitude)
-        ok = ask(rungs)
-        fail = np.flatnonzero(~ok)
-        if fail.size:
-            i = int(fail[0])
-            hi = float(rungs[i])
-            lo = float(rungs[i - 1]) if i > 0 else lo
-        else:
-            lo = float(rungs[-1])
-            if lo >= max_magnitude:
-                return _done(math.inf, math.inf, mags, oks)
-    while hi - lo > tol:  # k-section: k interior points per call
-        pts = lo + (hi - lo) * np.arange(1, int(k) + 1) / (k + 1)
-        pts = pts[(pts > lo) & (pts < hi)]  # guard against rounding at tiny brackets
-        if pts.size == 0:
-            break
-        ok = ask(pts)
-        fail = np.flatnonzero(~ok)
-        if fail.size:
-            i = int(fail[0])
-            hi = float(pts[i])
-            lo = float(pts[i - 1]) if i > 0 else lo
-        else:
-            lo = float(pts[-1])
-    return _done(lo, hi, mags, oks)
-
-
-def _deprecated_start(start: float | None, stacklevel: int = 4) -> float | None:
-    """The public functions' old ``start`` (the ladder's first rung), now ``h``: warns."""
-    if start is not None:
-        warn_renamed("start= (the first rung of the old doubling ladder)",
-                     "h= (the grid step, tslip.gait.robustness.GRID_STEPS)",
-                     stacklevel=stacklevel)
-    return start
-
-
-def _grid_steps(kinds: Sequence[str], h: Mapping[str, float] | None, start: float | None,
-                defaults: Mapping[str, float]) -> dict[str, float]:
-    """Each kind's grid step: ``h[kind]``, else the old ``start`` (warns), else ``defaults``.
-
-    The one resolution of a report's ``h`` for both models (``defaults`` is
-    :data:`GRID_STEPS` or the biped's); ``h`` may name only kinds of ``defaults``.
-    """
-    given = dict(h or {})
-    if not set(given) <= set(defaults):
-        raise ValueError(f"h must map kinds among {tuple(defaults)} to grid steps, "
-                         f"got keys {sorted(given)}")
-    old = _deprecated_start(start, stacklevel=6)
-    return {kind: _grid_step(given.get(kind), old) if kind in given or old is not None
-            else defaults[kind] for kind in kinds}
-
-
-def _grid_step(h: float | None, start: float | None) -> float:
-    """``h``, or its old name ``start``; refuse neither, both different, or a bad value."""
-    if h is None:
-        h = start
-    elif start is not None and start != h:
-        raise ValueError(f"give h or its old name start, not both (h={h!r}, start={start!r})")
-    if h is None:
-        raise ValueError("h (the grid step) must be given")
-    if not (math.isfinite(h) and h > 0):
-        raise ValueError(f"h must be in (0, inf), got {h!r}")
-    return float(h)
-
-
-def _done(lo: float, hi: float, mags: list[np.ndarray], oks: list[np.ndarray]) -> LimitSearch:
-    m = np.concatenate(mags) if mags else np.empty(0)
-    s = np.concatenate(oks) if oks else np.empty(0, dtype=bool)
-    return LimitSearch(lo=lo, hi=hi, n_calls=len(mags), n_evals=len(m), magnitudes=m, survived=s)
-
-
-# ---------------------------------------------------------------------------
-# Disturbed runs (the simulation side)
-# ---------------------------------------------------------------------------
-
-
-def run_disturbed(
-    params: Params,
-    state: TouchdownState,
-    kind: Kind,
-    values: Sequence[float] | np.ndarray,
-    *,
-    n_steps: int = 25,
-    options: IntegratorOptions | None = None,
-    placement: Placement = "touchdown",
-) -> BatchRun:
-    """Run ``n_steps`` strides after each disturbance, in one batch.
-
-    Parameters
-    ----------
-    params : Params
-    state : TouchdownState
-        Touch-down state that starts stride 0 (the gait's).
-    kind : {"step_down", "push", "pitch_rate"}
-    values : array_like, shape (n,)
-        Signed disturbances: ``dh`` [L] (negative: step down), ``dxd``
-        [g^1/2 L^1/2] (negative: backward push) or ``dphid``
-        [rad g^1/2 L^-1/2].
-    n_steps : int
-    options : IntegratorOptions, optional
-    placement : {"touchdown", "touchdown_hip", "liftoff", "apex"}
-        Where a push or pitch-rate change is applied (module notes); a
-        step-down is always ``"touchdown"``.
-
-    Returns
-    -------
-    BatchRun
-        Row ``i`` for ``values[i]``; with ``"touchdown"`` the same runs as
-        :func:`tslip.simulate` with ``Disturbance(at_step=0, dh=|dxd=|dphid=values[i])``.
-        For the flight placements the rows start at the touch-down after the
-        disturbance; a fall in that flight has ``n_done = 0`` and its status.
-    """
-    _check_kind(kind)
-    _check_placement(kind, placement)
-    d = np.asarray(values, dtype=float).reshape(-1)
-    if not np.all(np.isfinite(d)):
-        raise ValueError("disturbance values must be finite")
-    if placement in ("liftoff", "apex"):
-        return _run_flight_disturbed(params, state, kind, d, placement, n_steps, options)
-    S = np.tile(state.as_array(), (len(d), 1))
-    if placement == "touchdown_hip":  # hip velocity xd - r cos(phi) phid, yd - r sin(phi) phid held
-        S[:, 2] += params.r * math.cos(state.phi) * d
-        S[:, 3] += params.r * math.sin(state.phi) * d
-    terrain: list[Terrain] | None = None
-    if kind == "step_down":
-        xf = state.x + params.l0 * math.cos(state.beta) - params.r * math.sin(state.phi)
-        ground = Terrain.flat(state.h)
-        terrain = [ground.shifted_after(xf, float(v)) for v in d]
-    else:
-        S[:, _SECTION_COLUMN[kind]] += d
-    return run_batch(params, S, n_steps, terrain=terrain, options=options)
-
-
-def _run_flight_disturbed(params: Params, state: TouchdownState, kind: Kind, d: np.ndarray,
-                          placement: str, n_steps: int,
-                          options: IntegratorOptions | None) -> BatchRun:
-    """Stride 0 undisturbed; the change at lift-off or apex; flight; ``n_steps`` strides."""
-    s0 = step(params, state, options=options)
-    if not s0.ok:
-        raise ValueError(f"the undisturbed stride 0 ended: {s0.reason}")
-    lo = np.array([getattr(s0.liftoff, f) for f in ("x", "y", "xd", "yd", "phi", "phid")])
-    P = pk.pack_params(params)
-    O = (options or IntegratorOptions()).packed()  # noqa: E741 - kernels' name
-    fs = np.empty(10)
-    if placement == "apex":
-        t_a = min(max(lo[3], 0.0) / params.g, s0.flight_time)
-        # the leg's retraction clock keeps running (the apex clock starts at t_a)
-        P[pk.P_ALPHA] += P[pk.P_OMEGA] * max(t_a - kn.retraction_start(P, lo[3]), 0.0)
-        kn.flight_state(P, lo, t_a, fs)  # (the CoM part does not depend on alpha_r)
-        lo = fs[:6].copy()
-    tx, th = Terrain.flat(state.h).arrays()
-    S = np.full((len(d), 7), np.nan)
-    st0 = np.zeros(len(d), dtype=np.int64)
-    res = np.empty(3)
-    for i, di in enumerate(d):
-        lo_i = lo.copy()
-        lo_i[_FLIGHT_COLUMN[kind]] += di
-        st0[i] = kn.find_touchdown(P, O, lo_i, tx, th, res)
-        if st0[i] == Status.OK:
-            kn.flight_state(P, lo_i, res[0], fs)
-            S[i] = (fs[6], fs[4], fs[2], fs[3], fs[5], fs[0], res[1])
-    n = len(d)
-    n_done = np.zeros(n, dtype=np.int64)
-    t_fall = np.full(n, np.nan)
-    hist = np.full((n, int(n_steps) + 1, 7), np.nan)
-    status = st0.copy()
-    ok = st0 == Status.OK
-    if ok.any():
-        run = run_batch(params, S[ok], n_steps, options=options)
-        n_done[ok], status[ok], t_fall[ok], hist[ok] = (run.n_done, run.status, run.t_fall,
-                                                        run.touchdowns)
-    return BatchRun(n_done, status, t_fall, hist)
-
-
-def _check_kind(kind: str) -> None:
-    if kind not in KINDS:
-        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
-
-
-def _check_placement(kind: str, placement: str) -> None:
-    if placement not in PLACEMENTS:
-        raise ValueError(f"placement must be one of {PLACEMENTS}, got {placement!r}")
-    if placement != "touchdown" and kind == "step_down":
-        raise ValueError(f"placement must be 'touchdown' for a step-down, got {placement!r}")
-    if placement == "touchdown_hip" and kind != "pitch_rate":
-        raise ValueError(f"placement 'touchdown_hip' is for kind 'pitch_rate', got {kind!r}")
 
 
 def check_gait(gait: Gait) -> None:
@@ -497,10 +186,6 @@ def check_gait(gait: Gait) -> None:
             f"pass check=False to analyse it anyway"
         )
 
-
-# ---------------------------------------------------------------------------
-# Public API
-# ---------------------------------------------------------------------------
 
 
 @dataclass(frozen=True, slots=True, repr=False)
@@ -880,34 +565,3 @@ def search_limit(kind: str, sign: int,
     return RobustnessLimit(kind=kind, sign=sign, limit=sign * s.lo, first_failing=sign * s.hi,
                            fall_stride=stride, status=status, n_batches=s.n_calls,
                            n_runs=n_runs, n_errors=n_errors)
-
-
-def _touchdown_runner(gait: Gait, kind: Kind, placement: Placement, n_steps: int,
-                      options: IntegratorOptions | None) -> Callable[[float], tuple[int, int]]:
-    """``d -> (status, strides done)``: one run of :func:`run_disturbed` (touch-down placements).
-
-    The same disturbed start and terrain as :func:`run_disturbed` builds for
-    each row, run in the calling thread on arrays packed once
-    (:func:`tslip.simulation._packed.run`), stopping at the first fall.
-    """
-    params, state = gait.params, gait.state
-    P = pk.pack_params(params)
-    O = (options or _DEFAULT_OPTIONS).packed()  # noqa: E741 - the kernels' name
-    td0 = state.as_array()
-    flat = Terrain.flat(0.0).arrays()
-    xf = state.x + params.l0 * math.cos(state.beta) - params.r * math.sin(state.phi)
-    hip = (params.r * math.cos(state.phi), params.r * math.sin(state.phi))
-
-    def run_one(d: float) -> tuple[int, int]:
-        td = td0.copy()
-        tx, th = flat
-        if placement == "touchdown_hip":
-            td[2] += hip[0] * d
-            td[3] += hip[1] * d
-        if kind == "step_down":
-            tx, th = Terrain.flat(state.h).shifted_after(xf, d).arrays()
-        else:
-            td[_SECTION_COLUMN[kind]] += d
-        return _packed.run(P, O, td, n_steps, tx, th)
-
-    return run_one
