@@ -30,7 +30,6 @@ and ``alphad_ref_forced`` (``alphad_ref``, ``residual``, ``free``);
 study (Figures 4.8-4.9 with ``omega_r_bar`` held).
 """
 
-from ._checks import grid_stable_fractions
 from ._list import CLAIMS, evaluate
 from ._rules import (
     ID_PATTERN,
@@ -48,6 +47,7 @@ from ._rules import (
     stable_mask,
     stable_range,
 )
+from ._studies import grid_stable_fractions
 
 __all__ = ["Check", "Claim", "ClaimResult", "CLAIMS", "ID_PATTERN", "MIN_POINTS", "MULT_TOL",
            "PRINTED", "REL", "TEND", "TREND", "Verdict", "count_verdicts", "evaluate",

@@ -5,8 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from ._checks import (
-    _CONTROLLERS,
+from ._responses import (
     _c41,
     _c42,
     _c43,
@@ -14,17 +13,36 @@ from ._checks import (
     _c45,
     _c46,
     _c47,
+    _c62,
+)
+from ._robot import (
+    _c61,
+    _c61_alphad,
+    _c61_limit,
+    _c62_stride,
+    _cC1,
+    _ce2,
+    _ce4_falls,
+    _ce4_largest,
+    _ce4_meta,
+    _ce4_unstable,
+    _ce_stable,
+)
+from ._rules import (
+    Check,
+    Claim,
+    ClaimResult,
+    Numbers,
+    Verdict,
+)
+from ._studies import (
+    _CONTROLLERS,
     _c48_above,
     _c48_minimum,
     _c48_quickest,
     _c49_pitch,
     _c49_push,
     _c49_step,
-    _c61,
-    _c61_alphad,
-    _c61_limit,
-    _c62,
-    _c62_stride,
     _c410,
     _c411,
     _c411_flight,
@@ -47,20 +65,6 @@ from ._checks import (
     _c425_pitch,
     _c425_push,
     _c425_similar,
-    _cC1,
-    _ce2,
-    _ce4_falls,
-    _ce4_largest,
-    _ce4_meta,
-    _ce4_unstable,
-    _ce_stable,
-)
-from ._rules import (
-    Check,
-    Claim,
-    ClaimResult,
-    Numbers,
-    Verdict,
 )
 
 
@@ -69,7 +73,7 @@ def _claim(id_: str, figure: str, text: str, needs: tuple[str, ...], fn: Callabl
     return Claim(figure, text, needs, fn, quote, source, reading, id=id_)
 
 
-#: The "approximately towards the hip" criterion of 4.2 and 6.2 (claims._checks.HIP_BAND).
+#: The "approximately towards the hip" criterion of 4.2 and 6.2 (claims._responses.HIP_BAND).
 _HIP = ("'approximately towards the hip' as Section 7.1 explains it, 'the resultant ground "
         "impulse remains between the hip and centre of mass': the line of action passes "
         "within r (the hip-CoM distance) of the mean hip, for the undisturbed gait and both "
