@@ -149,6 +149,31 @@ def test_step_down_limit_is_the_first_failure_where_survival_has_islands():
     assert any(_survives_simulate(g, "dh", -m) for m in beyond)  # an island: not monotone
 
 
+def _failing_gaps(m, ok, step):
+    """The failing runs of a grid ``m`` (step ``step``) as intervals ``[a, b)``."""
+    fail = np.r_[False, ~ok, False].astype(int)
+    starts, ends = np.flatnonzero(np.diff(fail) == 1), np.flatnonzero(np.diff(fail) == -1)
+    return [(m[i], m[j - 1] + step) for i, j in zip(starts, ends)]
+
+
+def test_the_step_down_grid_step_sees_a_failing_gap_wider_than_it():
+    """Figure 4.23's fast retraction (Table 2.1, omega_r_bar 1.88): on a 0.0005 L grid of
+    step-downs, each run in simulate(), the first failing gap wider than 0.006 L is about
+    0.012 L wide (near 0.156 L; narrower slivers before it fall between grid points, module
+    notes) and survival returns past it. No multiple of 0.05 L lies in it, so a 0.05 L grid
+    steps over it onto the island; a grid of step h <= 0.005 L has a point inside, and the
+    first-failure limit lies below the gap (guards GRID_STEPS["step_down"])."""
+    fine = 0.0005
+    g = tslip.find_gait(tslip.preset("table2.1").with_omega_r_bar(1.88))
+    m = fine * np.arange(1, 401)  # up to 0.2 L
+    ok = np.array([_survives_simulate(g, "dh", -x) for x in m])
+    a, b = next((a, b) for a, b in _failing_gaps(m, ok, fine) if b - a >= 0.006)
+    assert b - a <= 0.05  # the premise: narrower than 0.05 L ...
+    assert not any(a - fine < c < b for c in 0.05 * np.arange(1, 5))  # ... between its points
+    assert ok[m > b - fine / 2][0]  # and survived again after it: an island
+    assert -robustness(g, "step_down", tol=TOL) < a
+
+
 # ---------------------------------------------------------------------------
 # Refusals and options
 # ---------------------------------------------------------------------------
