@@ -16,14 +16,36 @@ Each is measured on this checkout and on revision ``1b54594`` (today's code,
 ``_baseline.py``) in the same run, and printed as wall and CPU seconds with the
 ratio new/old. On a loaded machine the CPU seconds are the steadier figure.
 Targets (issue 12, item 6): import <= 0.3 s, first stride cold <= 3 s.
+
+``--first-run`` measures a new user's first run instead (issue 24): a fresh
+``git clone`` of this checkout (its committed HEAD), the README's install
+command in a fresh venv (with ``--reuse-venv PATH``: that venv, the clone's
+``src`` on ``PYTHONPATH``, no install), then the first ``tslip reproduce
+--quick`` with ``NUMBA_CACHE_DIR`` unset (numba caches next to the installed
+sources) and an empty ``XDG_CACHE_HOME`` (nothing in the user's cache folders).
+It prints the install time, the reproduction's wall and CPU seconds (every
+process: this one adopts orphaned descendants as a sub-reaper and reaps them),
+the time to its first line and the 1-minute load before it, then runs it again
+warm and checks that ``claims.json`` and every study's ``results.parquet``
+(but its ``seconds`` column) are equal. ``--compile-log`` also records numba's
+compile events in every process of the cold run (a ``sitecustomize`` on
+``PYTHONPATH``) and prints the compile CPU seconds per process, per kernel
+family and per top-level kernel, and any signature compiled in two processes.
 """
 
 from __future__ import annotations
 
 import argparse
+import ctypes
 import json
+import os
+import re
+import shlex
+import subprocess
 import sys
 import tempfile
+import time
+from collections import defaultdict
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -58,12 +80,235 @@ def first_stride(rev: str | None, stmt: str, cache: Path) -> tuple[float, float]
                                       env={"NUMBA_CACHE_DIR": str(cache)})))
 
 
+# ---------------------------------------------------------------------------
+# --first-run: a new user's install and first reproduction (issue 24)
+# ---------------------------------------------------------------------------
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: Installed as ``sitecustomize`` (``--compile-log``): every process of the run,
+#: the fork server and its workers included, appends one JSON line per numba
+#: compile with the thread CPU seconds it took, its callees' compiles excluded.
+_RECORDER = """
+import json, os, threading, time
+from numba.core import event
+
+_local = threading.local()
+
+
+class _Log(event.Listener):
+    def on_start(self, e):
+        if not hasattr(_local, "stack"):
+            _local.stack = []
+        _local.stack.append([time.thread_time(), 0.0])
+
+    def on_end(self, e):
+        c0, inner = _local.stack.pop()
+        incl = time.thread_time() - c0
+        if _local.stack:
+            _local.stack[-1][1] += incl
+        d = e.data["dispatcher"]
+        rec = {"pid": os.getpid(), "thread": threading.current_thread().name,
+               "fn": d.py_func.__module__ + "." + d.py_func.__qualname__,
+               "args": str(e.data["args"]), "cpu": incl - inner, "incl": incl,
+               "depth": len(_local.stack), "t": time.time()}
+        with open(os.environ["TSLIP_BENCH_COMPILE_LOG"], "a") as f:
+            f.write(json.dumps(rec) + "\\n")
+
+
+event.register("numba:compile", _Log())
+"""
+
+
+def readme_install() -> str:
+    """The README's install command: its Quickstart line before ``&& tslip reproduce``."""
+    for line in (ROOT / "README.md").read_text(encoding="utf-8").splitlines():
+        if "tslip reproduce --quick" in line and "pip install" in line:
+            return line.split("&&")[0].strip()
+    raise SystemExit("README.md has no 'pip install ... && tslip reproduce --quick' line")
+
+
+def _subreaper() -> None:
+    """Adopt orphaned descendants (the fork server outlives ``tslip``) so their CPU counts."""
+    if sys.platform.startswith("linux"):
+        ctypes.CDLL(None, use_errno=True).prctl(36, 1, 0, 0, 0)  # PR_SET_CHILD_SUBREAPER
+
+
+def _reap() -> None:
+    while True:
+        try:
+            os.waitpid(-1, 0)
+        except ChildProcessError:
+            return
+
+
+def timed_run(cmd: list[str], env: dict[str, str], cwd: Path, log: Path,
+              ) -> dict[str, float]:
+    """Wall, CPU (all descendants) and first-line seconds of ``cmd``; its output to ``log``."""
+    import resource
+
+    _reap()
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    load = os.getloadavg()[0]
+    t0 = time.perf_counter()
+    first = float("nan")
+    with log.open("w") as out:
+        p = subprocess.Popen(cmd, env=env, cwd=cwd, stdout=subprocess.PIPE,
+                             stderr=subprocess.STDOUT, text=True)
+        assert p.stdout is not None
+        for line in p.stdout:
+            t = time.perf_counter() - t0
+            if first != first and line.strip():
+                first = t
+            out.write(f"[{t:7.1f}] {line}")
+        p.wait()
+    wall = time.perf_counter() - t0
+    _reap()
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
+    if p.returncode:
+        raise SystemExit(f"{shlex.join(cmd)} failed ({p.returncode}); see {log}")
+    return {"wall": wall, "cpu": cpu, "first": first, "load": load}
+
+
+def same_results(a: Path, b: Path) -> list[str]:
+    """Where two report folders' results differ: claims.json, each study but its seconds."""
+    import pandas as pd
+
+    diffs = []
+    if json.loads((a / "claims.json").read_text()) != json.loads((b / "claims.json").read_text()):
+        diffs.append("claims.json")
+    studies = sorted(p.relative_to(a) for p in a.glob("studies/*/results.parquet"))
+    if not studies:
+        diffs.append("no study results")
+    for rel in studies:
+        x, y = (pd.read_parquet(d / rel).drop(columns="seconds", errors="ignore")
+                for d in (a, b))
+        if not x.equals(y):
+            diffs.append(str(rel))
+    return diffs
+
+
+def _family_of(fn: str) -> str:
+    """A compiled function's kernel family (by its top-level kernel's package and method)."""
+    if ".biped." in fn:
+        return "biped (dop853)" if fn.endswith("dop853") else "biped (dopri5) and helpers"
+    if "_record." in fn or "run_batch" in fn or "flight_state" in fn:
+        return "TSLIP recorded runs"
+    return "TSLIP gait search and analyses"
+
+
+def compile_breakdown(log: Path) -> None:
+    """Print the compile CPU seconds of ``log`` per process, family and top-level kernel."""
+    recs = [json.loads(line) for line in log.read_text().splitlines()]
+    if not recs:
+        print("no compiles recorded")
+        return
+    per_proc: dict[tuple[int, str], float] = defaultdict(float)
+    per_top: dict[tuple[str, str], float] = defaultdict(float)
+    where: dict[tuple[str, str], set[int]] = defaultdict(set)
+    stack_top: dict[tuple[int, str], list[dict]] = defaultdict(list)
+    for r in recs:  # callees end before their caller: attribute them to the next depth-0 end
+        per_proc[(r["pid"], r["thread"])] += r["cpu"]
+        where[(r["fn"], r["args"])].add(r["pid"])
+        stack_top[(r["pid"], r["thread"])].append(r)
+        if r["depth"] == 0:
+            top = r["fn"].replace("tslip.", "")
+            per_top[(_family_of(r["fn"]), top)] += sum(
+                x["cpu"] for x in stack_top.pop((r["pid"], r["thread"])))
+    print(f"compile CPU: {sum(r['cpu'] for r in recs):.1f} s in {len(recs)} compiles")
+    for (pid, thread), c in sorted(per_proc.items(), key=lambda kv: -kv[1]):
+        print(f"  process {pid} {thread:12s} {c:6.1f} s")
+    fam: dict[str, float] = defaultdict(float)
+    for (f, _), c in per_top.items():
+        fam[f] += c
+    for f, c in sorted(fam.items(), key=lambda kv: -kv[1]):
+        print(f"  {f:28s} {c:6.1f} s")
+        for (f2, top), c2 in sorted(per_top.items(), key=lambda kv: -kv[1]):
+            if f2 == f and c2 >= 0.2:
+                print(f"      {top:52s} {c2:6.2f} s (with its callees)")
+    twice = {k: v for k, v in where.items() if len(v) > 1}
+    print(f"signatures compiled in two processes: {len(twice)}"
+          + "".join(f"\n  {fn} {args[:80]}" for fn, args in twice))
+
+
+def first_run(reuse_venv: str | None, compile_log: bool, keep: bool) -> None:
+    """Clone, install (or reuse a venv), then a cold and a warm ``tslip reproduce --quick``."""
+    _subreaper()
+    tmp = Path(tempfile.mkdtemp(prefix="tslip-first-run-"))
+    clone = tmp / "clone"
+    subprocess.run(["git", "clone", "-q", str(ROOT), str(clone)], check=True)
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("NUMBA_CACHE_DIR", "PYTHONPATH", "VIRTUAL_ENV")}
+    env["XDG_CACHE_HOME"] = str(tmp / "user-cache")  # numba's fallback cache folder: empty
+    if reuse_venv:
+        venv = Path(reuse_venv)
+        env["PYTHONPATH"] = str(clone / "src")
+        install = float("nan")
+    else:
+        venv = tmp / "venv"
+        subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+        cmd = readme_install()
+        env["PATH"] = f"{venv / 'bin'}{os.pathsep}{env['PATH']}"
+        t = time.perf_counter()
+        subprocess.run(cmd, shell=True, cwd=clone, env=env, check=True)  # noqa: S602
+        install = time.perf_counter() - t
+    env["PATH"] = f"{venv / 'bin'}{os.pathsep}{env['PATH']}"
+    python = str(venv / "bin" / "python")
+    located = subprocess.run([python, "-c", "import tslip; print(tslip.__file__)"], env=env,
+                             capture_output=True, text=True, check=True).stdout.strip()
+    pkg = Path(located).parent
+    if any(pkg.rglob("*.nbi")):
+        raise SystemExit(f"{pkg} already holds numba cache files: not a first run")
+    run_env = dict(env)
+    if compile_log:
+        site = tmp / "site"
+        site.mkdir()
+        (site / "sitecustomize.py").write_text(_RECORDER)
+        run_env["PYTHONPATH"] = os.pathsep.join(
+            [str(site), *([env["PYTHONPATH"]] if "PYTHONPATH" in env else [])])
+        run_env["TSLIP_BENCH_COMPILE_LOG"] = str(tmp / "compiles.jsonl")
+    cmd = [python, "-m", "tslip", "reproduce", "--quick", "--out"]
+    print(f"clone {clone}; package {pkg}; install: "
+          f"{'reused ' + str(venv) if reuse_venv else readme_install()}", flush=True)
+    cold = timed_run([*cmd, "report-cold"], run_env, clone, tmp / "cold.log")
+    warm = timed_run([*cmd, "report-warm"], env, clone, tmp / "warm.log")
+    said = (tmp / "cold.log").read_text().splitlines()[0]
+    print(f"install {install:.1f} s")
+    for name, r in (("first reproduce --quick", cold), ("second (warm)", warm)):
+        print(f"{name:24s} wall {r['wall']:6.1f} s  CPU {r['cpu']:6.1f} s  "
+              f"first line {r['first']:5.1f} s  (1-min load before: {r['load']:.2f})")
+    print(f"first line: {said}")
+    print(f"warm run silent about compiling: "
+          f"{not re.search('compil', (tmp / 'warm.log').read_text())}")
+    diffs = same_results(clone / "report-cold", clone / "report-warm")
+    print("results identical to the warm run's" if not diffs else f"results DIFFER: {diffs}")
+    if compile_log:
+        compile_breakdown(tmp / "compiles.jsonl")
+    if keep:
+        print(f"kept {tmp}")
+    else:
+        import shutil
+
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5, help="fresh imports (best of)")
     ap.add_argument("--what", default="step_map,simulate", help="first strides to time")
     ap.add_argument("--rev", default=BASELINE_REV, help="baseline revision")
+    ap.add_argument("--first-run", action="store_true",
+                    help="a fresh clone's install and first `tslip reproduce --quick` instead")
+    ap.add_argument("--reuse-venv", metavar="PATH",
+                    help="with --first-run: this venv and the clone's src, no install")
+    ap.add_argument("--compile-log", action="store_true",
+                    help="with --first-run: numba's compile events of every process")
+    ap.add_argument("--keep", action="store_true", help="with --first-run: keep the folder")
     args = ap.parse_args()
+    if args.first_run:
+        first_run(args.reuse_venv, args.compile_log, args.keep)
+        return
     revs = {"new": None, "old": args.rev}
 
     print(f"{'':28s}{'new wall':>10s}{'old wall':>10s}{'ratio':>7s}"

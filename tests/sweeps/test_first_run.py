@@ -134,3 +134,45 @@ def test_study_and_reproduce_pools_warm_their_kernels_before_forking(monkeypatch
     with pytest.raises(Stop):
         reproduce.run_catalogue(tmp_path, "tiny", workers=2)
     assert seen["reproduce"][-1] == "tslip.sweeps._prewarm"
+
+
+_BIPED_WARM = textwrap.dedent("""
+    import json
+    from numba.core import event
+    from tslip import _kernel_cache as kc
+    from tslip.biped import BipedParams, BipedState
+    from tslip.biped.dynamics import body_positions, controller_references, momentum
+    from tslip.sweeps._warmup import WORKLOADS, cache_dirs
+
+    WORKLOADS["biped (dopri5)"]()
+    missing = kc.missing_families(cache_dirs(("biped",)), kc.sources_hash())
+    compiled = []
+
+    class _Log(event.Listener):
+        def on_start(self, e):
+            pass
+
+        def on_end(self, e):
+            compiled.append(e.data["dispatcher"].py_func.__qualname__)
+
+    event.register("numba:compile", _Log())
+    p, s = BipedParams(), BipedState.thesis()
+    momentum(p, s)
+    controller_references(p, 0.25)
+    body_positions(p, s)
+    print(json.dumps({"missing": missing, "compiled": compiled}))
+""")
+
+
+@pytest.mark.slow
+def test_the_biped_warm_up_compiles_what_appendix_e_calls_from_python(tmp_path):
+    """After the biped (dopri5) family's workload, its family is cached and the helpers
+    Appendix E's tasks call from Python (momentum, body positions, controller references)
+    compile nothing more: a worker running those tasks after the fork compiles nothing."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    out = subprocess.run([sys.executable, "-c", _BIPED_WARM], env=env, text=True,
+                         capture_output=True, timeout=1200, check=True).stdout
+    got = json.loads(out.splitlines()[-1])
+    assert "biped (dopri5)" not in got["missing"]
+    assert "biped (dop853)" in got["missing"]  # the other family is left to its own workload
+    assert got["compiled"] == []

@@ -97,8 +97,9 @@ def reproduce_cmd(
 ) -> None:
     """Run every thesis study and write a report (out/index.html).
 
-    A first run (empty numba cache) compiles the kernels first and says so: 5 minutes on a
-    loaded 2-core machine (2026-12-02), to be re-measured on a quiet one.
+    A first run (empty numba cache) compiles the kernels first and says so: about a minute
+    on a quiet 2-core machine (75 s of CPU compiling, on both cores), several minutes on a
+    loaded one (2026-12-02).
     """
     from contextlib import ExitStack
 

@@ -73,7 +73,13 @@ def _biped(method: str) -> Callable[[], None]:
         from ..biped import BipedParams, BipedState, simulate
         from ..biped.simulate import BipedOptions
 
-        simulate(BipedParams(), BipedState.thesis(), 1, options=BipedOptions(method=method))
+        params, state = BipedParams(), BipedState.thesis()
+        simulate(params, state, 1, options=BipedOptions(method=method))
+        if method == "dopri5":  # once: what Appendix E calls from Python besides a run
+            from ..biped.dynamics import controller_references, momentum
+
+            momentum(params, state)
+            controller_references(params, 0.5)
     return run
 
 
