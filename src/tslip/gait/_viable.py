@@ -243,15 +243,21 @@ def viable_sets_chunked(chunks: Sequence[np.ndarray], n_states: int, n_actions: 
         np.any(q2, axis=1, out=s_pad[:n_states])
         if sweeps >= limit:
             return q2, s_pad[:n_states].copy(), sweeps
-        changed = False
+        before = np.count_nonzero(q)
         for k, (a, b) in enumerate(bounds):
             live = q[a:b]
-            if not live.any():
-                continue
-            keep = s_pad[chunks[k]].all(axis=1)
-            if not changed and np.any(live & ~keep):
-                changed = True
-            live &= keep
-        if not changed:
+            if live.any():
+                live &= _all_rows(np.take(s_pad, chunks[k]))
+        if np.count_nonzero(q) == before:
             return q2, s_pad[:n_states].copy(), sweeps
         sweeps += 1
+
+
+def _all_rows(b: np.ndarray) -> np.ndarray:
+    """``b.all(axis=1)`` of a C-contiguous bool array; rows of 2, 4 or 8 read as one integer
+    each (a bool is one byte, 0 or 1), which is many times faster than the reduction."""
+    m = b.shape[1]
+    if m in (2, 4, 8):
+        ones = int.from_bytes(b"\x01" * m, "little")
+        return b.view(f"<u{m}")[:, 0] == ones
+    return b.all(axis=1)
