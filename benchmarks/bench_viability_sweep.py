@@ -79,15 +79,16 @@ def main() -> None:
         chunks, n_states = synthetic(int(size))
         n = n_states * N_ACTIONS
         w, c, (q, _, sweeps) = timed(
-            lambda: _viable.viable_sets_chunked(chunks, n_states, N_ACTIONS), args.repeat)
+            lambda c=chunks, n=n_states: _viable.viable_sets_chunked(c, n, N_ACTIONS),
+            args.repeat)
         passes = sweeps + 1
         print(f"{n:10d} {'chunked':>8} {passes:6d} {1e9 * c / n / passes:17.2f} "
               f"{1e9 * w / n / passes:8.2f}", flush=True)
         if size <= args.old_max:
             cells = np.concatenate(chunks).astype(np.int64)
             ok = np.all(cells >= 0, axis=1)
-            w, c, (q0, _, s0) = timed(lambda: _viable.viable_sets(cells, ok, n_states),
-                                      args.repeat)
+            w, c, (q0, _, s0) = timed(
+                lambda c=cells, o=ok, n=n_states: _viable.viable_sets(c, o, n), args.repeat)
             assert np.array_equal(q0, q) and s0 == sweeps
             print(f"{n:10d} {'whole':>8} {passes:6d} {1e9 * c / n / passes:17.2f} "
                   f"{1e9 * w / n / passes:8.2f}", flush=True)

@@ -259,5 +259,5 @@ def _all_rows(b: np.ndarray) -> np.ndarray:
     m = b.shape[1]
     if m in (2, 4, 8):
         ones = int.from_bytes(b"\x01" * m, "little")
-        return b.view(f"<u{m}")[:, 0] == ones
-    return b.all(axis=1)
+        return np.asarray(b.view(f"<u{m}")[:, 0] == ones)
+    return np.asarray(b.all(axis=1))

@@ -282,7 +282,7 @@ class Viability(Result):
     def projection(self, name: str) -> ViableSection:
         """The states viable for some grid value of ``name`` (a 3-D map's shadow)."""
         j = self._third(name)
-        return self._section(j, "projection", math.nan, self.s.any(axis=j))
+        return self._section(j, "projection", math.nan, np.asarray(self.s.any(axis=j)))
 
     def _third(self, name: str) -> int:
         names = self.map.names

@@ -217,8 +217,9 @@ def _action(data: dict[str, Any]) -> Axis:
         return _grid(data["action"], "[action]")
     acts = data["actions"]
     if not isinstance(acts, dict) or len(acts) != 1:
+        got = len(acts) if isinstance(acts, dict) else repr(acts)
         raise ValueError("[actions] must hold one [actions.<name>] table (two actions are "
-                         f"not supported yet), got {len(acts) if isinstance(acts, dict) else acts!r}")
+                         f"not supported yet), got {got}")
     (name, table), = acts.items()
     if not isinstance(table, dict) or "name" in table:
         raise ValueError(f"[actions.{name}] must be a table of values or from/to/points")
