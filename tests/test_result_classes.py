@@ -156,6 +156,7 @@ def test_every_result_class_is_covered(objects):
 #: checked through their subclasses.
 ELSEWHERE = {**dict.fromkeys(("StateActionMap", "Viability", "Basin"),
                              "tests/gait/test_viability.py"),
+             "ViableSection": "tests/gait/test_viability_3d.py",
              "RobustnessLimits": "RobustnessResult here and in tests/biped/test_results.py"}
 
 

@@ -172,3 +172,20 @@ def test_a_dot_dot_name_writes_nothing_without_out(tmp_path, monkeypatch):
     assert res.stderr.strip().startswith("error: viability name must match")
     assert list(work.iterdir()) == [] and sorted(p.name for p in tmp_path.iterdir()) == \
         ["spec.toml", "work"]
+
+
+def test_scheduler_option_runs_on_a_dask_cluster(spec, tmp_path):
+    """--scheduler ADDRESS: the chunks on a (local) Dask cluster, the bytes of the pool."""
+    from dask.distributed import LocalCluster
+
+    one = tmp_path / "one"
+    assert _run(spec, "--out", one, "--workers", "1").exit_code == 0
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster:
+        res = _run(spec, "--out", tmp_path / "d", "--scheduler", cluster.scheduler_address)
+    assert res.exit_code == 0, res.output
+    assert "240/240" in res.stderr
+    _same(Viability.load(one / "results.parquet"), Viability.load(tmp_path / "d" /
+                                                                  "results.parquet"))
+    meta = json.loads((tmp_path / "d" / "run.json").read_text())
+    assert meta["scheduler"] == cluster.scheduler_address and meta["computed"] == 240

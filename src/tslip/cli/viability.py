@@ -32,14 +32,18 @@ def viability_cmd(
     plot: Annotated[bool, typer.Option("--plot", help="Also draw viability.png.")] = False,
     wait: Annotated[bool, typer.Option("--wait", help="If another run is writing the "
                                        "output folder, wait for it (default: stop).")] = False,
+    scheduler: Annotated[str | None, typer.Option(
+        "--scheduler", help="Dask scheduler address (needs tslip\\[dask]); the chunks run "
+        "on its cluster and are cached here.")] = None,
 ) -> None:
     """Compute (or resume) the viable state-action set of a grid at fixed energy.
 
     The spec (TOML): name; preset; energy \\[MgL] of every cell; rule ("bracket" or
     "nearest"); optional \\[params] overrides and \\[options] (IntegratorOptions);
-    one or two \\[\\[state]] apex variables (the height "y", and "phi" or "phid"; each
-    a name with from/to/points or values) and one \\[action] (a parameter, e.g.
-    name = "alpha_r", with its values).
+    one to three \\[\\[state]] apex variables (the height "y", and "phi" and/or
+    "phid"; each a name with from/to/points or values) and one \\[action] (a
+    parameter, e.g. name = "alpha_r", with its values), or \\[actions.alpha_r]
+    with its values.
     Example and meaning: the documentation page "Viability and basins of
     attraction" (docs/analyses/viability.md).
 
@@ -64,6 +68,7 @@ def viability_cmd(
             task = bar.add_task(f"viability {spec.name}", total=spec.n_cells)
             try:
                 res = run_viability(spec, out_dir, workers=workers, wait=wait,
+                                    scheduler=scheduler,
                                     progress=lambda done, total: bar.update(task,
                                                                             completed=done))
             except StudyInterrupted as exc:

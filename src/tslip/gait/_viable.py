@@ -43,12 +43,16 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["RULES", "SNAP", "check_grid", "successor_cells", "viable_sets"]
+__all__ = ["RULES", "SNAP", "CHUNK_ROWS", "check_grid", "encode_chunks", "successor_cells",
+           "viable_sets", "viable_sets_chunked"]
 
 #: Cell rules of :func:`successor_cells`.
 RULES = ("bracket", "nearest", "vibly")
 #: A successor within this fraction of a grid spacing of a grid point is on it.
 SNAP = 1e-9
+#: State-action rows per chunk of :func:`viable_sets_chunked`'s sweep (its temporaries,
+#: a few bytes a row, stay in the processor's cache).
+CHUNK_ROWS = 1 << 16
 
 
 def check_grid(values: object, name: str) -> np.ndarray:
@@ -101,11 +105,16 @@ def successor_cells(axes: Sequence[np.ndarray], nxt: np.ndarray, ok: np.ndarray,
 
     Returns
     -------
-    ndarray of int64, shape (n, 2**d) for ``"bracket"`` and ``"vibly"``, (n, 1) for ``"nearest"``
+    ndarray of int32, shape (n, 2**d) for ``"bracket"`` and ``"vibly"``, (n, 1) for ``"nearest"``
         Indices into the flattened (C-order) state grid (a point may repeat);
         a row with a ``-1`` is a successor that counts as not viable whatever
-        the states are.
+        the states are: a failed step, or one beyond the grid under
+        ``"bracket"`` and ``"nearest"`` (``"vibly"`` bins a successor beyond
+        the grid onto its edge points, so it needs no extra bin). This is the
+        compact successor encoding: 4 bytes a corner, whatever the rule.
     """
+    if int(np.prod([len(g) for g in axes])) >= np.iinfo(np.int32).max:
+        raise ValueError("the state grid must have fewer than 2**31 - 1 points for int32 cells")
     if rule not in RULES:
         raise ValueError(f"rule must be one of {list(RULES)}, got {rule!r}")
     nxt = np.asarray(nxt, dtype=float)
@@ -132,9 +141,26 @@ def successor_cells(axes: Sequence[np.ndarray], nxt: np.ndarray, ok: np.ndarray,
         corners = [np.ravel_multi_index(tuple(pairs[j][c] for j, c in enumerate(pick)), shape)
                    for pick in itertools.product((0, 1), repeat=len(shape))]
         cells = np.stack(corners, axis=1)
-    cells = cells.astype(np.int64)
+    cells = cells.astype(np.int32)
     cells[~valid] = -1
     return cells
+
+
+def encode_chunks(axes: Sequence[np.ndarray], nxt: np.ndarray, ok: np.ndarray,
+                  rule: str = "bracket", rows: int = CHUNK_ROWS) -> list[np.ndarray]:
+    """:func:`successor_cells` chunk by chunk: the compact map for :func:`viable_sets_chunked`.
+
+    A failed row gets ``-1`` in every column, so the chunks alone say which
+    pairs fail; the float successors are needed only ``rows`` at a time.
+    """
+    nxt = np.asarray(nxt, dtype=float)
+    ok = np.asarray(ok, dtype=bool)
+    out = []
+    for i in range(0, len(nxt), rows):
+        c = successor_cells(axes, nxt[i:i + rows], ok[i:i + rows], rule)
+        c[~ok[i:i + rows]] = -1
+        out.append(c)
+    return out
 
 
 def viable_sets(cells: np.ndarray, ok: np.ndarray, n_states: int,
@@ -171,3 +197,67 @@ def viable_sets(cells: np.ndarray, ok: np.ndarray, n_states: int,
             return q, s, sweeps
         q = q_new
         sweeps += 1
+
+
+def viable_sets_chunked(chunks: Sequence[np.ndarray], n_states: int, n_actions: int,
+                        max_iter: int | None = None) -> tuple[np.ndarray, np.ndarray, int]:
+    """:func:`viable_sets` on the compact map held in chunks, never the whole map's temporaries.
+
+    ``chunks`` are int32 cell arrays (from :func:`encode_chunks`, or read
+    one at a time from a chunk store: any sequence whose items are arrays),
+    consecutive blocks of the (state, action) rows in C order, each row's
+    ``-1`` meaning "not viable whatever the states" (a failed pair has one).
+    Each sweep computes the states ``S`` from ``Q`` at its start and then
+    updates ``Q`` chunk by chunk from that ``S`` (the same sweeps as
+    :func:`viable_sets`, so the same ``sweeps`` count); memory beyond the
+    chunks is ``Q`` (one byte a pair) and one chunk's temporaries.
+
+    Returns
+    -------
+    q, s, sweeps : as :func:`viable_sets`
+    """
+    n = n_states * n_actions
+    q = np.empty(n, dtype=bool)
+    bounds = []
+    start = 0
+    for k in range(len(chunks)):
+        c = chunks[k]
+        if c.ndim != 2 or c.dtype.kind != "i":
+            raise ValueError(f"chunk {k} must be a 2-D integer cell array, got {c.dtype} "
+                             f"shape {c.shape}")
+        stop = start + len(c)
+        if stop > n:
+            raise ValueError(f"the chunks hold more than {n} rows ({n_states} states x "
+                             f"{n_actions} actions)")
+        q[start:stop] = np.all(c >= 0, axis=1)
+        bounds.append((start, stop))
+        start = stop
+    if start != n:
+        raise ValueError(f"the chunks hold {start} rows, not {n} ({n_states} states x "
+                         f"{n_actions} actions)")
+    q2 = q.reshape(n_states, n_actions)
+    limit = n + 1 if max_iter is None else max_iter
+    sweeps = 0
+    s_pad = np.zeros(n_states + 1, dtype=bool)  # index -1 (the last): never viable
+    while True:
+        np.any(q2, axis=1, out=s_pad[:n_states])
+        if sweeps >= limit:
+            return q2, s_pad[:n_states].copy(), sweeps
+        before = np.count_nonzero(q)
+        for k, (a, b) in enumerate(bounds):
+            live = q[a:b]
+            if live.any():
+                live &= _all_rows(np.take(s_pad, chunks[k]))
+        if np.count_nonzero(q) == before:
+            return q2, s_pad[:n_states].copy(), sweeps
+        sweeps += 1
+
+
+def _all_rows(b: np.ndarray) -> np.ndarray:
+    """``b.all(axis=1)`` of a C-contiguous bool array; rows of 2, 4 or 8 read as one integer
+    each (a bool is one byte, 0 or 1), which is many times faster than the reduction."""
+    m = b.shape[1]
+    if m in (2, 4, 8):
+        ones = int.from_bytes(b"\x01" * m, "little")
+        return np.asarray(b.view(f"<u{m}")[:, 0] == ones)
+    return np.asarray(b.all(axis=1))

@@ -3,16 +3,17 @@
 Three results, all numpy arrays on a grid with its coordinates:
 
 * :func:`state_action_map` -> :class:`StateActionMap`: for every grid state
-  at the apex (apex height ``y``; for the TSLIP two section variables, e.g.
-  ``(y, phid)``) and every grid action (a parameter, e.g. the touch-down
+  at the apex (apex height ``y``; for the TSLIP up to three section
+  variables, ``(y, phi, phid)``) and every grid action (a parameter, e.g. the touch-down
   angle ``alpha_r``), the next apex state after one stride at fixed total
   energy, or the reason it failed. All cells run in one call of the
   batched compiled kernels (:func:`tslip.simulation.step_batch`).
 * :func:`viability` -> :class:`Viability`: the viable state-action pairs
-  and states, by the iteration of vibly's ``compute_QV``
-  (:mod:`tslip.gait._viable`, which also states the cell rules: tslip's
-  conservative ``"bracket"`` (the default), ``"nearest"``, and vibly's own
-  ``"vibly"``).
+  and states, by the iteration of vibly's ``compute_QV`` on a compact
+  successor encoding held in chunks (:mod:`tslip.gait._viable`, which also
+  states the cell rules: tslip's conservative ``"bracket"`` (the default),
+  ``"nearest"``, and vibly's own ``"vibly"``); for a 3-D map its volume
+  fraction, slices and projections (:class:`ViableSection`).
 * :func:`basin` -> :class:`Basin`: from every grid start state at the
   apex, the strides until the runs reach a gait, or fall
   (:func:`tslip.simulation.run_batch`).
@@ -55,8 +56,9 @@ if TYPE_CHECKING:
 
     from .fixed_point import Gait
 
-__all__ = ["StateActionMap", "Viability", "Basin", "state_action_map", "viability", "basin",
-           "STATE_NAMES", "SECTION_UNITS", "check_map_inputs", "map_cells"]
+__all__ = ["StateActionMap", "Viability", "ViableSection", "Basin", "state_action_map",
+           "viability", "basin", "STATE_NAMES", "SECTION_UNITS", "check_map_inputs",
+           "map_cells"]
 
 #: Apex variables a grid can span (the forward speed follows from the energy).
 STATE_NAMES = ("y", "phi", "phid")
@@ -90,7 +92,7 @@ class StateActionMap(Result):
     Attributes
     ----------
     names : tuple of str
-        Names of the state variables (one or two), e.g. ``("y",)``.
+        Names of the state variables (one to three), e.g. ``("y",)``.
     grid : tuple of ndarray
         The state grid axes (strictly increasing), one per name.
     action : str
@@ -198,17 +200,24 @@ class StateActionMap(Result):
 
 
 def _state_grid(states: Mapping[str, Any]) -> tuple[tuple[str, ...], tuple[np.ndarray, ...]]:
-    if not isinstance(states, Mapping) or not 1 <= len(states) <= 2:
-        raise ValueError("states must be a dict of one or two grids, e.g. {'y': grid}, got "
+    if not isinstance(states, Mapping) or not 1 <= len(states) <= 3:
+        raise ValueError("states must be a dict of one to three grids, e.g. {'y': grid}, got "
                          f"{states!r}")
     names = tuple(str(n) for n in states)
     return names, tuple(_viable.check_grid(states[n], f"states[{n!r}]") for n in names)
 
 
 def _action_grid(actions: Any) -> tuple[str, np.ndarray]:
+    """``(name, grid)`` or ``{name: grid}`` (one entry) as ``(name, checked grid)``."""
+    if isinstance(actions, Mapping):
+        if len(actions) != 1:
+            raise ValueError("actions must be a dict of one {name: grid} (two actions are not "
+                             f"supported yet), got {len(actions)} entries")
+        actions = next(iter(actions.items()))
+        actions = (str(actions[0]), actions[1])
     if not (isinstance(actions, tuple) and len(actions) == 2 and isinstance(actions[0], str)):
-        raise ValueError("actions must be (name, grid), e.g. ('alpha_r', grid), got "
-                         f"{actions!r}")
+        raise ValueError("actions must be (name, grid) or {name: grid}, e.g. ('alpha_r', "
+                         f"grid), got {actions!r}")
     return actions[0], _viable.check_grid(actions[1], f"actions[{actions[0]!r}]")
 
 
@@ -252,6 +261,42 @@ class Viability(Result):
         """Share of the state-action grid that is viable."""
         return float(self.q.mean())
 
+    @property
+    def volume_fraction(self) -> float:
+        """Share of the state grid that is viable: the viable set's volume on the grid."""
+        return float(self.s.mean())
+
+    def slice(self, name: str) -> ViableSection:
+        """The viable states at the grid value of ``name`` nearest 0 (a 3-D map's section).
+
+        The grid of ``name`` must reach 0 (its first value <= 0 <= its last).
+        """
+        j = self._third(name)
+        g = self.map.grid[j]
+        if not g[0] <= 0.0 <= g[-1]:
+            raise ValueError(f"states[{name!r}] must contain 0 (first <= 0 <= last) to slice "
+                             f"at 0, got [{g[0]:g}, {g[-1]:g}]")
+        i = int(np.argmin(np.abs(g)))
+        return self._section(j, "slice", float(g[i]), np.take(self.s, i, axis=j))
+
+    def projection(self, name: str) -> ViableSection:
+        """The states viable for some grid value of ``name`` (a 3-D map's shadow)."""
+        j = self._third(name)
+        return self._section(j, "projection", math.nan, np.asarray(self.s.any(axis=j)))
+
+    def _third(self, name: str) -> int:
+        names = self.map.names
+        if len(names) != 3 or name == "y" or name not in names:
+            raise ValueError(f"name must be one of {[n for n in names if n != 'y']} of a "
+                             f"map over three state variables, got {name!r} of {list(names)}")
+        return names.index(name)
+
+    def _section(self, j: int, kind: str, at: float, s: np.ndarray) -> ViableSection:
+        m = self.map
+        keep = [k for k in range(3) if k != j]
+        return ViableSection(tuple(m.names[k] for k in keep), tuple(m.grid[k] for k in keep),
+                             s, kind, m.names[j], at, self.rule, m.energy)
+
     def to_dataframe(self) -> pd.DataFrame:
         """The map's table plus ``viable`` (the pair) and ``state_viable``."""
         df = self.map.to_dataframe()
@@ -287,18 +332,87 @@ class Viability(Result):
         return plot_viability(self, ax=ax)
 
 
+@dataclass(frozen=True, eq=False, repr=False)
+class ViableSection(Result):
+    """Viable states of a 3-D viability result over two of its variables.
+
+    Attributes
+    ----------
+    names, grid : as :class:`StateActionMap`, the two variables kept
+    s : ndarray of bool, shape (grid shape...)
+        Viable states.
+    kind : {"slice", "projection"}
+        ``"slice"``: at the grid value ``at`` of ``over`` (the one nearest 0);
+        ``"projection"``: viable for some grid value of ``over`` (``at`` NaN).
+    over : str
+        The variable left out.
+    at : float
+    rule : str
+    energy : float
+    """
+
+    names: tuple[str, ...]
+    grid: tuple[np.ndarray, ...]
+    s: np.ndarray
+    kind: str
+    over: str
+    at: float
+    rule: str
+    energy: float
+
+    @property
+    def label(self) -> str:
+        """Which section it is, e.g. ``"slice at phi = 0"`` or ``"projection over phid"``."""
+        if self.kind == "slice":
+            return f"slice at {self.over} = {self.at:.4g}"
+        return f"projection over {self.over} (viable for some {self.over})"
+
+    @property
+    def fraction(self) -> float:
+        """Share of the section's grid that is viable."""
+        return float(self.s.mean())
+
+    def __repr__(self) -> str:
+        return (f"ViableSection({_short(self.grid, self.names)}, {self.label}: "
+                f"{int(self.s.sum())} of {self.s.size} viable)")
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per state of the section: its coordinates and ``viable``."""
+        import pandas as pd
+
+        data: dict[str, Any] = dict(zip(self.names, grid_columns(self.grid)))
+        data["viable"] = self.s.ravel()
+        return with_units(pd.DataFrame(data), {**{n: _unit(n) for n in self.names},
+                                               "viable": "-"})
+
+    def _table_fields(self) -> tuple[str, ...]:
+        return ("s",)
+
+    @classmethod
+    def _from_table(cls, df: pd.DataFrame, fields: dict[str, Any]) -> dict[str, Any]:
+        shape = tuple(len(g) for g in fields["grid"])
+        return dict(fields, s=df["viable"].to_numpy(bool).reshape(shape))
+
+    def plot(self, ax: Axes | None = None) -> Any:
+        """The section (:func:`tslip.plotting.viability.plot_section`)."""
+        from ..plotting.viability import plot_section
+
+        return plot_section(self, ax=ax)
+
+
 def viability(smap: StateActionMap, rule: str = "bracket") -> Viability:
     """The viability kernel of a state-action map, by the iteration of vibly's ``compute_QV``.
 
     Starting from every pair whose stride does not fail, each sweep keeps a
     pair only if its successor lands in a viable state by ``rule``, and a
     state is viable while some action from it is, until nothing changes
-    (:func:`tslip.gait._viable.viable_sets`).
+    (:func:`tslip.gait._viable.viable_sets_chunked`, on the compact int32
+    successor cells of :func:`tslip.gait._viable.encode_chunks`).
 
     Cell rule (``rule``), for a successor between grid points:
 
     * ``"bracket"`` (default, tslip's, conservative): viable only if every
-      grid point of the cell around it (2 in 1-D, 4 in 2-D) is a viable
+      grid point of the cell around it (2 in 1-D, 4 in 2-D, 8 in 3-D) is a viable
       state; on a grid point (within 1e-9 of a spacing), only that point;
       outside the grid's range, never.
     * ``"nearest"``: viable if the nearest grid point is; outside the grid's
@@ -327,8 +441,8 @@ def viability(smap: StateActionMap, rule: str = "bracket") -> Viability:
     n_states = int(np.prod([len(g) for g in smap.grid]))
     d = len(smap.names)
     ok = ~smap.failed.ravel()
-    cells = _viable.successor_cells(smap.grid, smap.next.reshape(-1, d), ok, rule)
-    q, s, sweeps = _viable.viable_sets(cells, ok, n_states)
+    chunks = _viable.encode_chunks(smap.grid, smap.next.reshape(-1, d), ok, rule)
+    q, s, sweeps = _viable.viable_sets_chunked(chunks, n_states, len(smap.actions))
     return Viability(smap, rule, q.reshape(smap.shape), s.reshape(smap.shape[:-1]), sweeps)
 
 
@@ -436,11 +550,14 @@ def state_action_map(params: Params, states: Mapping[str, Sequence[float] | np.n
         lift-off; :func:`tslip.gait.section.apex_section_ok`), e.g.
         ``preset("slip")``.
     states : dict
-        One or two apex variables and their grids: ``{"y": heights}`` [L]
-        for the SLIP; for the TSLIP e.g. ``{"y": ..., "phid": ...}``
-        (:data:`STATE_NAMES`; the others are 0 at the apex).
-    actions : (str, array)
-        The action and its grid: ``("alpha_r", angles)`` (the leg angle set
+        One to three apex variables and their grids: ``{"y": heights}`` [L]
+        for the SLIP; for the TSLIP e.g. ``{"y": ..., "phid": ...}`` or all
+        three ``{"y": ..., "phi": ..., "phid": ...}`` (:data:`STATE_NAMES`;
+        any left out is 0 at the apex, so a map over fewer variables is the
+        slice of the 3-D map at 0, bit for bit).
+    actions : (str, array) or {str: array}
+        The action and its grid: ``("alpha_r", angles)`` or
+        ``{"alpha_r": angles}`` (one entry) (the leg angle set
         at lift-off, the SLIP's touch-down angle [rad]) or any parameter
         :func:`tslip.gait.continuation.set_param` accepts (e.g. ``"k"``).
     energy : float

@@ -3,7 +3,10 @@
 :func:`plot_viability` draws the state-action grid as vibly does: each cell
 coloured by whether its stride fails at once, survives it but leads out of
 the viable set, or is viable; for two state variables, the viable states
-coloured by the share of viable actions. :func:`plot_basin` draws the
+coloured by the share of viable actions; for three, the projection over the
+last (:meth:`tslip.gait.viability.Viability.projection`).
+:func:`plot_section` draws a 3-D result's slice or projection, labelled as
+which it is. :func:`plot_basin` draws the
 strides to reach the gait over the start grid, falls marked.
 """
 
@@ -22,9 +25,9 @@ from .notation import axis_label
 from .sweeps import _STABLE_GREEN, param_label
 
 if TYPE_CHECKING:
-    from ..gait.viability import Basin, Viability
+    from ..gait.viability import Basin, Viability, ViableSection
 
-__all__ = ["plot_viability", "plot_basin"]
+__all__ = ["plot_viability", "plot_section", "plot_basin"]
 
 _LABELS = {"y": axis_label("apex height $y$", UNIT["length"]),
            "phi": axis_label(r"apex pitch $\phi$", UNIT["angle"]),
@@ -59,9 +62,12 @@ def plot_viability(result: Viability, ax: Axes | None = None) -> Figure:
     stride but is not viable (it fails later, or leaves the grid, which the
     cell rule counts as not viable), green where it is viable. Two: the
     viable states, shaded by the share of their actions that are viable.
+    Three: the projection over the last variable (:func:`plot_section`).
     """
-    fig, ax = _fig(ax)
     m = result.map
+    if len(m.names) == 3:
+        return plot_section(result.projection(m.names[2]), ax=ax)
+    fig, ax = _fig(ax)
     energy = "" if np.isnan(m.energy) else f" at E = {m.energy:.4g} MgL"
     if len(m.names) == 1:
         cls = np.where(m.failed, 0, np.where(result.q, 2, 1))
@@ -81,6 +87,22 @@ def plot_viability(result: Viability, ax: Axes | None = None) -> Figure:
         ax.set_ylabel(_label(m.names[0]))
     ax.set_title(f"viability ({result.rule}){energy}: {100 * result.viable_fraction:.1f} % "
                  "of pairs viable", fontsize=10)
+    return fig
+
+
+def plot_section(result: ViableSection, ax: Axes | None = None) -> Figure:
+    """A slice or projection of a 3-D viable set, titled with which it is."""
+    fig, ax = _fig(ax)
+    ax.pcolormesh(_edges(result.grid[1]), _edges(result.grid[0]), result.s.astype(float),
+                  cmap=ListedColormap(["#f2d0a4", _STABLE_GREEN]), vmin=0, vmax=1)
+    ax.set_xlabel(_label(result.names[1]))
+    ax.set_ylabel(_label(result.names[0]))
+    energy = "" if np.isnan(result.energy) else f", E = {result.energy:.4g} MgL"
+    ax.set_title(f"viable states ({result.rule}{energy}), {result.label}: "
+                 f"{100 * result.fraction:.1f} %", fontsize=9)
+    ax.legend(handles=[Patch(color=_STABLE_GREEN, label="viable"),
+                       Patch(color="#f2d0a4", label="not viable")], fontsize=8,
+              loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2, frameon=False)
     return fig
 
 

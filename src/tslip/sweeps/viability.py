@@ -6,8 +6,13 @@ chunks of about :data:`CHUNK_CELLS` cells (state points times actions, in
 C order, fixed by the spec alone), computes each chunk's cells in one
 batched call (:func:`tslip.gait.viability.map_cells`) as a task of the
 study scheduler (:mod:`tslip.sweeps._schedule`, worker processes from
-:mod:`tslip.sweeps._pool`), and writes each chunk to ``cache/`` atomically
-the moment it is done, by the process that computed it. The cache key
+:mod:`tslip.sweeps._pool`, or a Dask cluster given its scheduler's
+address), and writes each chunk to ``cache/`` atomically the moment it is
+done, by the process that computed it (on Dask, by this process as the
+chunk arrives: the workers need not share its disk). A chunk is data only:
+one ``.npz`` of a float64 ``next`` and an integer ``status`` array, read
+with ``allow_pickle=False`` and its dtypes and shapes checked (anything
+else is computed again). The cache key
 hashes the base parameters, energy, options, the chunk's states and
 actions and the code behind them, so an interrupted run resumes with the
 missing chunks, a finished one reruns instantly, and any worker count
@@ -31,7 +36,7 @@ with ``run.json``; one run at a time per folder (``.lock``)::
     atol = 1e-12
     method = "dop853"
 
-    [[state]]                 # one or two apex variables
+    [[state]]                 # one to three apex variables: y, phi, phid
     name = "y"
     from = 1.0
     to = 1.6
@@ -42,6 +47,9 @@ with ``run.json``; one run at a time per folder (``.lock``)::
     from = 1.0
     to = 1.45
     points = 100
+
+The action may also be written ``[actions.alpha_r]`` with ``values = [...]``
+or ``from``/``to``/``points`` (one action).
 """
 
 from __future__ import annotations
@@ -51,6 +59,7 @@ import hashlib
 import io
 import json
 import time
+import zipfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -73,7 +82,7 @@ from .run import StudyInterrupted, _cached_names
 from .spec import Axis
 
 __all__ = ["CHUNK_CELLS", "ViabilityInterrupted", "ViabilitySpec", "chunk_keys", "run_viability",
-           "saved_cells"]
+           "saved_cells", "read_chunk"]
 
 Progress = Callable[[int, int], None]
 
@@ -156,7 +165,7 @@ class ViabilitySpec:
     def from_dict(cls, data: dict[str, Any]) -> ViabilitySpec:
         data = dict(data)
         allowed = {"name", "description", "preset", "params", "options", "state", "action",
-                   "energy", "rule"}
+                   "actions", "energy", "rule"}
         unknown = set(data) - allowed
         if unknown:
             raise ValueError(f"unknown key {sorted(unknown)[0]!r}; allowed: {sorted(allowed)}")
@@ -179,13 +188,11 @@ class ViabilitySpec:
                              f"allowed: {sorted(known)}")
         options = IntegratorOptions(**{**_TIGHT, **opts})
         states = data.get("state")
-        if not isinstance(states, list) or not 1 <= len(states) <= 2:
-            raise ValueError("give one or two [[state]] tables (apex variables)")
-        if "action" not in data:
-            raise ValueError("[action] is missing: a parameter and its grid")
+        if not isinstance(states, list) or not 1 <= len(states) <= 3:
+            raise ValueError("give one to three [[state]] tables (apex variables)")
         return cls(name=str(data.get("name", "viability")), base=base,
                    states=tuple(_grid(s, "[[state]]") for s in states),
-                   action=_grid(data["action"], "[action]"),
+                   action=_action(data),
                    energy=check_number(data["energy"], "energy [MgL]", lower=0.0,
                                        lower_open=True),
                    rule=data.get("rule", "bracket"), options=options,
@@ -199,6 +206,24 @@ class ViabilitySpec:
 
 
 _TIGHT = {"rtol": 1e-12, "atol": 1e-12, "method": "dop853"}
+
+
+def _action(data: dict[str, Any]) -> Axis:
+    """The action: ``[action]`` (with a name) or ``[actions.<name>]`` (one entry)."""
+    if ("action" in data) == ("actions" in data):
+        raise ValueError("give the action as [action] (name and values) or as "
+                         "[actions.<name>] (values), one of the two")
+    if "action" in data:
+        return _grid(data["action"], "[action]")
+    acts = data["actions"]
+    if not isinstance(acts, dict) or len(acts) != 1:
+        got = len(acts) if isinstance(acts, dict) else repr(acts)
+        raise ValueError("[actions] must hold one [actions.<name>] table (two actions are "
+                         f"not supported yet), got {got}")
+    (name, table), = acts.items()
+    if not isinstance(table, dict) or "name" in table:
+        raise ValueError(f"[actions.{name}] must be a table of values or from/to/points")
+    return _grid({"name": name, **table}, f"[actions.{name}]")
 
 
 def _prefix(spec: ViabilitySpec) -> Any:
@@ -235,24 +260,45 @@ def _chunk_task(spec: ViabilitySpec, points: np.ndarray, key: str, cache: str | 
                             (spec.action.param, np.asarray(spec.action.values)), spec.energy,
                             spec.options)
     if cache is not None:
-        buf = io.BytesIO()
-        np.savez(buf, next=nxt, status=status)
-        atomic_write(Path(cache) / f"{key}.npz", lambda tmp: Path(tmp).write_bytes(buf.getvalue()))
+        _write_chunk(Path(cache) / f"{key}.npz", nxt, status)
     (tick or _pool.notify)(int(status.size))
     return nxt, status
 
 
-def _read_chunk(path: Path) -> tuple[np.ndarray, np.ndarray] | None:
+def _write_chunk(path: Path, nxt: np.ndarray, status: np.ndarray) -> None:
+    buf = io.BytesIO()
+    np.savez(buf, next=np.asarray(nxt, dtype=np.float64),
+             status=np.asarray(status, dtype=np.int64))
+    atomic_write(path, lambda tmp: Path(tmp).write_bytes(buf.getvalue()))
+
+
+def read_chunk(path: str | Path, n_points: int, n_actions: int,
+               n_names: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """A cached chunk's ``(next, status)``, or None if it is not exactly that data.
+
+    Data only: read with ``allow_pickle=False`` (an object array is refused),
+    the two arrays and nothing else, ``next`` float64 of shape
+    ``(n_points, n_actions, n_names)`` and ``status`` an integer array of
+    shape ``(n_points, n_actions)``. Anything else (damaged, foreign, a
+    pickle) is None: the chunk is computed again.
+    """
     try:
-        with np.load(path) as z:
-            return z["next"], z["status"]
-    except (OSError, ValueError, KeyError):  # damaged: compute it again
+        with open(path, "rb") as f, np.load(f, allow_pickle=False) as z:
+            if sorted(z.files) != ["next", "status"]:
+                return None
+            nxt, status = z["next"], z["status"]
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
         return None
+    if (nxt.dtype != np.float64 or status.dtype.kind not in "iu"
+            or nxt.shape != (n_points, n_actions, n_names)
+            or status.shape != (n_points, n_actions)):
+        return None
+    return nxt, status.astype(np.int64)
 
 
 def run_viability(spec: ViabilitySpec, out_dir: str | Path | None = None, *,
                   workers: int | None = None, progress: Progress | None = None,
-                  wait: bool = False) -> Viability:
+                  wait: bool = False, scheduler: str | None = None) -> Viability:
     """Compute (or resume) the spec's state-action map and its viability kernel.
 
     Parameters
@@ -267,6 +313,10 @@ def run_viability(spec: ViabilitySpec, out_dir: str | Path | None = None, *,
         ``progress(cells_done, cells_total)``.
     wait : bool
         Wait for another run holding ``out_dir`` instead of raising.
+    scheduler : str, optional
+        Address of a Dask distributed scheduler (``tslip[dask]``): the chunks
+        run on its cluster (``workers`` is then ignored) and are cached here
+        as they arrive; the result is the same, bit for bit.
 
     Raises
     ------
@@ -277,16 +327,16 @@ def run_viability(spec: ViabilitySpec, out_dir: str | Path | None = None, *,
         raise ValueError(f"workers must be >= 1, got {workers}")
     try:
         if out_dir is None:
-            return _run(spec, None, workers, progress)
+            return _run(spec, None, workers, progress, scheduler)
         with folder_lock(out_dir, wait=wait):
-            return _run(spec, Path(out_dir), workers, progress)
+            return _run(spec, Path(out_dir), workers, progress, scheduler)
     except KeyboardInterrupt:
         saved = saved_cells(spec, out_dir) if out_dir is not None else 0
         raise ViabilityInterrupted(saved, spec.n_cells) from None
 
 
 def _run(spec: ViabilitySpec, out: Path | None, n_workers: int | None,
-         progress: Progress | None) -> Viability:
+         progress: Progress | None, scheduler: str | None = None) -> Viability:
     t0 = time.perf_counter()
     cache = out / "cache" if out is not None else None
     names = _cached_names(cache)
@@ -303,15 +353,17 @@ def _run(spec: ViabilitySpec, out: Path | None, n_workers: int | None,
 
     tasks = []
     for sl, key in zip(spec.chunks(), chunk_keys(spec)):
-        got = _read_chunk(cache / f"{key}.npz") if f"{key}.npz" in names else None  # type: ignore[operator]
+        got = (read_chunk(cache / f"{key}.npz", sl.stop - sl.start, n_a, d)  # type: ignore[operator]
+               if f"{key}.npz" in names else None)
         if got is not None:
             nxt[sl], status[sl] = got
             state["done"] += got[1].size
             continue
         n = (sl.stop - sl.start) * n_a
+        here = cache is not None and scheduler is None  # on Dask: cached here, on arrival
         tasks.append(Task((spec.name, sl.start), _chunk_task,
-                          (spec, pts[sl], key, str(cache) if cache is not None else None),
-                          cost=n * CELL_SECONDS, meta={"slice": sl}))
+                          (spec, pts[sl], key, str(cache) if here else None),
+                          cost=n * CELL_SECONDS, meta={"slice": sl, "key": key}))
     n_cached = state["done"]
     if progress:
         progress(n_cached, total)
@@ -319,10 +371,15 @@ def _run(spec: ViabilitySpec, out: Path | None, n_workers: int | None,
     def on_done(task: Task, result: tuple[np.ndarray, np.ndarray]) -> list[Task]:
         sl = task.meta["slice"]
         nxt[sl], status[sl] = result
+        if scheduler is not None:
+            if cache is not None:
+                _write_chunk(cache / f"{task.meta['key']}.npz", *result)
+            tick(int(result[1].size))
         return []
 
-    workers = choose_workers(sum(t.cost for t in tasks), n_workers, width=len(tasks))
-    run_tasks(tasks, on_done, workers, tick=tick)
+    workers = (1 if scheduler is not None else
+               choose_workers(sum(t.cost for t in tasks), n_workers, width=len(tasks)))
+    run_tasks(tasks, on_done, workers, tick=tick, scheduler=scheduler)
     smap = StateActionMap(tuple(a.param for a in spec.states),
                           tuple(np.asarray(a.values, dtype=float) for a in spec.states),
                           spec.action.param, np.asarray(spec.action.values, dtype=float),
@@ -335,5 +392,6 @@ def _run(spec: ViabilitySpec, out: Path | None, n_workers: int | None,
             "tslip_version": __version__, "code": code_hash("tslip.gait.viability"),
             "git": git_hash(), "spec": spec.to_dict(), "cells": total,
             "computed": total - n_cached, "cached": n_cached, "workers": workers,
+            "scheduler": scheduler,
             "seconds": time.perf_counter() - t0})
     return result

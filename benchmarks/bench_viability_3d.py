@@ -1,0 +1,136 @@
+"""The TSLIP's viable set over (y, phi, phid): the r study, and the 3-D map at scale.
+
+Run by hand (not in CI), one mode at a time:
+
+``python benchmarks/bench_viability_3d.py study``
+    The r study of docs/analyses/viability.md: the Table 2.1 passive model
+    with no retraction (``omega_r = 0``, so the apex is a Poincare section)
+    at r = -0.3, 0, 0.3, 0.6, all at the total energy of the Table 2.1 gait
+    (r = 0.3, E = 13.0675 MgL), on one grid: apex height y in [0.4, 1.4] (26
+    points), pitch phi in [-0.2, 0.2] (11), pitch rate phid in [-0.5, 0.5]
+    (11), leg angle alpha_r in [0.85, 1.25] (21): 66,066 cells per r. For
+    each r and cell rule: the share of strides that do not fail, the viable
+    volume (share of the state grid), and the slice at phi = 0 / phid = 0 and
+    projections, as :class:`tslip.gait.viability.ViableSection` fractions.
+``python benchmarks/bench_viability_3d.py scale --n 20``
+    An n x n x n state grid (y in [0.4, 1.4], phi in [-0.2, 0.2], phid in
+    [-0.5, 0.5]) x 41 actions (alpha_r in [0.85, 1.25]) at r = 0.3 through
+    :func:`tslip.sweeps.viability.run_viability`: on 1 and 2 worker
+    processes and on a Dask ``LocalCluster`` of 2 single-threaded worker
+    processes; wall, CPU per cell (this process plus its children), the
+    chunks (tasks), and the peak resident memory of this process and of its
+    largest child. The issue's grid is ``--n 60`` (8.9 million cells).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import resource
+import tempfile
+import time
+
+import numpy as np
+
+E = 13.06748095449187  # the Table 2.1 gait's total energy [MgL] (r = 0.3)
+
+
+def grid(n_y: int, n_phi: int, n_phid: int) -> dict[str, np.ndarray]:
+    return {"y": np.linspace(0.4, 1.4, n_y), "phi": np.linspace(-0.2, 0.2, n_phi),
+            "phid": np.linspace(-0.5, 0.5, n_phid)}
+
+
+def params(r: float):  # noqa: ANN201
+    import tslip
+
+    return dataclasses.replace(tslip.preset("table2.1"), omega_r=0.0, r=r)
+
+
+def study() -> None:
+    from tslip.gait.viability import state_action_map, viability
+
+    g = grid(26, 11, 11)
+    acts = ("alpha_r", np.linspace(0.85, 1.25, 21))
+    print(f"E = {E} MgL; y {g['y'][0]}..{g['y'][-1]} ({len(g['y'])}), phi ±0.2 (11), "
+          f"phid ±0.5 (11), alpha_r 0.85..1.25 (21)")
+    print(f"{'r':>5} {'rule':>8} {'no fall':>8} {'volume':>7} {'pairs':>7} "
+          f"{'phi=0':>7} {'phid=0':>7} {'proj phi':>8} {'proj phid':>9} {'sweeps':>6}")
+    for r in (-0.3, 0.0, 0.3, 0.6):
+        m = state_action_map(params(r), g, acts, energy=E)
+        for rule in ("bracket", "nearest", "vibly"):
+            v = viability(m, rule)
+            print(f"{r:5.1f} {rule:>8} {1 - m.failed.mean():8.4f} {v.volume_fraction:7.4f} "
+                  f"{v.viable_fraction:7.4f} {v.slice('phi').fraction:7.4f} "
+                  f"{v.slice('phid').fraction:7.4f} {v.projection('phi').fraction:8.4f} "
+                  f"{v.projection('phid').fraction:9.4f} {v.sweeps:6d}", flush=True)
+
+
+def _cpu() -> float:
+    s, c = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return s.ru_utime + s.ru_stime + c.ru_utime + c.ru_stime
+
+
+def _spec(n: int):  # noqa: ANN202
+    from tslip.sweeps.spec import Axis
+    from tslip.sweeps.viability import ViabilitySpec
+
+    g = grid(n, n, n)
+    return ViabilitySpec(name=f"scale{n}", base=params(0.3),
+                         states=tuple(Axis(k, tuple(float(x) for x in v)) for k, v in g.items()),
+                         action=Axis("alpha_r", tuple(float(x) for x in
+                                                      np.linspace(0.85, 1.25, 41))),
+                         energy=E)
+
+
+def run_scale(n: int) -> None:
+    from tslip.sweeps.viability import run_viability
+
+    spec = _spec(n)
+    cells = spec.n_cells
+    print(f"{n}^3 x 41 = {cells} cells, {len(spec.chunks())} chunks")
+    for label, kw in (("pool 1", {"workers": 1}), ("pool 2", {"workers": 2}), ("dask 2", None)):
+        with tempfile.TemporaryDirectory() as tmp:
+            c0, w0 = _cpu(), time.perf_counter()
+            if kw is None:
+                from dask.distributed import Client, LocalCluster
+
+                with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, Client(cluster) as client:
+                    w0 = time.perf_counter()
+                    c0 = _cpu() - sum(client.run(_own_cpu).values())
+                    v = run_viability(spec, tmp, scheduler=cluster.scheduler_address)
+                    wall = time.perf_counter() - w0
+                    cpu = _cpu() - c0 + sum(client.run(_own_cpu).values())
+                    peak_w = max(client.run(_own_peak).values())
+            else:
+                v = run_viability(spec, tmp, **kw)
+                wall, cpu = time.perf_counter() - w0, _cpu() - c0
+                peak_w = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+        print(f"{label}: wall {wall:8.1f} s, CPU {cpu:8.1f} s = {1e6 * cpu / cells:6.1f} us "
+              f"per cell; peak RSS here {peak:.0f} MB, largest worker {peak_w:.0f} MB; "
+              f"volume {v.volume_fraction:.4f}", flush=True)
+
+
+def _own_cpu() -> float:
+    s = resource.getrusage(resource.RUSAGE_SELF)
+    return s.ru_utime + s.ru_stime
+
+
+def _own_peak() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("mode", choices=("study", "scale"))
+    ap.add_argument("--n", type=int, default=20, help="state grid points per axis (scale)")
+    args = ap.parse_args()
+    if args.mode == "study":
+        study()
+    else:
+        run_scale(args.n)
+
+
+if __name__ == "__main__":
+    main()
