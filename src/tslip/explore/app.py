@@ -107,8 +107,8 @@ class Explorer:
         self.limits: dict[str, float] | None = None
         self.loading = False  # while widgets are set from a state, do not ask per widget
         self._build(state)
-        self.show_errors(errors)
         self.request()
+        self.show_errors(errors)  # the URL's refused entries stay until the next change
 
     # -- layout --------------------------------------------------------------
     def _build(self, state: ExploreState) -> None:
@@ -143,7 +143,7 @@ class Explorer:
         self.fraction.on_change("value", self._guard(self._on_fraction))
         self._show_gains(p.controller.name)
 
-        self.gait_src = ColumnDataSource({"x": [], "y": []})
+        self.gait_src = ColumnDataSource({"x": [], "y": []}, name="gait_source")
         self.stance_src = ColumnDataSource({"x": [], "y": []})
         self.pose_src = ColumnDataSource({"xs": [], "ys": []})
         self.gait_fig = figure(title="periodic gait (2 strides)", width=560, height=260,
@@ -204,7 +204,8 @@ class Explorer:
         self.map_go = Button(label="compute map", name="map_go", button_type="primary")
         self.map_stop = Button(label="cancel", name="map_stop", disabled=True)
         self.map_status = Div(text="", name="map_status")
-        self.map_src = ColumnDataSource({"x": [], "y": [], "w": [], "h": [], "lam": []})
+        self.map_src = ColumnDataSource({"x": [], "y": [], "w": [], "h": [], "lam": []},
+                                        name="map_source")
         mapper = LinearColorMapper(palette=Viridis256, low=0.0, high=1.2, nan_color="lightgrey")
         self.map_fig = figure(title="largest non-trivial |multiplier| (grey: no gait)",
                               width=460, height=380, tools="tap,reset", name="map_plot",
@@ -443,11 +444,17 @@ class Explorer:
         x, y = self.map_x.value, self.map_y.value
         if x == y:
             raise ValueError("map x and map y must be two different parameters")
+        for name in (x, y):
+            if not self.sliders[name].visible:
+                raise ValueError(f"{name} is not a gain of the {self.controller.value} "
+                                 "controller; map one of the controls shown")
         n = int(self.map_n.value)
         spans = []
-        for name in (x, y):
-            c = control_for(name)
-            spans.append((name, c.start, c.end))
+        for name in (x, y):  # around the current value: a quarter of the slider's span
+            s = self.sliders[name]
+            half = 0.125 * (s.end - s.start)
+            lo = min(max(s.start, s.value - half), s.end - 2 * half)
+            spans.append((name, float(lo), float(lo + 2 * half)))
         self.map_cancel.clear()
         self.map_go.disabled, self.map_stop.disabled = True, False
         self.map_status.text = f"map: 0/{n * n} points"
