@@ -23,18 +23,9 @@ from typing import Any
 import numpy as np
 from bokeh.document import Document
 from bokeh.layouts import column, row
-from bokeh.models import (
-    Button,
-    ColorBar,
-    ColumnDataSource,
-    CustomJS,
-    Div,
-    LinearColorMapper,
-    Select,
-    Slider,
-    Spinner,
-    TapTool,
-)
+from bokeh.models import ColumnDataSource, CustomJS, LinearColorMapper, Range1d, TapTool
+from bokeh.models.annotations import ColorBar
+from bokeh.models.widgets import Button, Div, Select, Slider, Spinner
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
@@ -115,11 +106,11 @@ class Explorer:
         p = state.params
         self.status = Div(text="computing the first gait", name="status")
         self.error = Div(text="", name="error", styles={"color": "#b00020"})
-        self.preset = Select(title="preset", value=state.preset, options=list(PRESETS),
+        self.preset = Select(title="preset", value=state.preset, options=_options(PRESETS),
                              name="preset")
         self.controller = Select(title="hip controller", value=p.controller.name,
-                                 options=list(GAINS), name="controller")
-        self.clock = Select(title="retraction clock", value=p.retraction, options=list(CLOCKS),
+                                 options=_options(GAINS), name="controller")
+        self.clock = Select(title="retraction clock", value=p.retraction, options=_options(CLOCKS),
                             name="retraction")
         self.sliders: dict[str, Slider] = {}
         for c in CONTROLS:
@@ -128,7 +119,7 @@ class Explorer:
             value = getattr(p.controller, name, control_for(name).start)
             self.sliders[name] = self._slider(name, float(value))
         self.kind = Select(title="disturbance at the 2nd touch-down", value=state.disturbance,
-                           options=list(DISTURBANCES), name="disturbance")
+                           options=_options(DISTURBANCES), name="disturbance")
         self.fraction = Slider(title="magnitude [fraction of its limit]", start=0.0, end=2.0,
                                step=0.05, value=state.fraction, name="fraction")
         self.link = Div(text="", name="permalink")
@@ -159,7 +150,8 @@ class Explorer:
         self.mult_src = ColumnDataSource({"re": [], "im": [], "abs": [], "kind": []})
         self.triv_src = ColumnDataSource({"re": [], "im": [], "kind": []})
         self.mult_fig = figure(title="Floquet multipliers", width=300, height=300,
-                               x_range=(-1.3, 1.3), y_range=(-1.3, 1.3), match_aspect=True,
+                               x_range=Range1d(start=-1.3, end=1.3),
+                               y_range=Range1d(start=-1.3, end=1.3), match_aspect=True,
                                x_axis_label="Re", y_axis_label="Im", name="multiplier_plot",
                                tooltips=[("|lambda|", "@abs"), ("", "@kind")])
         self.mult_fig.line(cx, cy, color="grey")
@@ -197,8 +189,8 @@ class Explorer:
 
     def _build_map(self) -> None:
         names = [c.name for c in CONTROLS] + _all_gains()
-        self.map_x = Select(title="map x", value="r", options=names, name="map_x")
-        self.map_y = Select(title="map y", value="k", options=names, name="map_y")
+        self.map_x = Select(title="map x", value="r", options=_options(names), name="map_x")
+        self.map_y = Select(title="map y", value="k", options=_options(names), name="map_y")
         self.map_n = Spinner(title="points per axis", low=2, high=30, step=1, value=8,
                              name="map_points")
         self.map_go = Button(label="compute map", name="map_go", button_type="primary")
@@ -208,12 +200,12 @@ class Explorer:
                                         name="map_source")
         mapper = LinearColorMapper(palette=Viridis256, low=0.0, high=1.2, nan_color="lightgrey")
         self.map_fig = figure(title="largest non-trivial |multiplier| (grey: no gait)",
-                              width=460, height=380, tools="tap,reset", name="map_plot",
+                              width=460, height=380, tools=[TapTool(mode="replace"), "reset"],
+                              name="map_plot",
                               tooltips=[("x", "@x"), ("y", "@y"), ("|lambda|", "@lam")])
         self.map_fig.rect("x", "y", "w", "h", source=self.map_src,
                           fill_color={"field": "lam", "transform": mapper}, line_color=None)
         self.map_fig.add_layout(ColorBar(color_mapper=mapper), "right")
-        self.map_fig.select_one(TapTool).mode = "replace"
         self.map_go.on_click(self._guard(self._on_map))
         self.map_stop.on_click(self._guard(lambda: self.map_cancel.set()))
         self.map_src.selected.on_change("indices", self._guard(self._on_cell))
@@ -394,7 +386,7 @@ class Explorer:
         if not solved.ok:
             for src in (self.gait_src, self.stance_src, self.mult_src, self.triv_src,
                         self.pose_src, self.strip_src, self.strip_pose, self.ground_src):
-                src.data = {k: [] for k in src.data}
+                src.data = {str(k): [] for k in src.data}
             self.mult_text.text = "no gait"
             self.limit_text.text = "robustness limits: no gait"
             self.strip_text.text = ""
@@ -448,7 +440,7 @@ class Explorer:
             if not self.sliders[name].visible:
                 raise ValueError(f"{name} is not a gain of the {self.controller.value} "
                                  "controller; map one of the controls shown")
-        n = int(self.map_n.value)
+        n = int(self.map_n.value or 2)
         spans = []
         for name in (x, y):  # around the current value: a quarter of the slider's span
             s = self.sliders[name]
@@ -508,12 +500,17 @@ class Explorer:
         self.request()
 
 
+def _options(names: Any) -> list[Any]:
+    """A Select's options (Bokeh's stubs want a list of str or pairs)."""
+    return list(names)
+
+
 def _label(name: str) -> str:
     c = control_for(name)
     return f"{name} [{c.unit}]"
 
 
-def _poses(tr: Any, idx: np.ndarray) -> dict[str, list[list[float]]]:
+def _poses(tr: Any, idx: np.ndarray) -> dict[str, Any]:
     """Leg (foot to hip) and trunk (hip to CoM) lines at the samples ``idx``."""
     xs, ys = [], []
     for i in idx:
@@ -534,9 +531,9 @@ def make_document(doc: Document) -> None:
     from .state import parse_query
 
     args: dict[str, str] = {}
-    ctx = doc.session_context
-    if ctx is not None and ctx.request is not None:
-        for k, v in ctx.request.arguments.items():
+    request = getattr(doc.session_context, "request", None)
+    if request is not None:
+        for k, v in request.arguments.items():
             if k.startswith("bokeh-"):
                 continue
             args[k] = v[-1].decode("utf-8", "replace") if v else ""
