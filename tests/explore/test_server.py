@@ -1,13 +1,13 @@
 """The explorer's server over HTTP: the page, the websocket allow-list, the exports."""
 
-import asyncio
+import base64
+import http.client
 import io
+import os
 import tomllib
 
 import pandas as pd
 import pytest
-from tornado.httpclient import HTTPClientError, HTTPRequest
-from tornado.websocket import websocket_connect
 
 import tslip
 from tslip.simulation.result import TRAJECTORY_COLUMNS
@@ -21,26 +21,31 @@ def test_the_page_is_served_on_the_loopback_address(server):
     assert b"<title>tslip explore</title>" in body
 
 
-async def _open_ws(port: int, origin: str) -> int:
-    """The HTTP status of a websocket handshake from ``origin`` (101 when it opens)."""
-    req = HTTPRequest(f"ws://127.0.0.1:{port}/ws", headers={"Origin": origin})
+def _open_ws(port: int, origin: str) -> int:
+    """The HTTP status of a websocket handshake (RFC 6455) from ``origin``: 101 opens it.
+
+    Plain HTTP, as a browser sends it (no event loop: Playwright's runs in this thread).
+    """
+    conn = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
     try:
-        conn = await websocket_connect(req, subprotocols=["bokeh", "no-token"])
-    except HTTPClientError as exc:
-        return exc.code
-    conn.close()
-    return 101
+        conn.request("GET", "/ws", headers={
+            "Upgrade": "websocket", "Connection": "Upgrade", "Origin": origin,
+            "Sec-WebSocket-Key": base64.b64encode(os.urandom(16)).decode(),
+            "Sec-WebSocket-Version": "13", "Sec-WebSocket-Protocol": "bokeh, no-token"})
+        return conn.getresponse().status
+    finally:
+        conn.close()
 
 
 @pytest.mark.parametrize("origin", ["http://evil.example", "http://127.0.0.1:1",
                                     "null", "http://127.0.0.1.evil.example"])
 def test_a_websocket_from_another_origin_is_refused(server, origin):
-    assert asyncio.run(_open_ws(server.port, origin)) == 403
+    assert _open_ws(server.port, origin) == 403
 
 
 def test_a_websocket_from_its_own_origin_gets_past_the_allow_list(server):
     """The control for the test above: the same handshake from the page's own origin."""
-    assert asyncio.run(_open_ws(server.port, server.url)) == 101
+    assert _open_ws(server.port, server.url) == 101
 
 
 def test_the_toml_export_holds_the_solved_gait_parameters(server):
