@@ -1,0 +1,42 @@
+"""``tslip explore``: the interactive explorer in the browser (the ``explore`` extra)."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+from ._common import errors, interruptible
+
+__all__ = ["commands", "explore_cmd"]
+
+#: ``explore``, added to the app by :mod:`tslip.cli.main`.
+commands = typer.Typer()
+
+
+@commands.command("explore")
+def explore_cmd(
+    port: Annotated[int, typer.Option("--port", min=1, max=65535,
+                                      help="Port to serve on.")] = 5006,
+    host: Annotated[str, typer.Option("--host", help="Address to bind (default 127.0.0.1, "
+                                      "this machine only).")] = "127.0.0.1",
+    no_open: Annotated[bool, typer.Option("--no-open", help="Do not open a browser.")] = False,
+) -> None:
+    """Explore gaits in the browser: sliders, gait, multipliers, robustness, stability map.
+
+    Serves a local web page (Bokeh server) until Ctrl-C. It binds 127.0.0.1
+    unless --host says otherwise, and accepts websocket connections only from
+    its own host:port. Needs the explore extra: pip install "tslip[explore]".
+    """
+    with errors(), interruptible():
+        try:
+            import bokeh  # noqa: F401
+        except ImportError:
+            raise ValueError('tslip explore needs Bokeh: pip install "tslip[explore]"') from None
+        if host != "127.0.0.1":
+            typer.echo(f"warning: serving on {host}: other machines that reach this address "
+                       "can use the explorer (and the CPU); use --host 127.0.0.1 to keep it "
+                       "local", err=True)
+        from ..explore.server import serve
+
+        serve(port, host, open_browser=not no_open)

@@ -1,0 +1,21 @@
+"""``tslip explore``: an interactive explorer of the TSLIP in the browser (``tslip[explore]``).
+
+Move a slider, see the periodic gait, its Floquet multipliers, its robustness
+limits and the runner after a disturbance; map the largest multiplier over
+two parameters. A Bokeh server (:mod:`.server`) serves one document per tab
+(:mod:`.app`); what it computes are plain functions (:mod:`.compute`) and its
+state and URL query are data parsed with the validators of
+:class:`tslip.Params` (:mod:`.state`). Needs the ``explore`` extra (Bokeh);
+``import tslip.explore`` loads neither Bokeh nor the kernels.
+"""
+
+from .state import CONTROLS, GAINS, ExploreState, parse_query
+
+__all__ = ["CONTROLS", "GAINS", "ExploreState", "parse_query", "serve"]
+
+
+def serve(port: int = 5006, host: str = "127.0.0.1", open_browser: bool = True) -> None:
+    """Serve the explorer at ``http://host:port/`` until Ctrl-C (:func:`.server.serve`)."""
+    from .server import serve as _serve
+
+    _serve(port, host, open_browser)

@@ -1,0 +1,141 @@
+"""What the explorer computes, as plain functions of the parameters (no web code).
+
+The gait and its multipliers (:func:`solve`), the three robustness limits
+(:func:`limits`, stoppable between limits), the runner after a disturbance at
+the second touch-down (:func:`disturbed_run`), the stability map over two
+parameters through the study machinery (:func:`stability_map`), and the
+exports (:func:`params_toml`, :func:`trajectory_parquet`).
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..gait import Floquet, Gait, find_gait, floquet, robustness
+from ..model.parameters import Params
+from ..simulation import Disturbance, Trajectory, simulate
+from ..sweeps import Axis, StudyResult, StudySpec, run_study
+
+__all__ = ["Solved", "solve", "limit", "limits", "disturbed_run", "stability_map", "MapCancelled",
+           "params_toml", "trajectory_parquet", "FIELDS", "magnitude", "unit_circle"]
+
+#: The disturbance field of :class:`tslip.Disturbance` for each robustness kind.
+FIELDS = {"step_down": "dh", "push": "dxd", "pitch_rate": "dphid"}
+
+
+@dataclass(frozen=True, slots=True)
+class Solved:
+    """A gait search's outcome: the gait, its multipliers and two strides, or why not."""
+
+    gait: Gait | None
+    floquet: Floquet | None
+    trajectory: Trajectory | None
+    message: str
+
+    @property
+    def ok(self) -> bool:
+        """A converged gait with multipliers and a recorded run."""
+        return self.floquet is not None and self.trajectory is not None
+
+
+def solve(params: Params, n_steps: int = 2) -> Solved:
+    """The periodic gait of ``params`` (Section 2.8), its multipliers and ``n_steps`` strides."""
+    gait = find_gait(params)
+    if not gait.converged:
+        return Solved(gait, None, None, f"no gait: {gait.message}")
+    fl = floquet(gait)
+    traj = simulate(gait.params, gait.state, n_steps)
+    if traj.status.fell or traj.status.is_error:
+        return Solved(gait, fl, None, f"no gait: the periodic run ended in {traj.status.name}")
+    return Solved(gait, fl, traj, f"gait found (residual {gait.residual:.1e})")
+
+
+def limit(gait: Gait, kind: str) -> float:
+    """One robustness limit of ``gait`` (Section 3.1.3, 25 strides): :func:`tslip.robustness`."""
+    return robustness(gait, kind)  # type: ignore[arg-type]
+
+
+def limits(gait: Gait, stop: Callable[[], bool] = lambda: False,
+           run: Callable[[Gait, str], float] = limit) -> dict[str, float] | None:
+    """The step-down, push and pitch-rate limits (Section 3.1.3); None if ``stop()`` turns true.
+
+    ``stop`` is asked before each limit, so a newer request ends this one
+    after at most one limit's search (about 0.1 s). ``run(gait, kind)``
+    computes one limit (the explorer runs :func:`limit` in a worker process).
+    """
+    out = {}
+    for kind in FIELDS:
+        if stop():
+            return None
+        out[kind] = run(gait, kind)
+    return out
+
+
+def disturbed_run(gait: Gait, kind: str, magnitude: float, n_steps: int = 6) -> Trajectory:
+    """``n_steps`` strides of ``gait`` with a ``kind`` disturbance at the second touch-down."""
+    dist = Disturbance(at_step=1, **{FIELDS[kind]: float(magnitude)})
+    return simulate(gait.params, gait.state, n_steps, disturbance=dist)
+
+
+def magnitude(limit: float, fraction: float) -> float:
+    """The disturbance ``fraction`` of a signed ``limit``; 0 for an infinite or missing one."""
+    return fraction * limit if math.isfinite(limit) else 0.0
+
+
+class MapCancelled(Exception):
+    """The stability map was cancelled."""
+
+
+def stability_map(params: Params, x: tuple[str, float, float], y: tuple[str, float, float],
+                  points: int, progress: Callable[[int, int], None]) -> StudyResult:
+    """Largest non-trivial multiplier over a ``points`` x ``points`` grid of two parameters.
+
+    ``x`` and ``y`` are ``(name, from, to)``; the study runs in this process
+    (:func:`tslip.sweeps.run_study` with one worker), and ``progress`` may
+    raise :class:`MapCancelled` to stop it. The result's ``grid`` has the
+    shape ``(points of y, points of x)``.
+    """
+    spec = StudySpec(name="explore-map", base=params,
+                     axes=(Axis.linspace(_axis(y[0]), y[1], y[2], points),
+                           Axis.linspace(_axis(x[0]), x[1], x[2], points)))
+    return run_study(spec, workers=1, progress=progress)
+
+
+def _axis(name: str) -> str:
+    """A study's name of a control: Params fields as they are, gains as ``controller.<gain>``."""
+    return name if name in Params.__dataclass_fields__ else f"controller.{name}"
+
+
+def params_toml(params: Params) -> str:
+    """The parameters as a TOML file that :meth:`tslip.Params.from_toml` reads back."""
+    data = params.to_dict()
+    ctrl = data.pop("controller")
+    lines = ["# tslip explore: parameters of the current gait", "[params]"]
+    lines += [f"{k} = {_toml(v)}" for k, v in data.items()]
+    lines += ["", "[params.controller]"]
+    lines += [f"{k} = {_toml(v)}" for k, v in ctrl.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _toml(value: object) -> str:
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return repr(float(value))  # type: ignore[arg-type]
+
+
+def trajectory_parquet(traj: Trajectory) -> bytes:
+    """The trajectory's table (:meth:`Trajectory.to_dataframe`) as parquet bytes."""
+    buf = io.BytesIO()
+    traj.to_dataframe().to_parquet(buf, index=False)
+    return buf.getvalue()
+
+
+def unit_circle(n: int = 181) -> tuple[np.ndarray, np.ndarray]:
+    """Points on the unit circle, for the multiplier plot."""
+    t = np.linspace(0.0, 2.0 * np.pi, n)
+    return np.cos(t), np.sin(t)

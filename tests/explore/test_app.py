@@ -1,0 +1,95 @@
+"""The page's logic in this process: first-run message, newer moves win, errors shown."""
+
+from __future__ import annotations
+
+import dataclasses
+import threading
+import time
+
+import pytest
+from bokeh.document import Document
+
+import tslip
+from tslip.explore import app, compute
+from tslip.explore.state import parse_query
+
+
+class Page:
+    """An :class:`app.Explorer` on a document whose next-tick callbacks run when asked."""
+
+    def __init__(self, query: dict[str, str]) -> None:
+        self.doc = Document()
+        self.calls: list = []
+        self.shown: list[str] = []  # the multipliers' text after each callback
+        self.doc.add_next_tick_callback = self.calls.append  # type: ignore[method-assign]
+        state, errors = parse_query(query)
+        self.ex = app.Explorer(self.doc, state, errors)
+
+    def until(self, done, timeout: float = 60.0) -> None:
+        t0 = time.monotonic()
+        while not done():
+            while self.calls:
+                self.calls.pop(0)()
+                self.shown.append(self.ex.mult_text.text)
+            if time.monotonic() - t0 > timeout:
+                raise AssertionError("timed out")
+            time.sleep(0.01)
+
+
+@pytest.fixture
+def held(monkeypatch):
+    """``compute.solve`` waits for ``release``; limits run here, not in a process."""
+    release = threading.Event()
+    solve = compute.solve
+
+    def slow(params):
+        release.wait(30)
+        return solve(params)
+
+    monkeypatch.setattr(compute, "solve", slow)
+    monkeypatch.setattr(app, "_limit_in_process", compute.limit)
+    return release
+
+
+def test_a_cold_kernel_cache_shows_the_compile_message_until_the_first_gait(monkeypatch, held):
+    monkeypatch.setattr(app, "kernels_cold", lambda: True)
+    monkeypatch.setattr(app, "_WARM", threading.Event())
+    page = Page({"preset": "table6.1"})
+    page.until(lambda: page.ex.status.text == app.COMPILING)
+    held.set()
+    page.until(lambda: page.ex.status.text.startswith("gait found"))
+    assert "largest non-trivial" in page.ex.mult_text.text
+    page.ex.close()
+
+
+def test_a_newer_move_replaces_an_older_one(held):
+    page = Page({"preset": "table6.1"})
+    page.ex.sliders["k"].value = 9.0  # while the first request is still held
+    held.set()
+    want = tslip.floquet(tslip.find_gait(
+        dataclasses.replace(tslip.preset("table6.1"), k=9.0))).max_nontrivial
+    page.until(lambda: f"{want:.4f}" in page.ex.mult_text.text)
+    page.until(lambda: page.ex.limit_text.text.startswith("robustness limits (25"))
+    old = tslip.floquet(tslip.find_gait(tslip.preset("table6.1"))).max_nontrivial
+    assert not any(f"{old:.4f}" in text for text in page.shown)  # the older gait never drawn
+    page.ex.close()
+
+
+def test_an_exception_in_the_work_is_shown_and_the_page_goes_on(monkeypatch):
+    monkeypatch.setattr(app, "_limit_in_process", compute.limit)
+    solve = compute.solve
+    calls = []
+
+    def failing_once(params):
+        calls.append(params)
+        if len(calls) == 1:
+            raise RuntimeError("kernel exploded")
+        return solve(params)
+
+    monkeypatch.setattr(compute, "solve", failing_once)
+    page = Page({"preset": "table6.1"})
+    page.until(lambda: "kernel exploded" in page.ex.error.text)
+    page.ex.sliders["k"].value = 9.0
+    page.until(lambda: page.ex.status.text.startswith("gait found"))
+    assert page.ex.error.text == ""
+    page.ex.close()

@@ -1,0 +1,123 @@
+"""The explorer in a real browser (Playwright driving the system Chromium).
+
+The page's widgets live in Bokeh's shadow DOM; the tests read them through
+Bokeh's document in the page (``Bokeh.documents[0]``), the state the browser
+shows, and change a control by setting its model's value there, which the page
+sends to the server exactly as a dragged slider's value. The compute button
+is clicked with the mouse.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from urllib.parse import parse_qs, urlparse
+
+import pytest
+
+import tslip
+
+from .conftest import get
+
+#: JavaScript: the model named ``name`` in the page's Bokeh document, or null.
+_MODEL = "(name) => { const d = window.Bokeh && Bokeh.documents[0];" \
+         " return d ? d.get_model_by_name(name) : null; }"
+TEXT = f"(name) => {{ const m = ({_MODEL})(name); return m ? m.text : null; }}"
+#: Where the docs page finds its screenshot (copied to the site's root; never committed).
+SHOT = Path(__file__).parents[2] / "docs" / "_generated" / "extra" / "explore.png"
+TIMEOUT = 60_000  # ms: the first gait of a page on a loaded machine
+
+
+@pytest.fixture
+def page(browser):
+    ctx = browser.new_context(viewport={"width": 1300, "height": 1500})
+    pg = ctx.new_page()
+    yield pg
+    ctx.close()
+
+
+def open_page(page, server, query: str = "") -> None:
+    page.goto(f"{server.url}/{query}")
+    page.wait_for_function(f"() => ({TEXT})('multipliers')", timeout=TIMEOUT)
+
+
+def text(page, name: str) -> str:
+    return page.evaluate(TEXT, name)
+
+
+def wait_text(page, name: str, contains: str) -> str:
+    page.wait_for_function(f"([n, s]) => (({TEXT})(n) || '').includes(s)", arg=[name, contains],
+                           timeout=TIMEOUT)
+    return text(page, name)
+
+
+def set_value(page, name: str, value: object) -> None:
+    page.evaluate(f"([n, v]) => {{ ({_MODEL})(n).value = v; }}", [name, value])
+
+
+def expected_largest(params: tslip.Params) -> str:
+    """The page's text of the largest non-trivial multiplier, computed here."""
+    return f"largest non-trivial {tslip.floquet(tslip.find_gait(params)).max_nontrivial:.4f}"
+
+
+def test_moving_a_slider_redraws_the_gait_and_the_multipliers(page, server):
+    p = tslip.preset("table6.1")
+    open_page(page, server, "?preset=table6.1")
+    assert expected_largest(p) in text(page, "multipliers")
+    gait_x = page.evaluate(f"() => Array.from(({_MODEL})('gait_source').data.x)")
+    set_value(page, "k", 9.0)
+    moved = expected_largest(dataclasses.replace(p, k=9.0))
+    assert moved != expected_largest(p)
+    wait_text(page, "multipliers", moved)
+    new_x = page.evaluate(f"() => Array.from(({_MODEL})('gait_source').data.x)")
+    assert new_x != gait_x and len(new_x) > 10
+    # the address bar holds the new state: the permalink
+    page.wait_for_function("() => location.search.includes('k=9.0')", timeout=TIMEOUT)
+    assert parse_qs(urlparse(page.url).query)["k"] == ["9.0"]
+    # the robustness limits follow, then the runner after the disturbance
+    limit = tslip.robustness(tslip.find_gait(dataclasses.replace(p, k=9.0)), "step_down")
+    wait_text(page, "limits", f"step_down {limit:.4g} [L]")
+    wait_text(page, "runner", "at the 2nd touch-down")
+    SHOT.parent.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(SHOT), full_page=True)
+
+
+@pytest.mark.parametrize("bad", ["-1", "nan", "abc", "1e999"])
+def test_a_bad_url_value_shows_an_error_and_the_server_keeps_serving(page, server, bad):
+    open_page(page, server, f"?preset=table6.1&k={bad}")
+    assert "k" in text(page, "error") and bad.replace("1e999", "inf") in text(page, "error")
+    # the refused value kept the preset's, whose gait the page shows
+    assert expected_largest(tslip.preset("table6.1")) in text(page, "multipliers")
+    assert server.alive() and get(server.url + "/favicon.ico")[0] == 200
+
+
+def test_a_bad_value_sent_by_a_control_shows_an_error_and_the_page_goes_on(page, server):
+    open_page(page, server, "?preset=table6.1")
+    set_value(page, "k", -5.0)  # a slider cannot go there; a crafted message can
+    assert "(0, inf)" in wait_text(page, "error", "k [MgL^-1]")
+    set_value(page, "k", 9.0)
+    wait_text(page, "multipliers", expected_largest(
+        dataclasses.replace(tslip.preset("table6.1"), k=9.0)))
+    assert text(page, "error") == ""
+    assert server.alive()
+
+
+def test_a_map_cell_loads_its_gait(page, server):
+    open_page(page, server, "?preset=table6.1")
+    set_value(page, "map_points", 3)
+    page.get_by_role("button", name="compute map").click()
+    wait_text(page, "map_status", "click a cell")
+    data = page.evaluate(f"() => {{ const d = ({_MODEL})('map_source').data;"
+                         " return {x: Array.from(d.x), y: Array.from(d.y),"
+                         " lam: Array.from(d.lam)}; }")
+    assert len(data["x"]) == 9
+    # a cell with a gait, other than the current one
+    i = next(j for j in range(9) if data["lam"][j] == data["lam"][j]
+             and (data["x"][j], data["y"][j]) != (0.3, 8.0))
+    r, k = data["x"][i], data["y"][i]
+    want = dataclasses.replace(tslip.preset("table6.1"), r=r, k=k)
+    assert data["lam"][i] == pytest.approx(tslip.floquet(tslip.find_gait(want)).max_nontrivial,
+                                           abs=1e-6)
+    page.evaluate(f"(i) => {{ ({_MODEL})('map_source').selected.indices = [i]; }}", i)
+    wait_text(page, "multipliers", expected_largest(want))
+    assert page.evaluate(f"() => ({_MODEL})('k').value") == pytest.approx(k)

@@ -1,0 +1,76 @@
+"""The explorer's server over HTTP: the page, the websocket allow-list, the exports."""
+
+import base64
+import http.client
+import io
+import os
+import tomllib
+
+import pandas as pd
+import pytest
+
+import tslip
+from tslip.simulation.result import TRAJECTORY_COLUMNS
+
+from .conftest import get
+
+
+def test_the_page_is_served_on_the_loopback_address(server):
+    status, body = get(server.url + "/")
+    assert status == 200
+    assert b"<title>tslip explore</title>" in body
+
+
+def _open_ws(port: int, origin: str) -> int:
+    """The HTTP status of a websocket handshake (RFC 6455) from ``origin``: 101 opens it.
+
+    Plain HTTP, as a browser sends it (no event loop: Playwright's runs in this thread).
+    """
+    conn = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+    try:
+        conn.request("GET", "/ws", headers={
+            "Upgrade": "websocket", "Connection": "Upgrade", "Origin": origin,
+            "Sec-WebSocket-Key": base64.b64encode(os.urandom(16)).decode(),
+            "Sec-WebSocket-Version": "13", "Sec-WebSocket-Protocol": "bokeh, no-token"})
+        return conn.getresponse().status
+    finally:
+        conn.close()
+
+
+@pytest.mark.parametrize("origin", ["http://evil.example", "http://127.0.0.1:1",
+                                    "null", "http://127.0.0.1.evil.example"])
+def test_a_websocket_from_another_origin_is_refused(server, origin):
+    assert _open_ws(server.port, origin) == 403
+
+
+def test_a_websocket_from_its_own_origin_gets_past_the_allow_list(server):
+    """The control for the test above: the same handshake from the page's own origin."""
+    assert _open_ws(server.port, server.url) == 101
+
+
+def test_the_toml_export_holds_the_solved_gait_parameters(server):
+    status, body = get(server.url + "/export/params.toml?preset=table6.1&k=9")
+    assert status == 200, body
+    params = tslip.Params.from_dict(tomllib.loads(body.decode())["params"])
+    q = tslip.Params.from_dict({"preset": "table6.1", "k": 9.0})
+    assert params == tslip.find_gait(q).params  # alpha_r and alphad_ref solved
+
+
+def test_the_parquet_export_holds_the_gaits_trajectory(server):
+    status, body = get(server.url + "/export/trajectory.parquet?preset=table2.1")
+    assert status == 200
+    df = pd.read_parquet(io.BytesIO(body))
+    assert list(df.columns) == list(TRAJECTORY_COLUMNS)
+    g = tslip.find_gait(tslip.preset("table2.1"))
+    assert df["t"].iloc[-1] == pytest.approx(2 * (g.stance_time + g.flight_time), rel=1e-6)
+
+
+@pytest.mark.parametrize(("query", "word"), [("k=-3", "k [MgL^-1]"), ("k=nan", "nan"),
+                                             ("v0=fast", "'fast'"), ("preset=x", "preset")])
+def test_a_bad_export_query_is_refused_with_the_reason_and_the_server_goes_on(server, query,
+                                                                            word):
+    status, body = get(server.url + "/export/params.toml?" + query)
+    assert status == 400
+    assert word in body.decode()
+    assert get(server.url + "/favicon.ico")[0] == 200  # still serving
+    assert server.alive()
