@@ -248,3 +248,11 @@ def test_cli_runs_a_spec_and_refuses_a_bad_one(tmp_path):
     r = runner.invoke(app, ["design", str(spec), "--out", str(tmp_path / "p")])
     assert r.exit_code == 2
     assert r.output.strip().count("\n") == 0 and "budget" in r.output
+
+
+def test_the_shipped_example_spec_is_valid():
+    from pathlib import Path
+
+    spec = DesignSpec.from_toml(Path(__file__).resolve().parents[2] / "examples" / "design.toml")
+    assert len(spec.objectives) == 2 and len(spec.variables) == 3 and spec.budget == 2000
+    assert all(v.lower > 0 for v in spec.variables if v.param == "r")  # off the held-pitch r

@@ -9,8 +9,7 @@ from typing import Annotated
 import typer
 
 from .._checks import check_output
-from ._common import errors, interruptible, make_console, progress_bar
-from .studies import SchedulerOpt, WorkersOpt
+from ._common import SchedulerOpt, WorkersOpt, errors, interruptible, make_console, progress_bar
 
 __all__ = ["commands", "design_cmd"]
 

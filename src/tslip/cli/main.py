@@ -29,7 +29,8 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 
-for _module in (simulate, experiment, gait, studies, design, viability):  # the order `tslip --help` lists
+# the order `tslip --help` lists
+for _module in (simulate, experiment, gait, studies, design, viability):
     app.registered_commands.extend(_module.commands.registered_commands)
 app.add_typer(biped.biped_app, name="biped")
 

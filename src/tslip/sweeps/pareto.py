@@ -61,6 +61,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from ..gait.fixed_point import Gait
+    from ..gait.robustness import Kind
 
 __all__ = ["DesignResult", "design", "evaluate", "pareto_mask"]
 
@@ -70,7 +71,7 @@ Progress = Callable[[int, int], None]
 _CHUNK = 8
 #: Seconds one evaluation costs about (gait search and Floquet; robustness adds ~0.1 s a kind).
 _COST = 0.02
-_ROBUSTNESS = ("step_down", "push", "pitch_rate")
+_ROBUSTNESS: tuple[Kind, ...] = ("step_down", "push", "pitch_rate")
 _STORE = "evaluations.jsonl"
 #: Samples of the stance in which the peak leg force is looked for.
 _FORCE_SAMPLES = 2000
