@@ -62,8 +62,9 @@ def _requirements(*extras: str) -> set[str]:
 
 
 def test_every_module_the_package_imports_is_a_runtime_dependency():
-    """The optional dask backend is the one import from an extra (``tslip[dask]``)."""
-    bad = _undeclared(ROOT, _requirements("dask"))
+    """The optional backends are the only imports from extras (``tslip[dask]``, the design
+    search's ``tslip[design]``)."""
+    bad = _undeclared(ROOT, _requirements("dask", "design"))
     assert not bad, "\n".join(bad)
 
 

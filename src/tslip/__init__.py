@@ -66,7 +66,7 @@ _SUBPACKAGE = {
     **dict.fromkeys(("Gait", "find_gait", "Floquet", "floquet", "robustness",
                      "robustness_report", "Branch", "continue_gait", "all_gaits",
                      "stable_region", "ApexState", "apex_map", "apex_map_batch"), "gait"),
-    **dict.fromkeys(("design", "DesignSpec"), "sweeps"),
+    "design": "sweeps.pareto", "DesignSpec": "sweeps.design_spec",
     "load": "_results",
 }
 

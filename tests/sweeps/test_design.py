@@ -222,7 +222,14 @@ def test_without_pymoo_the_error_names_the_extra(monkeypatch):
 
 
 def test_result_saves_loads_and_has_units(tmp_path):
+    from _result_checks import check_frozen, check_plot, check_repr, check_round_trip, \
+        check_units
+
     res = tslip.design(_spec(budget=20, population=20), tmp_path, workers=1)
+    for check in (check_frozen, check_units, check_repr, check_plot):
+        check(res)
+    for suffix in (".json", ".parquet", ".csv"):
+        check_round_trip(res, tmp_path / f"r{suffix}")
     back = tslip.load(tmp_path / "designs.parquet")
     assert back.frame.equals(res.frame) and back.spec == res.spec
     units = res.front.attrs["units"]
