@@ -62,9 +62,9 @@ def _requirements(*extras: str) -> set[str]:
 
 
 def test_every_module_the_package_imports_is_a_runtime_dependency():
-    """The optional dask backend and the explorer are the imports from extras
-    (``tslip[dask]``, ``tslip[explore]``)."""
-    bad = _undeclared(ROOT, _requirements("dask", "explore"))
+    """The optional backends are the only imports from extras (``tslip[dask]``, the
+    explorer's ``tslip[explore]``, the design search's ``tslip[design]``)."""
+    bad = _undeclared(ROOT, _requirements("dask", "explore", "design"))
     assert not bad, "\n".join(bad)
 
 

@@ -157,7 +157,8 @@ def test_every_result_class_is_covered(objects):
 ELSEWHERE = {**dict.fromkeys(("StateActionMap", "Viability", "Basin"),
                              "tests/gait/test_viability.py"),
              "ViableSection": "tests/gait/test_viability_3d.py",
-             "RobustnessLimits": "RobustnessResult here and in tests/biped/test_results.py"}
+             "RobustnessLimits": "RobustnessResult here and in tests/biped/test_results.py",
+             "DesignResult": "tests/sweeps/test_design.py"}
 
 
 def _subclasses(cls):

@@ -53,6 +53,8 @@ if TYPE_CHECKING:  # the same names, for type checkers and tslip._codehash
         step_jacobian,
         step_map,
     )
+    from .sweeps.design_spec import DesignSpec
+    from .sweeps.pareto import design
 
 #: The subpackage (or private module) each public name is imported from.
 _SUBPACKAGE = {
@@ -64,6 +66,7 @@ _SUBPACKAGE = {
     **dict.fromkeys(("Gait", "find_gait", "Floquet", "floquet", "robustness",
                      "robustness_report", "Branch", "continue_gait", "all_gaits",
                      "stable_region", "ApexState", "apex_map", "apex_map_batch"), "gait"),
+    "design": "sweeps.pareto", "DesignSpec": "sweeps.design_spec",
     "load": "_results",
 }
 
@@ -79,7 +82,7 @@ __all__ = [
     "run_batch", "simulate", "step", "step_batch", "step_map", "step_jacobian",
     "Gait", "find_gait", "Floquet", "floquet", "robustness", "robustness_report", "Branch",
     "continue_gait", "all_gaits", "stable_region", "ApexState", "apex_map", "apex_map_batch",
-    "load",
+    "design", "DesignSpec", "load",
 ]
 
 

@@ -32,6 +32,7 @@ from .._checks import check_output, parse_number
 from ..model.parameters import PARAMETER_TABLE, Params, preset, presets, read_params_file
 
 __all__ = [
+    "SchedulerOpt", "WorkersOpt",
     "DATA_SUFFIXES", "Failed", "ParamsOpt", "PresetOpt", "SetOpt", "build_params",
     "build_params_and_preset", "check_plot_suffix", "check_suffix", "echo_error", "errors",
     "fail", "file_size", "interruptible", "make_console", "progress_bar", "run", "stopped",
@@ -88,6 +89,12 @@ ParamsOpt = Annotated[
 ]
 
 # -- consoles and errors ---------------------------------------------------------------
+
+
+WorkersOpt = Annotated[int | None, typer.Option("--workers", min=1,
+                                                help="Worker processes (default: all cores).")]
+SchedulerOpt = Annotated[str | None, typer.Option(
+    "--scheduler", help="Dask scheduler address (needs tslip\\[dask]).")]
 
 
 def make_console(stderr: bool = False) -> Console:

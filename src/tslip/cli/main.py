@@ -1,8 +1,8 @@
 """``tslip`` command line: the app, assembled from the subcommand modules.
 
 Each subcommand module (:mod:`~tslip.cli.simulate`, :mod:`~tslip.cli.experiment`,
-:mod:`~tslip.cli.gait`, :mod:`~tslip.cli.studies`, :mod:`~tslip.cli.viability`,
-:mod:`~tslip.cli.explore`, :mod:`~tslip.cli.biped`)
+:mod:`~tslip.cli.gait`, :mod:`~tslip.cli.studies`, :mod:`~tslip.cli.design`,
+:mod:`~tslip.cli.viability`, :mod:`~tslip.cli.explore`, :mod:`~tslip.cli.biped`)
 defines its commands and imports its shared options and error handling from
 :mod:`tslip.cli._common`; this module only puts them together, adds
 ``--version`` and is the console script's entry point. Invalid input prints
@@ -15,7 +15,7 @@ from typing import Annotated
 import typer
 
 from .. import __version__
-from . import biped, experiment, explore, gait, simulate, studies, viability
+from . import biped, design, experiment, explore, gait, simulate, studies, viability
 from ._common import run
 
 __all__ = ["app", "main"]
@@ -28,7 +28,8 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 
-for _module in (simulate, experiment, gait, studies, viability, explore):  # `--help` order
+# the order `tslip --help` lists
+for _module in (simulate, experiment, gait, studies, design, viability, explore):
     app.registered_commands.extend(_module.commands.registered_commands)
 app.add_typer(biped.biped_app, name="biped")
 

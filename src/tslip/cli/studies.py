@@ -11,17 +11,21 @@ from rich import box
 from rich.table import Table
 
 from .._checks import check_output
-from ._common import errors, interruptible, make_console, progress_bar, stopped
+from ._common import (
+    SchedulerOpt,
+    WorkersOpt,
+    errors,
+    interruptible,
+    make_console,
+    progress_bar,
+    stopped,
+)
 
 __all__ = ["commands", "study_cmd", "reproduce_cmd"]
 
 #: ``study`` and ``reproduce``, added to the app by :mod:`tslip.cli.main`.
 commands = typer.Typer()
 
-WorkersOpt = Annotated[int | None, typer.Option("--workers", min=1,
-                                                help="Worker processes (default: all cores).")]
-SchedulerOpt = Annotated[str | None, typer.Option(
-    "--scheduler", help="Dask scheduler address (needs tslip\\[dask]).")]
 
 
 def _saved_message(out: Path, quick: bool) -> str:

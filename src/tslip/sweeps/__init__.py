@@ -1,6 +1,19 @@
-"""Parameter studies: declarative specs, a parallel resumable runner."""
+"""Parameter studies and design searches: declarative specs, a parallel resumable runner."""
 
 from .run import StudyResult, run_study
 from .spec import ANALYSES, Axis, StudySpec
 
-__all__ = ["ANALYSES", "Axis", "StudyResult", "StudySpec", "run_study"]
+# design searches (and pymoo, their optional dependency) load on first use
+_DESIGN = {"design": "pareto", "DesignResult": "pareto", "DesignSpec": "design_spec",
+           "Variable": "design_spec"}
+
+__all__ = ["ANALYSES", "Axis", "DesignResult", "DesignSpec", "StudyResult", "StudySpec",
+           "Variable", "design", "run_study"]
+
+
+def __getattr__(name: str) -> object:
+    import importlib
+
+    if name in _DESIGN:
+        return getattr(importlib.import_module(f".{_DESIGN[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
