@@ -84,10 +84,19 @@ class Disturbance:
 
 #: The default options, built (and validated) once: ``step_map`` runs once a stride.
 _DEFAULT_OPTIONS = IntegratorOptions()
+#: ... packed once, with their stride kernel (never written into)
+_DEFAULT_O = _DEFAULT_OPTIONS.packed()
+_DEFAULT_STRIDE = kn.STRIDE[int(_DEFAULT_O[pk.O_METHOD])]
+_TX = np.empty(0)  # flat ground: no terrain breakpoints ...
+_TH0 = np.zeros(1)  # ... at height 0
+_F64 = np.dtype(float)
+#: ``Status`` by code (the enum's own lookup costs a microsecond, once a stride in ``step_map``)
+_STATUS = {int(s): s for s in Status}
+_new_tuple = tuple.__new__  # a NamedTuple without its Python-level __new__
 
 
 def _options(options: IntegratorOptions | None) -> np.ndarray:
-    return (options or _DEFAULT_OPTIONS).packed()
+    return _DEFAULT_O.copy() if options is None else options.packed()
 
 
 def _as_state(state: TouchdownState | Sequence[float] | np.ndarray) -> TouchdownState:
@@ -105,16 +114,16 @@ def _as_state(state: TouchdownState | Sequence[float] | np.ndarray) -> Touchdown
 
 def _section(q: Sequence[float] | np.ndarray, h: float) -> np.ndarray:
     """The touch-down vector ``(beta, phi, xd, yd, phid, x=0, h)`` of a checked section."""
-    qa = np.asarray(q, dtype=float)
+    qa = q if type(q) is np.ndarray and q.dtype is _F64 else np.asarray(q, dtype=float)
     if qa.shape != (5,):
         raise ValueError(f"q (beta, phi, xd, yd, phid) must have 5 entries, got shape {qa.shape}")
-    # plain floats: this runs once a stride in every analysis, where NumPy's ufuncs cost more
-    if not all(map(math.isfinite, qa.tolist())):
-        raise ValueError(f"q (beta, phi, xd, yd, phid) must be finite, got {qa.tolist()}")
-    td = np.zeros(pk.NTD)
-    td[:5] = qa
-    td[6] = h if type(h) is float and math.isfinite(h) else check_number(h, "h", unit="L")
-    return td
+    # plain floats: this runs once a stride in every analysis, where NumPy's ufuncs cost more;
+    # the sum is finite unless an entry is not (or it overflows: then each is checked)
+    vals = qa.tolist()
+    if not math.isfinite(sum(vals)) and not all(map(math.isfinite, vals)):
+        raise ValueError(f"q (beta, phi, xd, yd, phid) must be finite, got {vals}")
+    vals += (0.0, h if type(h) is float and math.isfinite(h) else check_number(h, "h", unit="L"))
+    return np.array(vals)
 
 
 #: Bytes a recorded stride holds per sample row (a table row and its time since
@@ -231,17 +240,19 @@ def step_map(
     recording. ``packed`` may carry ``pack_params(params)`` to save time in
     tight loops.
     """
-    P = pk.pack_params(params) if packed is None else packed
-    td = _section(q, h)
+    # lean, as it runs once a stride in every analysis (benchmarks/bench_limit.py)
+    P = pk.packed_params(_check_params(params)) if packed is None else packed
+    td = _section(q, h)  # checks h too
     out = np.empty(pk.NOUT)
-    tx, th = _FLAT.arrays()
-    th = th + h
-    O = _options(options)
-    status = Status(int(kn.STRIDE[int(O[pk.O_METHOD])](P, O, td, tx, th, _NO_REC, 0.0, out)))
-    return MapResult(
-        out[pk.OUT_TD : pk.OUT_TD + 5].copy(), float(out[pk.OUT_TS]), float(out[pk.OUT_TF]),
-        status,
-    )
+    if options is None:
+        O, stride = _DEFAULT_O, _DEFAULT_STRIDE
+    else:
+        O = options.packed()
+        stride = kn.STRIDE[int(O[pk.O_METHOD])]
+    th = _TH0 if h == 0.0 else td[pk.TD_H :]
+    status = stride(P, O, td, _TX, th, _NO_REC, 0.0, out)
+    return _new_tuple(MapResult, (out[pk.OUT_TD : pk.OUT_TD + 5], out.item(pk.OUT_TS),
+                                  out.item(pk.OUT_TF), _STATUS[status]))
 
 
 def step_jacobian(
