@@ -492,18 +492,11 @@ class Trajectory(Result):
 
     def to_dataframe(self) -> pd.DataFrame:
         """Time series as a tidy ``pandas.DataFrame``, one row per sample (units in attrs)."""
-        import pandas as pd
 
         value = self.__dict__["_data"]
-        # a new column-major table the frame owns: its float columns become one block
-        # without a copy (time, step and stance, the first three, go in as their own)
+        # a new column-major table that the frame owns and takes without a copy
         table = value.columns() if isinstance(value, RunTable) else self.data.T.copy()
-        df = pd.DataFrame(table[pk.TR_X :].T, columns=list(TRAJECTORY_COLUMNS[pk.TR_X :]),
-                          copy=False)
-        df.insert(0, "t", table[pk.TR_T])
-        df.insert(1, "step", table[pk.TR_STEP].astype(int))
-        df.insert(2, "stance", table[pk.TR_STANCE].astype(bool))
-        return with_units(df, COLUMN_UNITS)
+        return with_units(_frame(table), COLUMN_UNITS)
 
     def plot(self, ax: Axes | None = None) -> Figure:
         """Four panels (:func:`~tslip.plotting.plot_trajectory`), or the CoM path on ``ax``."""
@@ -571,6 +564,35 @@ class Trajectory(Result):
                 }
             )
         return with_units(pd.DataFrame(rows, columns=_STEP_COLUMNS), COLUMN_UNITS)
+
+
+def _frame(table: np.ndarray) -> pd.DataFrame:
+    """The frame of a column-major trajectory ``table`` (``NTRAJ x rows``), sharing its memory.
+
+    Time and the columns from ``x`` on stay float blocks of ``table`` (pandas stores
+    a block column-major too); ``step`` and ``stance`` become integer and boolean
+    columns. pandas 3's block constructor does this without a copy; earlier
+    versions insert the three columns one by one.
+    """
+    import pandas as pd
+
+    names = list(TRAJECTORY_COLUMNS)
+    first = pk.TR_X  # the typed columns come before it: time, step, stance
+    step = table[pk.TR_STEP : pk.TR_STEP + 1].astype(np.int64)
+    stance = table[pk.TR_STANCE : pk.TR_STANCE + 1].astype(bool)
+    try:
+        from pandas.api.internals import create_dataframe_from_blocks
+    except ImportError:  # pandas < 3
+        df = pd.DataFrame(table[first:].T, columns=names[first:], copy=False)
+        df.insert(0, "t", table[pk.TR_T])
+        df.insert(1, "step", step[0])
+        df.insert(2, "stance", stance[0])
+        return df
+    blocks = [(table[pk.TR_T : pk.TR_T + 1], np.array([pk.TR_T])),
+              (step, np.array([pk.TR_STEP])), (stance, np.array([pk.TR_STANCE])),
+              (table[first:], np.arange(first, pk.NTRAJ))]
+    return create_dataframe_from_blocks(blocks, index=pd.RangeIndex(table.shape[1]),
+                                        columns=pd.Index(names))
 
 
 _STEP_COLUMNS = ["step", "beta", "phi", "xd", "yd", "phid", "v", "delta", "x", "h",
