@@ -92,7 +92,7 @@ def packed_params(p: Params) -> np.ndarray:
     :func:`pack_params`.
     """
     try:
-        return p._packed  # type: ignore[attr-defined, no-any-return]
+        return p._packed  # type: ignore[attr-defined]
     except AttributeError:
         out = pack_params(p)
         object.__setattr__(p, "_packed", out)

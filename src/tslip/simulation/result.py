@@ -378,7 +378,7 @@ class _Data:
         value = obj.__dict__["_data"]
         if isinstance(value, RunTable):
             value = obj.__dict__["_data"] = value.columns().T
-        return value  # type: ignore[no-any-return]
+        return value
 
     def __set__(self, obj: Trajectory, value: np.ndarray | RunTable) -> None:
         obj.__dict__["_data"] = value
@@ -454,7 +454,10 @@ class Trajectory(Result):
     :func:`tslip.simulate`: a :class:`StepList` and an :class:`EventList`, built on access).
     """
 
-    data: _Data = _Data()
+    if TYPE_CHECKING:
+        data: np.ndarray
+    else:
+        data: _Data = _Data()  # an array, or a RunTable derived into one on first read
     steps: Sequence[StepResult]
     events: Sequence[Event]
     status: Status
