@@ -83,8 +83,24 @@ ST_ERR_NONFINITE = 14
 ST_NO_APEX = 20  # the flight after lift-off has no apex (apex map); 21 is the biped's T_END
 
 
+def packed_params(p: Params) -> np.ndarray:
+    """``pack_params(p)``, packed once per ``Params`` instance and kept on it: never write into it.
+
+    ``Params`` is frozen and checked when built, so a call that only reads the
+    vector (``step_map``, ``simulate``) need neither check nor pack it again;
+    callers that write unknowns into their vector take a fresh one from
+    :func:`pack_params`.
+    """
+    try:
+        return p._packed  # type: ignore[attr-defined]
+    except AttributeError:
+        out = pack_params(p)
+        object.__setattr__(p, "_packed", out)
+        return out
+
+
 def pack_params(p: Params) -> np.ndarray:
-    """``Params`` -> P vector."""
+    """``Params`` -> P vector (a new array)."""
     out = np.zeros(NP)
     out[P_M], out[P_J], out[P_R], out[P_K], out[P_L0], out[P_G] = p.m, p.J, p.r, p.k, p.l0, p.g
     out[P_CL], out[P_OMEGA], out[P_ALPHA] = p.c_l, p.omega_r, p.alpha_r

@@ -123,8 +123,19 @@ def _f(name: str) -> Any:
     )
 
 
+class _PackCache:
+    """The slot where :func:`tslip.model._pack.packed_params` keeps a ``Params``' kernel vector.
+
+    Not a dataclass field, so equality, hashing, ``repr``, ``dataclasses.replace``
+    and pickling (a slotted dataclass pickles its fields only) never see it: a
+    copy or an unpickled instance packs itself again on first use.
+    """
+
+    __slots__ = ("_packed",)
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
-class Params:
+class Params(_PackCache):
     """Parameters of the TSLIP model (thesis Table 2.1, Figure 2.1).
 
     Parameters

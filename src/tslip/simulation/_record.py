@@ -1,8 +1,10 @@
-"""Compiled recorded runs (``tslip.simulate``): strides sampled into trajectory rows.
+"""Compiled recorded runs (``tslip.simulate``): strides sampled into compact rows.
 
 Private (see :mod:`._kernels`). :data:`RECORD_RUN` holds one kernel per
-integrator method (:func:`._stride.specialise`); the row builders are
-``inline="always"``.
+integrator method (:func:`._stride.specialise`): the strides and their stance
+record rows as the stride kernel writes them. :func:`fill_table` derives the
+trajectory's columns from those when they are first read (the row builders are
+``inline="always"``), so a run that is not looked at row by row never pays for them.
 """
 
 from __future__ import annotations
@@ -16,7 +18,6 @@ from numba import njit
 from .._kernel_cache import check as _check_cache
 from ..model._pack import (
     NOUT,
-    NREC,
     NTD,
     OUT_LO,
     OUT_NREC,
@@ -31,6 +32,7 @@ from ..model._pack import (
     P_L0,
     P_M,
     P_R,
+    REC_T,
     RI_LOFY,
     RI_NSTANCE,
     RI_ROW0,
@@ -64,7 +66,7 @@ from ..model._pack import (
     TR_YD,
 )
 from ._flight import flight_leg_angle, flight_state, retraction_start
-from ._rk import _INLINE
+from ._rk import _INLINE, _JIT
 from ._specialise import specialise
 from ._stance import _com_velocity
 from ._stride import stride_of
@@ -148,40 +150,40 @@ def n_flight_samples(tf, dt, final):
 
 
 def _make_record_run(method: int) -> Callable:
-    def record_run(P, O, td, tx, th, first, last, close, dt, data, tloc, starts, outs, info, pos):
-        """Strides ``first .. last - 1`` of a run, sampled every ``dt`` into trajectory rows.
+    def record_run(P, O, td, tx, th, first, last, close, dt, rows, starts, outs, info, pos):
+        """Strides ``first .. last - 1`` of a run, sampled every ``dt`` into compact rows.
 
         Starts from the touch-down state ``td`` (7) at time ``pos[1]`` and writes
-        from row ``pos[0]`` of ``data`` (rows x NTRAJ, columns ``TR_*``): each
-        stance on the grid of :func:`._stride._make_stride` (touch-down and lift-off
-        rows included), each flight in closed form at ``dt, 2 dt, ...`` after
-        lift-off, and the touch-down instant closing the last stride if ``close``
-        (otherwise the next stride's first row is that instant). ``tloc`` gets each
-        stance row's time since its touch-down. Stride ``s`` fills ``starts[s]``
-        (its touch-down state), ``outs[s]`` (:func:`._stride._make_stride`'s output) and
-        ``info[s]`` (``RI_*``).
+        from row ``pos[0]`` of ``rows`` (n x NREC), one row per trajectory sample:
+        each stance's record rows as the stride kernel writes them (``REC_*``, on the
+        grid of :func:`._stride._make_stride`, touch-down and lift-off rows
+        included), then one row per flight sample holding only its time since
+        lift-off in ``REC_T`` (``dt, 2 dt, ...``, and the touch-down instant closing
+        the last stride if ``close``; otherwise the next stride's first row is that
+        instant). Stride ``s`` fills ``starts[s]`` (its touch-down state),
+        ``outs[s]`` (:func:`._stride._make_stride`'s output) and ``info[s]``
+        (``RI_*``). :func:`fill_table` derives the trajectory's columns from them
+        when they are first read.
 
         Returns the status of the last stride run (it stops at the first that is
         not OK), or ``RUN_FULL`` if the next stride's rows would not fit; then
         ``td``, ``pos = (row, t0, stride)`` say where to resume with more rows.
         """
-        rec = np.empty((64, NREC))
         out = np.empty(NOUT)
         lo = np.empty(6)
-        fs = np.empty(10)
         row = int(pos[0])
         t0 = pos[1]
-        nmax = data.shape[0]
+        nmax = rows.shape[0]
         status = ST_OK
         for s in range(first, last):
             pos[0] = row
             pos[1] = t0
             pos[2] = s
-            while True:
-                status = stride_of(method, P, O, td, tx, th, rec, dt, out)
-                if out[OUT_RECOVF] == 0.0:
-                    break
-                rec = np.empty((4 * rec.shape[0], NREC))
+            if nmax - row < 2:
+                return RUN_FULL
+            status = stride_of(method, P, O, td, tx, th, rows[row:], dt, out)
+            if out[OUT_RECOVF] != 0.0:
+                return RUN_FULL
             nrec = int(out[OUT_NREC])
             ts = out[OUT_TS]
             tf = out[OUT_TF]
@@ -189,19 +191,13 @@ def _make_record_run(method: int) -> Callable:
             nfl = n_flight_samples(tf, dt, final) if tf > 0.0 else 0
             if row + nrec + nfl > nmax:
                 return RUN_FULL
-            xf = out[OUT_XF]
-            h = td[6]
-            for k in range(nrec):
-                _stance_row(P, t0, s, xf, h, rec[k], data[row + k])
-                tloc[row + k] = rec[k, 0]
-            t_lo = t0 + ts
-            for j in range(6):
-                lo[j] = out[OUT_LO + j]
             for k in range(nfl):
                 tau = dt + k * dt
                 if final and k == nfl - 1:
                     tau = tf
-                _flight_row(P, t_lo, s, lo, tau, fs, data[row + nrec + k])
+                rows[row + nrec + k, REC_T] = tau
+            for j in range(6):
+                lo[j] = out[OUT_LO + j]
             for j in range(NTD):
                 starts[s, j] = td[j]
             for j in range(NOUT):
@@ -212,7 +208,7 @@ def _make_record_run(method: int) -> Callable:
             inf[RI_NSTANCE] = nrec
             inf[RI_ROW1] = row + nrec + nfl
             inf[RI_STATUS] = status
-            inf[RI_TDY] = h + P[P_L0] * math.sin(td[0]) - P[P_R] * math.cos(td[1])
+            inf[RI_TDY] = td[6] + P[P_L0] * math.sin(td[0]) - P[P_R] * math.cos(td[1])
             inf[RI_LOFY] = (lo[1] + P[P_R] * math.cos(lo[4])) - out[OUT_LO + 6] * math.sin(
                 out[OUT_LO + 7])
             row += nrec + nfl
@@ -220,7 +216,7 @@ def _make_record_run(method: int) -> Callable:
             pos[2] = s + 1
             if status != ST_OK:
                 break
-            t0 = t_lo + tf
+            t0 = t0 + ts + tf
             pos[1] = t0
             for j in range(NTD):
                 td[j] = out[OUT_TD + j]
@@ -229,7 +225,36 @@ def _make_record_run(method: int) -> Callable:
     return record_run
 
 
-#: ``(P, O, td, tx, th, first, last, close, dt, data, tloc, starts, outs, info, pos)
+@njit(**_JIT)
+def fill_table(P, rows, starts, outs, info, n, table):
+    """The trajectory columns (``TR_*``, one row of ``table`` each) of a recorded run.
+
+    ``rows``, ``starts``, ``outs`` and ``info`` hold strides ``0 .. n - 1`` as
+    :func:`_make_record_run`'s ``record_run`` wrote them; ``table`` is
+    ``NTRAJ x rows`` (column-major: a column of the trajectory is a row here).
+    Stance rows come from the record rows by eqs A.3-A.5, flight rows from the
+    lift-off state in closed form (eq. 2.7).
+    """
+    lo = np.empty(6)
+    fs = np.empty(10)
+    for s in range(n):
+        inf = info[s]
+        out = outs[s]
+        t0 = inf[RI_T0]
+        row = int(inf[RI_ROW0])
+        nrec = int(inf[RI_NSTANCE])
+        xf = out[OUT_XF]
+        h = starts[s, 6]
+        for k in range(nrec):
+            _stance_row(P, t0, s, xf, h, rows[row + k], table[:, row + k])
+        t_lo = t0 + out[OUT_TS]
+        for j in range(6):
+            lo[j] = out[OUT_LO + j]
+        for k in range(row + nrec, int(inf[RI_ROW1])):
+            _flight_row(P, t_lo, s, lo, rows[k, REC_T], fs, table[:, k])
+
+
+#: ``(P, O, td, tx, th, first, last, close, dt, rows, starts, outs, info, pos)
 #: -> status`` by method (:func:`_make_record_run`).
 RECORD_RUN = specialise(_make_record_run, "record_run")
 

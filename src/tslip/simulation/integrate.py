@@ -28,6 +28,7 @@ from .result import (
     Event,
     EventList,
     IntegrationError,
+    RunTable,
     Status,
     StepList,
     StepResult,
@@ -84,10 +85,19 @@ class Disturbance:
 
 #: The default options, built (and validated) once: ``step_map`` runs once a stride.
 _DEFAULT_OPTIONS = IntegratorOptions()
+#: ... packed once, with their stride kernel (never written into)
+_DEFAULT_O = _DEFAULT_OPTIONS.packed()
+_DEFAULT_STRIDE = kn.STRIDE[int(_DEFAULT_O[pk.O_METHOD])]
+_TX = np.empty(0)  # flat ground: no terrain breakpoints ...
+_TH0 = np.zeros(1)  # ... at height 0
+_F64 = np.dtype(float)
+#: ``Status`` by code (the enum's own lookup costs a microsecond, once a stride in ``step_map``)
+_STATUS = {int(s): s for s in Status}
+_new_tuple = tuple.__new__  # a NamedTuple without its Python-level __new__
 
 
 def _options(options: IntegratorOptions | None) -> np.ndarray:
-    return (options or _DEFAULT_OPTIONS).packed()
+    return _DEFAULT_O.copy() if options is None else options.packed()
 
 
 def _as_state(state: TouchdownState | Sequence[float] | np.ndarray) -> TouchdownState:
@@ -105,22 +115,23 @@ def _as_state(state: TouchdownState | Sequence[float] | np.ndarray) -> Touchdown
 
 def _section(q: Sequence[float] | np.ndarray, h: float) -> np.ndarray:
     """The touch-down vector ``(beta, phi, xd, yd, phid, x=0, h)`` of a checked section."""
-    qa = np.asarray(q, dtype=float)
+    qa = q if type(q) is np.ndarray and q.dtype is _F64 else np.asarray(q, dtype=float)
     if qa.shape != (5,):
         raise ValueError(f"q (beta, phi, xd, yd, phid) must have 5 entries, got shape {qa.shape}")
-    # plain floats: this runs once a stride in every analysis, where NumPy's ufuncs cost more
-    if not all(map(math.isfinite, qa.tolist())):
-        raise ValueError(f"q (beta, phi, xd, yd, phid) must be finite, got {qa.tolist()}")
-    td = np.zeros(pk.NTD)
-    td[:5] = qa
-    td[6] = h if type(h) is float and math.isfinite(h) else check_number(h, "h", unit="L")
-    return td
+    # plain floats: this runs once a stride in every analysis, where NumPy's ufuncs cost more;
+    # the sum is finite unless an entry is not (or it overflows: then each is checked)
+    vals = qa.tolist()
+    if not math.isfinite(sum(vals)) and not all(map(math.isfinite, vals)):
+        raise ValueError(f"q (beta, phi, xd, yd, phid) must be finite, got {vals}")
+    vals += (0.0, h if type(h) is float and math.isfinite(h) else check_number(h, "h", unit="L"))
+    return np.array(vals)
 
 
-#: Bytes a recorded stride holds per sample row (a table row and its time since
-#: touch-down) and per stride (the kernel's start, output and info rows); checked
-#: against tracemalloc for Table 2.1 and 6.1 (tests/simulation/test_input_checks.py).
-_ROW_BYTES = 8.0 * (pk.NTRAJ + 1)
+#: Bytes a recorded stride holds per sample row (a compact row: the stance record row)
+#: and per stride (the kernel's start, output and info rows); checked against
+#: tracemalloc for Table 2.1 and 6.1 (tests/simulation/test_input_checks.py). The
+#: columns derived on first read (``Trajectory.data``) take ``NTRAJ / NREC`` times more.
+_ROW_BYTES = 8.0 * pk.NREC
 _STRIDE_BYTES = 8.0 * (pk.NTD + pk.NOUT + pk.NRI)
 
 
@@ -231,17 +242,19 @@ def step_map(
     recording. ``packed`` may carry ``pack_params(params)`` to save time in
     tight loops.
     """
-    P = pk.pack_params(params) if packed is None else packed
-    td = _section(q, h)
+    # lean, as it runs once a stride in every analysis (benchmarks/bench_limit.py)
+    P = pk.packed_params(_check_params(params)) if packed is None else packed
+    td = _section(q, h)  # checks h too
     out = np.empty(pk.NOUT)
-    tx, th = _FLAT.arrays()
-    th = th + h
-    O = _options(options)
-    status = Status(int(kn.STRIDE[int(O[pk.O_METHOD])](P, O, td, tx, th, _NO_REC, 0.0, out)))
-    return MapResult(
-        out[pk.OUT_TD : pk.OUT_TD + 5].copy(), float(out[pk.OUT_TS]), float(out[pk.OUT_TF]),
-        status,
-    )
+    if options is None:
+        O, stride = _DEFAULT_O, _DEFAULT_STRIDE
+    else:
+        O = options.packed()
+        stride = kn.STRIDE[int(O[pk.O_METHOD])]
+    th = _TH0 if h == 0.0 else td[pk.TD_H :]
+    status = stride(P, O, td, _TX, th, _NO_REC, 0.0, out)
+    return _new_tuple(MapResult, (out[pk.OUT_TD : pk.OUT_TD + 5], out.item(pk.OUT_TS),
+                                  out.item(pk.OUT_TF), _STATUS[status]))
 
 
 def step_jacobian(
@@ -328,22 +341,23 @@ def simulate(
 class _Recording:
     """The buffers of one :func:`simulate` run, which :func:`_kernels.record_run` fills.
 
-    Rows are allocated for a few strides first, then, once the kernel reports
-    them full, for the rest of the run at the rows per stride seen so far
-    (geometric growth if that falls short); the table is trimmed at the end.
+    Compact rows (the stance record rows, a time for each flight sample) are
+    allocated for a few strides first, then, once the kernel reports them full,
+    for the rest of the run at the rows per stride seen so far (geometric growth
+    if that falls short); they are trimmed at the end. The trajectory's columns
+    are derived from them when first read (:class:`~.result.RunTable`).
     """
 
     def __init__(self, params: Params, options: IntegratorOptions | None, n_steps: int,
                  dt: float) -> None:
         self.params = params
-        self.P = pk.pack_params(params)
-        self.O = _options(options)
+        self.P = pk.packed_params(params)
+        self.O = _DEFAULT_O if options is None else options.packed()
         self.n_steps = n_steps
         self.dt = dt
         t_s = 2.0 * params.l0 * math.cos(params.beta0) / params.v0  # as in the memory estimate
         rows = int(min(n_steps, 8) * 2.0 * (t_s / dt + 2.0)) + 16
-        self.data = np.empty((rows, pk.NTRAJ))
-        self.tloc = np.empty(rows)
+        self.rows = np.empty((rows, pk.NREC))
         self.starts = np.empty((n_steps, pk.NTD))
         self.outs = np.empty((n_steps, pk.NOUT))
         self.info = np.empty((n_steps, pk.NRI))
@@ -353,41 +367,39 @@ class _Recording:
         """Run strides ``first .. last - 1`` from ``td`` (updated to the next touch-down)."""
         tx, th = terrain.arrays()
         close = last == self.n_steps
+        record_run = kn.RECORD_RUN[int(self.O[pk.O_METHOD])]
         while True:
-            st = int(kn.record_run(self.P, self.O, td, tx, th, first, last, close, self.dt,
-                                   self.data, self.tloc, self.starts, self.outs, self.info,
-                                   self.pos))
+            st = int(record_run(self.P, self.O, td, tx, th, first, last, close, self.dt,
+                                self.rows, self.starts, self.outs, self.info, self.pos))
             if st != pk.RUN_FULL:
-                return Status(st)
+                return _STATUS[st]
             first = int(self.pos[2])
             self._grow()
 
     def _grow(self) -> None:
         row, done = int(self.pos[0]), int(self.pos[2])
-        cap = len(self.data)
+        cap = len(self.rows)
         rows = 2 * cap
         if done > 0:
             rows = max(row + math.ceil((self.n_steps - done) * 1.05 * row / done) + 64,
                        cap + cap // 2)
-        data = np.empty((rows, pk.NTRAJ))
-        data[:row] = self.data[:row]
-        tloc = np.empty(rows)
-        tloc[:row] = self.tloc[:row]
-        self.data, self.tloc = data, tloc
+        grown = np.empty((rows, pk.NREC))
+        grown[:row] = self.rows[:row]
+        self.rows = grown
 
     def trajectory(self, status: Status, terrain: Terrain, meta: dict) -> Trajectory:
         rows, n = int(self.pos[0]), int(self.pos[2])
-        self.data.resize((rows, pk.NTRAJ), refcheck=False)  # trim in place, no copy
-        self.tloc.resize(rows, refcheck=False)
+        self.rows.resize((rows, pk.NREC), refcheck=False)  # trim in place, no copy
         starts, outs, info = self.starts[:n], self.outs[:n], self.info[:n]
-        steps = StepList(self.params, starts, outs, info, self.data, self.tloc)
+        steps = StepList(self.params, starts, outs, info, self.rows)
         last = None
         if status == Status.OK and n == self.n_steps:
             td = TouchdownState(*outs[-1, pk.OUT_TD : pk.OUT_TD + 7].tolist())
             last = Event("touchdown", n, float(self.pos[1]), *_com_xy(self.params, td),
                          _foot_x(self.params, td), td.h)
-        return Trajectory(data=self.data, steps=steps, events=EventList(steps, last),
-                          status=status, params=self.params, terrain=terrain, meta=meta)
+        return Trajectory(data=RunTable(self.P, steps), steps=steps,  # type: ignore[arg-type]
+                          events=EventList(steps, last), status=status, params=self.params,
+                          terrain=terrain, meta=meta)
 
 
 def _foot_x(params: Params, td: TouchdownState) -> float:

@@ -280,21 +280,21 @@ class StepList(Sequence[StepResult]):
 
     :func:`tslip.simulate` keeps its strides as the kernel wrote them: the
     touch-down states ``starts`` (n, 7), the stride outputs ``outs`` (n, NOUT),
-    the ``info`` rows (n, NRI; status and rows of each stride), and the stance
-    rows of the trajectory ``data`` with their times since touch-down ``tloc``.
+    the ``info`` rows (n, NRI; status and rows of each stride), and ``rec``, one
+    row (NREC) per trajectory sample: a stance sample's record row (``REC_*``,
+    time since touch-down first), a flight sample's time since lift-off.
     Building a thousand result objects would cost more than the run.
     """
 
-    __slots__ = ("_params", "_starts", "_outs", "_info", "_data", "_tloc", "_items")
+    __slots__ = ("_params", "_starts", "_outs", "_info", "_rec", "_items")
 
     def __init__(self, params: Params, starts: np.ndarray, outs: np.ndarray, info: np.ndarray,
-                 data: np.ndarray, tloc: np.ndarray) -> None:
+                 rec: np.ndarray) -> None:
         self._params = params
         self._starts = starts
         self._outs = outs
         self._info = info
-        self._data = data
-        self._tloc = tloc
+        self._rec = rec
         self._items: list[StepResult | None] = [None] * len(starts)
 
     def __len__(self) -> int:
@@ -322,7 +322,7 @@ class StepList(Sequence[StepResult]):
     def _build(self, k: int) -> StepResult:
         inf = self._info[k]
         a, b = int(inf[pk.RI_ROW0]), int(inf[pk.RI_ROW0] + inf[pk.RI_NSTANCE])
-        rec = np.column_stack((self._tloc[a:b], self._data[a:b][:, _REC_FROM_TRAJ]))
+        rec = self._rec[a:b]
         start = TouchdownState(*self._starts[k].tolist())
         return StepResult.from_kernel(self._params, start, int(inf[pk.RI_STATUS]), self._outs[k],
                                       rec)
@@ -332,6 +332,56 @@ class StepList(Sequence[StepResult]):
 
     def __repr__(self) -> str:
         return f"<{len(self)} strides>"
+
+
+class RunTable:
+    """The columns of a recorded run before they are derived: ``Trajectory.data`` until read.
+
+    :func:`tslip.simulate` records each stance's record rows and each flight
+    sample's time (:class:`StepList`'s arrays); :meth:`columns` derives the
+    trajectory's columns from them in one compiled pass
+    (:func:`._record.fill_table`: CoM and hip from the leg, eqs A.3-A.5; flight
+    in closed form, eq. 2.7), with the same arithmetic as a row written while
+    running, so every value is the same.
+    """
+
+    __slots__ = ("_P", "_steps")
+
+    def __init__(self, P: np.ndarray, steps: StepList) -> None:  # noqa: N803 - the kernels' name
+        self._P = P
+        self._steps = steps
+
+    def __len__(self) -> int:
+        return len(self._steps._rec)
+
+    def columns(self) -> np.ndarray:
+        """A new ``(NTRAJ, rows)`` array: trajectory column ``j`` is its row ``j``."""
+        from ._record import fill_table
+
+        sl = self._steps
+        table = np.empty((pk.NTRAJ, len(sl._rec)))
+        fill_table(self._P, sl._rec, sl._starts, sl._outs, sl._info, len(sl), table)
+        return table
+
+
+class _Data:
+    """``Trajectory.data``: the array it was given, or a :class:`RunTable` derived on first read.
+
+    A data descriptor, so the frozen dataclass's ``__init__`` stores through it and
+    reading the field derives the columns once (kept column-major: each column of
+    ``data`` is contiguous, and :meth:`Trajectory.to_dataframe` needs no transpose).
+    """
+
+    def __get__(self, obj: Trajectory | None, owner: type | None = None) -> np.ndarray:
+        if obj is None:
+            raise AttributeError("data")  # no class-level default: the field is required
+        value = obj.__dict__["_data"]
+        if isinstance(value, RunTable):
+            value = obj.__dict__["_data"] = value.columns().T
+        return value
+
+    def __set__(self, obj: Trajectory, value: np.ndarray | RunTable) -> None:
+        obj.__dict__["_data"] = value
 
 
 class EventList(Sequence[Event]):
@@ -404,7 +454,10 @@ class Trajectory(Result):
     :func:`tslip.simulate`: a :class:`StepList` and an :class:`EventList`, built on access).
     """
 
-    data: np.ndarray
+    if TYPE_CHECKING:
+        data: np.ndarray
+    else:
+        data: _Data = _Data()  # an array, or a RunTable derived into one on first read
     steps: Sequence[StepResult]
     events: Sequence[Event]
     status: Status
@@ -442,12 +495,11 @@ class Trajectory(Result):
 
     def to_dataframe(self) -> pd.DataFrame:
         """Time series as a tidy ``pandas.DataFrame``, one row per sample (units in attrs)."""
-        import pandas as pd
 
-        df = pd.DataFrame(self.data, columns=list(TRAJECTORY_COLUMNS))
-        df["step"] = df["step"].astype(int)
-        df["stance"] = df["stance"].astype(bool)
-        return with_units(df, COLUMN_UNITS)
+        value = self.__dict__["_data"]
+        # a new column-major table that the frame owns and takes without a copy
+        table = value.columns() if isinstance(value, RunTable) else self.data.T.copy()
+        return with_units(_frame(table), COLUMN_UNITS)
 
     def plot(self, ax: Axes | None = None) -> Figure:
         """Four panels (:func:`~tslip.plotting.plot_trajectory`), or the CoM path on ``ax``."""
@@ -462,7 +514,7 @@ class Trajectory(Result):
         st, ev = self.steps, self.events
         if isinstance(st, StepList) and isinstance(ev, EventList) and ev._steps is st:
             out["strides"] = {"starts": st._starts, "outs": st._outs, "info": st._info,
-                              "tloc": st._tloc, "last": ev._last}
+                              "tloc": st._rec[:, pk.REC_T].copy(), "last": ev._last}
         else:
             out["steps"], out["events"] = tuple(st), tuple(ev)
         return out
@@ -472,8 +524,8 @@ class Trajectory(Result):
         fields = dict(fields)
         rec = fields.pop("strides", None)
         if rec is not None:
-            steps = StepList(fields["params"], rec["starts"], rec["outs"], rec["info"],
-                             fields["data"], rec["tloc"])
+            rows = np.column_stack((rec["tloc"], fields["data"][:, _REC_FROM_TRAJ]))
+            steps = StepList(fields["params"], rec["starts"], rec["outs"], rec["info"], rows)
             fields["steps"], fields["events"] = steps, EventList(steps, rec["last"])
         return cls(**fields)
 
@@ -515,6 +567,35 @@ class Trajectory(Result):
                 }
             )
         return with_units(pd.DataFrame(rows, columns=_STEP_COLUMNS), COLUMN_UNITS)
+
+
+def _frame(table: np.ndarray) -> pd.DataFrame:
+    """The frame of a column-major trajectory ``table`` (``NTRAJ x rows``), sharing its memory.
+
+    Time and the columns from ``x`` on stay float blocks of ``table`` (pandas stores
+    a block column-major too); ``step`` and ``stance`` become integer and boolean
+    columns. pandas 3's block constructor does this without a copy; earlier
+    versions insert the three columns one by one.
+    """
+    import pandas as pd
+
+    names = list(TRAJECTORY_COLUMNS)
+    first = pk.TR_X  # the typed columns come before it: time, step, stance
+    step = table[pk.TR_STEP : pk.TR_STEP + 1].astype(np.int64)
+    stance = table[pk.TR_STANCE : pk.TR_STANCE + 1].astype(bool)
+    try:
+        from pandas.api.internals import create_dataframe_from_blocks
+    except ImportError:  # pandas < 3
+        df = pd.DataFrame(table[first:].T, columns=names[first:], copy=False)
+        df.insert(0, "t", table[pk.TR_T])
+        df.insert(1, "step", step[0])
+        df.insert(2, "stance", stance[0])
+        return df
+    blocks = [(table[pk.TR_T : pk.TR_T + 1], np.array([pk.TR_T])),
+              (step, np.array([pk.TR_STEP])), (stance, np.array([pk.TR_STANCE])),
+              (table[first:], np.arange(first, pk.NTRAJ))]
+    return create_dataframe_from_blocks(blocks, index=pd.RangeIndex(table.shape[1]),
+                                        columns=pd.Index(names))
 
 
 _STEP_COLUMNS = ["step", "beta", "phi", "xd", "yd", "phid", "v", "delta", "x", "h",

@@ -1,0 +1,175 @@
+"""How close the simulator runs to its physical limit: five ratios measured in one run (issue 25).
+
+Run by hand (not in CI): ``python benchmarks/bench_limit.py``. Everything is on
+the Table 6.1 periodic gait (``tslip.find_gait(tslip.preset("table6.1"))``) with
+the default options (dopri5, ``rtol = atol = 1e-8``), on one thread. The
+workloads are timed interleaved, call by call, for ``--rounds`` rounds
+(``_baseline.ab``); each ratio is of the median times (CPU seconds by default,
+steadier than wall time on a shared machine; ``--wall`` for wall time). It
+prints exactly these lines, after context lines (load, counts)::
+
+    stride kernel / RHS-bound limit: X.XX
+    simulate / unrecorded strides: X.XX
+    simulate + to_dataframe / unrecorded strides: X.XX
+    step_map / stride kernel: X.XX
+    study point / its compiled work: X.XX
+
+Definitions:
+
+* **stride kernel**: the time of one compiled stride, from one
+  :func:`tslip.run_batch` call of ``--steps`` strides of the gait (one row,
+  nothing recorded) divided by ``--steps``.
+* **RHS-bound limit** = ``t_rhs x N_RHS``. ``t_rhs`` is the median time of one
+  compiled stance right-hand side (``_stance.rhs``) over the stride's own stance
+  states (the states at the integrator's steps, ``tslip.step(...).stance``), called
+  in a compiled loop. :data:`N_RHS` = 146 is frozen: the right-hand sides
+  (accepted and rejected steps, 6 per dopri5 step, plus the initial-step
+  estimate; no dense-output stages) that the kernel of revision 3b38fb1 spends
+  on this stride. Today's count is printed beside it (counted exactly by running
+  one stride as plain Python, ``NUMBA_DISABLE_JIT=1``, in a subprocess, with a
+  counting ``rhs``), so a kernel taking fewer steps shows as a gain.
+* **unrecorded strides**: the same ``--steps`` strides through the compiled
+  batch kernel without recording, one :func:`tslip.run_batch` call.
+* **simulate**: :func:`tslip.simulate` of those strides at ``dt = --dt``;
+  **simulate + to_dataframe**: the same and ``Trajectory.to_dataframe()`` (all
+  columns).
+* **step_map**: one :func:`tslip.step_map` call from the gait's section (a
+  loop of ``--maps`` calls, divided by ``--maps``), against one stride kernel.
+* **study point / its compiled work**: the wall time of one serial continuation
+  point of ``run_study`` over the summed time of the compiled kernel calls it
+  makes (wrapped and timed), both from ``benchmarks/_study_limit.py``'s
+  ``measure(rounds) -> (point seconds, kernel seconds)``; ``n/a`` if that
+  module is missing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numba
+import numpy as np
+from _baseline import ab
+from numba import njit
+
+import tslip
+from tslip.model import _pack as pk
+from tslip.simulation import _stance
+
+#: Right-hand sides of the Table 6.1 stride at dopri5 1e-8 with the kernel of
+#: revision 3b38fb1 (frozen: the limit does not move when the kernel takes fewer steps).
+N_RHS = 146
+
+_COUNT = """
+import json, sys, tslip
+from tslip.simulation import _stance
+calls = [0]
+rhs = _stance.rhs
+def counting(*a):
+    calls[0] += 1
+    rhs(*a)
+for name, mod in list(sys.modules.items()):
+    if name.startswith("tslip.simulation") and getattr(mod, "rhs", None) is rhs:
+        mod.rhs = counting
+g = tslip.find_gait(tslip.preset("table6.1"))
+calls[0] = 0
+tslip.step_map(g.params, g.state.section())
+print(json.dumps(calls[0]))
+"""
+
+
+def rhs_count() -> int:
+    """Stance right-hand sides of one stride of the gait today (plain Python, counted)."""
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    out = subprocess.run([sys.executable, "-c", _COUNT], env=env, capture_output=True,
+                         text=True, check=True).stdout
+    return int(json.loads(out.strip().splitlines()[-1]))
+
+
+@njit(cache=False)
+def _rhs_loop(P, Y, reps):  # noqa: N803
+    """``reps`` passes of ``rhs`` over the rows of ``Y``; the sum keeps the calls alive."""
+    dy = np.empty(6)
+    acc = 0.0
+    for _ in range(reps):
+        for i in range(Y.shape[0]):
+            _stance.rhs(P, Y[i], dy)
+            acc += dy[3]
+    return acc
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rounds", type=int, default=21, help="interleaved rounds")
+    ap.add_argument("--steps", type=int, default=1000, help="strides of the runs")
+    ap.add_argument("--maps", type=int, default=1000, help="step_map calls a round")
+    ap.add_argument("--reps", type=int, default=200, help="passes over the stance states")
+    ap.add_argument("--dt", type=float, default=0.01)
+    ap.add_argument("--wall", action="store_true", help="wall time instead of CPU time")
+    a = ap.parse_args()
+    clock = time.perf_counter if a.wall else time.process_time
+    numba.set_num_threads(1)
+    load0 = os.getloadavg()[0]
+
+    g = tslip.find_gait(tslip.preset("table6.1"))
+    p, s = g.params, g.state
+    q = s.section()
+    P = pk.pack_params(p)
+    Y = np.ascontiguousarray(tslip.step(p, s).stance[:, 1:7])
+    n_now = rhs_count()
+
+    def maps() -> None:
+        for _ in range(a.maps):
+            tslip.step_map(p, q)
+
+    fns = {
+        "rhs": lambda: _rhs_loop(P, Y, a.reps),
+        "strides": lambda: tslip.run_batch(p, [s], a.steps),
+        "simulate": lambda: tslip.simulate(p, s, a.steps, dt=a.dt),
+        "simulate + df": lambda: tslip.simulate(p, s, a.steps, dt=a.dt).to_dataframe(),
+        "step_map": maps,
+    }
+    t = ab(fns, a.rounds, clock=clock).median
+    rows = len(tslip.simulate(p, s, a.steps, dt=a.dt).data)
+    t_rhs = t["rhs"] / (a.reps * len(Y))
+    stride = t["strides"] / a.steps
+    study = None
+    try:
+        from _study_limit import measure  # another helper's module (issue 25)
+    except ImportError:
+        pass
+    else:
+        study = measure(a.rounds)
+    load1 = os.getloadavg()[0]
+
+    what = "wall" if a.wall else "CPU"
+    print(f"Table 6.1 gait, dopri5 rtol = atol = 1e-8, one thread; medians of {a.rounds} "
+          f"interleaved rounds ({what} time); 1-minute load {load0:.2f} before, "
+          f"{load1:.2f} after")
+    print(f"RHS: t_rhs {t_rhs * 1e9:.1f} ns over {len(Y)} stance states x {a.reps}; "
+          f"N_rhs {N_RHS} (revision 3b38fb1, frozen), today {n_now}; limit "
+          f"{t_rhs * N_RHS * 1e6:.2f} us (today's count: {t_rhs * n_now * 1e6:.2f} us)")
+    print(f"stride kernel {stride * 1e6:.2f} us ({a.steps} strides, run_batch); step_map "
+          f"{t['step_map'] / a.maps * 1e6:.2f} us a call; simulate {t['simulate'] * 1e3:.2f} ms, "
+          f"+ to_dataframe {t['simulate + df'] * 1e3:.2f} ms ({a.steps} strides, {rows} rows, "
+          f"dt {a.dt:g})")
+    if study is not None:
+        print(f"study point {study[0] * 1e3:.3f} ms, its compiled kernel calls "
+              f"{study[1] * 1e3:.3f} ms")
+    print(f"stride kernel / RHS-bound limit: {stride / (t_rhs * N_RHS):.2f}")
+    print(f"simulate / unrecorded strides: {t['simulate'] / t['strides']:.2f}")
+    print(f"simulate + to_dataframe / unrecorded strides: "
+          f"{t['simulate + df'] / t['strides']:.2f}")
+    print(f"step_map / stride kernel: {t['step_map'] / a.maps / stride:.2f}")
+    if study is None:
+        print("study point / its compiled work: n/a (benchmarks/_study_limit.py missing)")
+    else:
+        print(f"study point / its compiled work: {study[0] / study[1]:.2f}")
+
+
+if __name__ == "__main__":
+    main()
