@@ -44,7 +44,7 @@ from ..model.parameters import PARAMETER_TABLE, Params
 from ..model.units import COLUMN_UNITS, param_unit
 from ..simulation.options import IntegratorOptions
 from .fixed_point import Gait, GaitProblem, find_gait
-from .problem import Fix, Section, nominal_energy
+from .problem import Fix, Section, checked_replace, nominal_energy
 from .section import apex_section_ok
 from .stability import floquet
 
@@ -110,6 +110,8 @@ def set_param(params: Params, name: str, value: float) -> Params:
     Returns
     -------
     Params
+        Only the changed value is checked (``params`` was checked when built;
+        :func:`~tslip.gait.problem.checked_replace`).
 
     Raises
     ------
@@ -123,10 +125,9 @@ def set_param(params: Params, name: str, value: float) -> Params:
         return params.with_omega_r_bar(value)
     if name.startswith("controller."):
         gain: dict[str, Any] = {name.split(".", 1)[1]: value}
-        return dataclasses.replace(params, controller=dataclasses.replace(params.controller,
-                                                                          **gain))
+        return checked_replace(params, controller=checked_replace(params.controller, **gain))
     change: dict[str, Any] = {name: value}
-    return dataclasses.replace(params, **change)
+    return checked_replace(params, **change)
 
 
 # ---------------------------------------------------------------------------

@@ -287,17 +287,17 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
     except ValueError:
         return None, math.inf
     z = z0
-    nrm = float(np.linalg.norm(r))
+    nrm = _norm(r)
     for it in range(_NEWTON_MAX_ITER + 1):
-        if not (np.all(np.isfinite(J)) and math.isfinite(nrm)):
+        if not (math.isfinite(nrm) and np.isfinite(J).all()):
             return None, math.inf
-        err = float(np.max(np.abs(r)))
+        err = max(map(abs, r.tolist()))  # r is finite here (its norm is)
+        if err <= 1e-2 * tol:  # done (the map's Jacobian at z is kept for floquet)
+            return z, err
         if err > tol and it == _NEWTON_MAX_ITER:
             return None, math.inf
         dz = np.linalg.lstsq(J, -r, rcond=None)[0]
         if err <= tol:
-            if err <= 1e-2 * tol:  # done (the map's Jacobian at z is kept for floquet)
-                return z, err
             try:  # one polishing step with the Jacobian at hand
                 rp = residual(z + dz)
             except ValueError:
@@ -316,7 +316,7 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
                     rn, Jn = fj(zn)
                 else:
                     rn, Jn = residual(zn), None
-                nn = float(np.linalg.norm(rn))
+                nn = _norm(rn)
             except ValueError:
                 nn = math.inf
             if nn <= (1.0 - 1e-4 * t) * nrm:
@@ -331,6 +331,11 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
                 return None, math.inf
         z, r, J, nrm = zn, rn, Jn, nn
     return None, math.inf  # not reached
+
+
+def _norm(r: np.ndarray) -> float:
+    """``np.linalg.norm(r)`` of a float vector, without its generality (the same bits)."""
+    return math.sqrt(float(r.dot(r)))
 
 
 # ---------------------------------------------------------------------------
@@ -447,8 +452,10 @@ def _held_pitch_guess(prob: GaitProblem, z0: np.ndarray) -> np.ndarray:
     docs/conventions.md, "Held pitch"). The old form is accepted, with a
     ``DeprecationWarning``, until 0.5.
     """
+    if z0.ndim != 1 or z0.size == prob.size:
+        return z0
     full = ("delta", "phi", "phid", *prob.names[prob.names.index("alpha_r"):])
-    if z0.ndim != 1 or z0.size == prob.size or z0.size != len(full):
+    if z0.size != len(full):
         return z0
     held = [n for n in full if n not in prob.names]
     warnings.warn(

@@ -35,7 +35,6 @@ analysis, and only those.
 from __future__ import annotations
 
 import functools
-import json
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -107,20 +106,19 @@ def _num(x: Any) -> float:
 class _Seed:
     """A solved point as its neighbours see it: the record's unknowns.
 
-    Duck-types the two things a warm start reads from a :class:`Gait`:
-    ``state.delta/phi/phid`` and ``params`` (with the solved ``alpha_r`` and
-    controller reference).
+    Duck-types the two things a warm start (:meth:`GaitProblem.encode`) reads
+    from a :class:`Gait`: ``state.delta/phi/phid`` and, of ``params``, the
+    solved ``alpha_r`` and controller reference (``controller.alphad_ref`` or
+    ``controller.tau_c``): the record's numbers, which the gait's parameters
+    hold.
     """
 
-    def __init__(self, decode: Callable[[], Any], z: dict[str, float]) -> None:
-        self._decode = decode
+    def __init__(self, z: dict[str, float]) -> None:
         self.z = z
-        self.state = SimpleNamespace(**z)  # encode() reads gait.state.delta, phi, phid
-
-    @functools.cached_property
-    def params(self) -> Any:
-        """Decoded when first read: only the natural continuation's predictor reads it."""
-        return self._decode()
+        self.state = SimpleNamespace(**z)
+        self.params = SimpleNamespace(
+            alpha_r=z["alpha_r"],
+            controller=SimpleNamespace(alphad_ref=z["alphad_ref"], tau_c=z["tau_c"]))
 
 
 def seeds_from_records(records: Sequence[dict[str, Any] | None],
@@ -157,12 +155,8 @@ class _Line:
     def point_params(self, i: int) -> Any:
         return self.spec.params_at({**self.assignment, self.inner: float(self.values[i])})
 
-    def seed(self, i: int, rec: dict[str, Any]) -> _Seed:
-        def decode() -> Any:
-            prob = GaitProblem.from_params(self.point_params(i))
-            return prob.decode([rec[n] for n in prob.names])[0]
-
-        return _Seed(decode, {n: _num(rec.get(n)) for n in UNKNOWNS})
+    def seed(self, rec: dict[str, Any]) -> _Seed:
+        return _Seed({n: _num(rec.get(n)) for n in UNKNOWNS})
 
     def attempt(self, i: int, solve: Callable[[], tuple[Gait, str]],
                 keep_failure: bool) -> _Seed | None:
@@ -184,7 +178,7 @@ class _Line:
             rec = self.finish(i, g, _num(g.residual), message)
         elif not (rec["converged"] and rec["_attempt"] == self.tries[i]):
             return None
-        self.gaits[i] = self.seed(i, rec)
+        self.gaits[i] = self.seed(rec)
         return self.gaits[i]
 
     def attempt_from(self, i: int, z: dict[str, float], message: str) -> bool:
@@ -273,7 +267,7 @@ class _Line:
                                        self.spent[i]))
         self.pending[i] = Pending(i, point, g, _num(residual), message, self.tries[i],
                                   self.spent[i])
-        return json.loads(json.dumps({**point, "converged": True, **_unknowns(g)}))
+        return {**point, "converged": True, **_unknowns(g)}
 
     def record(self, item: Pending) -> dict[str, Any]:
         """Analyse one solved point and emit its record."""
@@ -344,14 +338,14 @@ def _unknowns(g: Gait) -> dict[str, float]:
 
 def analyse_point(spec: StudySpec, item: Pending, neutral_tol: float | None = None
                   ) -> dict[str, Any]:
-    """The record of one solved point (exactly what the cache holds)."""
+    """The record of one solved point (exactly what the cache holds: plain numbers and text)."""
     if neutral_tol is None:
         neutral_tol = floquet_tol(spec)
     t0 = time.perf_counter()
     rec = _analyse(spec, item.point, item.gait, item.residual, item.message, neutral_tol)
     rec["seconds"] = item.seconds + time.perf_counter() - t0
     rec["_attempt"] = item.attempt
-    return json.loads(json.dumps(rec))
+    return rec
 
 
 def _analyse(spec: StudySpec, point: dict[str, float], g: Gait | None, residual: float,

@@ -10,7 +10,8 @@ all cores, unless ``workers`` is given), or on a Dask cluster given its
 address. Each point is appended to the study's file in ``cache/``
 (:mod:`tslip.sweeps._store`: one JSON line a point) the moment it is final,
 by the process that computed it, and the progress callback advances with
-it. The cache key is a hash of everything that can change a point's numbers: the study's base parameters, its axes (every value: the
+it. The cache key is a hash of everything that can change a point's
+numbers: the study's base parameters, its axes (every value: the
 resolution), the point's axis values, the analyses, the gait and Floquet
 tolerances, the strides of a robustness run, and the code that computes
 them with the versions of Python and the numerical libraries
