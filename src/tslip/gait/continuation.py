@@ -43,7 +43,7 @@ from .._results import Result, with_units
 from ..model.parameters import PARAMETER_TABLE, Params
 from ..model.units import COLUMN_UNITS, param_unit
 from ..simulation.options import IntegratorOptions
-from .fixed_point import Gait, GaitProblem, find_gait
+from .fixed_point import Gait, GaitProblem, _search, find_gait
 from .problem import Fix, Section, checked_replace, nominal_energy
 from .section import apex_section_ok
 from .stability import floquet
@@ -305,12 +305,12 @@ def _solve_point(
         starts.append(("neighbour", z1))
     best: Gait | None = None
     for how, z in starts:
-        g = find_gait(p, guess=z, tol=tol, options=options, **hold)
+        g = _search(prob, z, tol)
         if g.converged:
             return g, f"{g.message} (warm start: {how})"
         if best is None or g.residual < best.residual:
             best = g
-    g = find_gait(p, tol=tol, options=options, **hold)
+    g = _search(prob, None, tol)
     if g.converged or best is None or g.residual < best.residual:
         best = g
     how = "automatic guess" + (" after the warm start failed" if starts else "")

@@ -403,6 +403,17 @@ def _newton_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float,
     return _make_gait(prob, z, tol, msg)
 
 
+def _search(prob: GaitProblem, guess: np.ndarray | None = None, tol: float = 1e-10) -> Gait:
+    """:func:`find_gait`'s Newton search on a problem built by the caller.
+
+    From ``guess`` (``prob.names``, the right length) or, without one, from
+    the automatic guesses; continuation builds the problem once per point.
+    """
+    if guess is None:
+        return _newton_gait(prob, prob.guesses(), tol, _MAX_STARTS)
+    return _newton_gait(prob, [guess], tol, None)
+
+
 def _cma_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float, seed: int | None,
               max_evals: int, polish: bool, jacobian: Literal["fd", "exact"]) -> Gait:
     if seed is None:
@@ -566,16 +577,15 @@ def find_gait(
             beta0=params.beta0 if beta0 is None else beta0,
         )
     prob = GaitProblem.from_params(params, options, fix=fix, section=section, energy=energy)
+    z0 = None
     if guess is not None:
         z0 = _held_pitch_guess(prob, np.asarray(guess, dtype=float))
         if z0.shape != (prob.size,):
             raise ValueError(f"guess must have {prob.size} entries {list(prob.names)}, "
                              f"got {z0.size}")
-        starts: Iterable[np.ndarray] = [z0]
-    else:
-        starts = prob.guesses()
     if method == "cma":
         if max_evals < 1:
             raise ValueError(f"max_evals must be >= 1, got {max_evals!r}")
+        starts = prob.guesses() if z0 is None else [z0]
         return _cma_gait(prob, starts, tol, seed, max_evals, polish, jacobian)
-    return _newton_gait(prob, starts, tol, None if guess is not None else _MAX_STARTS)
+    return _search(prob, z0, tol)

@@ -88,10 +88,17 @@ def checked_replace(obj: _T, **changes: Any) -> _T:
     for name, value in changes.items():
         md = fields[name].metadata if name in fields else {}
         if "lower" in md:
-            checked[name] = check_number(
-                value, f"{prefix}{name}", unit=md.get("unit", ""), lower=md["lower"],
-                upper=md.get("upper", math.inf), lower_open=md.get("lower_open", False),
-                upper_open=md.get("upper_open", False), integer=fields[name].type in (int, "int"))
+            lo, hi = md["lower"], md.get("upper", math.inf)
+            if (type(value) is float and fields[name].type not in (int, "int")
+                    and (lo < value if md.get("lower_open") else lo <= value)
+                    and (value < hi if md.get("upper_open") else value <= hi)
+                    and math.isfinite(value)):
+                checked[name] = value  # what check_number returns for it
+                continue
+            checked[name] = check_number(  # the rest, and the error message
+                value, f"{prefix}{name}", unit=md.get("unit", ""), lower=lo, upper=hi,
+                lower_open=md.get("lower_open", False), upper_open=md.get("upper_open", False),
+                integer=fields[name].type in (int, "int"))
         elif name == "controller" and type(value) is type(getattr(obj, name)):
             checked[name] = value  # a controller is checked when built
         else:
@@ -132,10 +139,13 @@ def _unknown_names(params: Params) -> tuple[str, ...]:
     return tuple(names)
 
 
-def _allowed_names() -> set[tuple[str, ...]]:
-    return {("delta", *mid, "alpha_r", *ext)
-            for mid in ((), ("phi",), ("phid",), ("phi", "phid"))
-            for ext in ((), ("alphad_ref",), ("tau_c",))}
+#: The forms ``GaitProblem.names`` may take.
+_ALLOWED_NAMES = frozenset(("delta", *mid, "alpha_r", *ext)
+                           for mid in ((), ("phi",), ("phid",), ("phi", "phid"))
+                           for ext in ((), ("alphad_ref",), ("tau_c",)))
+#: What a stride's output vector and Jacobian hold before the kernel fills them.
+_NAN_OUT = np.full(pk.NOUT, math.nan)
+_NAN_J = np.full((5, 5), math.nan)
 
 
 def nominal_energy(params: Params) -> float:
@@ -258,7 +268,7 @@ class GaitProblem:
     def __post_init__(self) -> None:
         if not self.names:
             object.__setattr__(self, "names", _unknown_names(self.params))
-        if tuple(self.names) not in _allowed_names():
+        if tuple(self.names) not in _ALLOWED_NAMES:
             raise ValueError("names must be ('delta', ['phi'], ['phid'], 'alpha_r') and at most "
                              f"one of 'alphad_ref', 'tau_c', got {self.names}")
         if self.fix not in ("speed", "energy"):
@@ -413,8 +423,8 @@ class GaitProblem:
             P[pk.P_C0] = self._ref_gain * ref
         v = self.speed(delta, phi, phid)
         q = np.array([self.params.beta0, phi, v * math.cos(delta), v * math.sin(delta), phid])
-        out = np.full(pk.NOUT, math.nan)
-        J = np.full((5, 5), math.nan) if jacobian else None
+        out = _NAN_OUT.copy()
+        J = _NAN_J.copy() if jacobian else None
         if not math.isfinite(v):
             return P, q, int(Status.NONFINITE), out, J, v
         if J is not None:
@@ -439,7 +449,7 @@ class GaitProblem:
         P, q, st, out, Jq, v = self._stride(x, jacobian=True)
         r, _, _ = _section_residual(q, st, out, self.params, v)
         n = self.size
-        if st != Status.OK or Jq is None or not np.isfinite(Jq).all():
+        if st != Status.OK or Jq is None or not (Jq * 0.0).sum() == 0.0:  # a NaN or inf
             return r, np.full((5, n), math.nan)
         delta, phi, phid, _, ref = x
         i_delta, i_phi, i_phid, i_alpha, i_ref = self._at

@@ -27,27 +27,43 @@ import os
 from pathlib import Path
 from typing import Any
 
-__all__ = ["SUFFIX", "append", "read"]
+__all__ = ["SUFFIX", "Writer", "read"]
 
 SUFFIX = ".jsonl"
 _DECODER = json.JSONDecoder()  # strict: plain JSON values, no hooks
 _SCALARS = (str, int, float, bool, type(None))
 
 
-def append(path: str | Path, key: str, record: dict[str, Any]) -> None:
-    """Append the record of point ``key`` to ``path`` as one line (one write)."""
-    line = (json.dumps({"key": key, "record": record}) + "\n").encode()
-    try:
-        fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o666)
-    except FileNotFoundError:
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o666)
-    try:
+class Writer:
+    """Appends records to ``path``, each as one line in one write; a context manager.
+
+    The file (and its folder) is opened on the first record and closed on
+    exit. ``path`` None keeps nothing (a study run without a folder).
+    """
+
+    def __init__(self, path: str | Path | None) -> None:
+        self.path = None if path is None else Path(path)
+        self._fd: int | None = None
+
+    def add(self, key: str, record: dict[str, Any]) -> None:
+        """Append the record of point ``key``: it is saved when this returns."""
+        if self.path is None:
+            return
+        line = (json.dumps({"key": key, "record": record}) + "\n").encode()
+        if self._fd is None:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self._fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o666)
         view = memoryview(line)
         while view:
-            view = view[os.write(fd, view):]
-    finally:
-        os.close(fd)
+            view = view[os.write(self._fd, view):]
+
+    def __enter__(self) -> Writer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._fd is not None:
+            os.close(self._fd)
+            self._fd = None
 
 
 def read(path: str | Path, *, repair: bool = False) -> dict[str, dict[str, Any]]:

@@ -45,8 +45,8 @@ from typing import Any
 import numpy as np
 
 from .._codehash import code_hash, module_digest
-from ..gait.continuation import _solve_point, get_param
-from ..gait.fixed_point import Gait, GaitProblem, find_gait
+from ..gait.continuation import _solve_point, get_param, set_param
+from ..gait.fixed_point import Gait, GaitProblem, _search, find_gait
 from ..gait.robustness import KINDS, robustness_report
 from ..gait.stability import floquet
 from ..gait.stride import stride_properties
@@ -153,7 +153,8 @@ class _Line:
 
     # -- points -----------------------------------------------------------------
     def point_params(self, i: int) -> Any:
-        return self.spec.params_at({**self.assignment, self.inner: float(self.values[i])})
+        """``spec.params_at`` of point ``i``: the line's parameters with the inner value set."""
+        return set_param(self.params, self.inner, float(self.values[i]))
 
     def seed(self, rec: dict[str, Any]) -> _Seed:
         return _Seed({n: _num(rec.get(n)) for n in UNKNOWNS})
@@ -183,12 +184,11 @@ class _Line:
 
     def attempt_from(self, i: int, z: dict[str, float], message: str) -> bool:
         """Attempt point ``i`` from a neighbour's unknowns ``z``."""
-        p = self.point_params(i)
-        names = GaitProblem.from_params(p).names
-        guess = np.array([z.get(n, math.nan) for n in names], dtype=float)
+        prob = GaitProblem.from_params(self.point_params(i))
+        guess = np.array([z.get(n, math.nan) for n in prob.names], dtype=float)
         if not np.all(np.isfinite(guess)):
             return False
-        return self.attempt(i, lambda: (find_gait(p, guess=guess, tol=self.tol), message),
+        return self.attempt(i, lambda: (_search(prob, guess, self.tol), message),
                             keep_failure=False) is not None
 
     # -- strategies -------------------------------------------------------------
@@ -362,13 +362,14 @@ def _analyse(spec: StudySpec, point: dict[str, float], g: Gait | None, residual:
             fl = None
     rec["stability"] = fl.stability if fl is not None else ("unknown" if g is not None
                                                             else "none")
-    mags = np.sort(np.abs(fl.multipliers))[::-1] if fl is not None else np.full(5, np.nan)
+    mags = np.abs(fl.multipliers) if fl is not None else np.full(5, np.nan)
+    desc = np.sort(mags)[::-1].tolist()
     for j in range(5):
-        rec[f"abs_lambda_{j + 1}"] = _num(mags[j])
+        rec[f"abs_lambda_{j + 1}"] = desc[j]
     rec["max_nontrivial"] = _num(fl.max_nontrivial) if fl is not None else math.nan
-    rec["n_trivial"] = int(np.sum(fl.trivial)) if fl is not None else 0
-    nt = np.abs(fl.multipliers[~fl.trivial]) if fl is not None else np.array([])
-    rec["min_nontrivial"] = _num(nt.min()) if nt.size else math.nan
+    rec["n_trivial"] = int(fl.trivial.sum()) if fl is not None else 0
+    nt = mags[~fl.trivial] if fl is not None else mags[:0]
+    rec["min_nontrivial"] = float(nt.min()) if nt.size else math.nan
     rec["stance_time"] = _num(g.stance_time) if g is not None else math.nan
     rec["flight_time"] = _num(g.flight_time) if g is not None else math.nan
     if g is not None:

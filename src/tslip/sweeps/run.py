@@ -155,9 +155,9 @@ def saved_points(spec: StudySpec, out_dir: str | Path) -> int:
     return sum(k in stored for _, _, keys in study_keys(spec) for k in keys)
 
 
-def _save(file: str | Path, key: str, rec: dict[str, Any]) -> None:
-    """Cache one final point (:func:`tslip.sweeps._store.append`)."""
-    _store.append(file, key, rec)
+def _save(writer: _store.Writer, key: str, rec: dict[str, Any]) -> None:
+    """Cache one final point."""
+    writer.add(key, rec)
 
 
 def _solve_task(spec: StudySpec, assignment: dict[str, float], values: list[float],
@@ -166,13 +166,13 @@ def _solve_task(spec: StudySpec, assignment: dict[str, float], values: list[floa
                 tick: Callable[[int], None] | None = None) -> Solved:
     """Find one line's gaits; its points without a gait are cached as final (in workers)."""
     tick = tick or _pool.notify
+    with _store.Writer(cache) as writer:
 
-    def emit(i: int, rec: dict[str, Any]) -> None:
-        if cache is not None:
-            _save(cache, keys[i], rec)
-        tick(1)
+        def emit(i: int, rec: dict[str, Any]) -> None:
+            _save(writer, keys[i], rec)
+            tick(1)
 
-    return solve_gaits(spec, assignment, values, seeds=seeds, cached=cached, emit=emit)
+        return solve_gaits(spec, assignment, values, seeds=seeds, cached=cached, emit=emit)
 
 
 def _analyse_task(spec: StudySpec, items: list[Pending], keys: list[str], cache: str | None,
@@ -180,12 +180,12 @@ def _analyse_task(spec: StudySpec, items: list[Pending], keys: list[str], cache:
     """Analyse solved points, caching each record as it is final (in workers)."""
     tick = tick or _pool.notify
     out = []
-    for item, key in zip(items, keys):
-        rec = analyse_point(spec, item)
-        if cache is not None:
-            _save(cache, key, rec)
-        tick(1)
-        out.append(rec)
+    with _store.Writer(cache) as writer:
+        for item, key in zip(items, keys):
+            rec = analyse_point(spec, item)
+            _save(writer, key, rec)
+            tick(1)
+            out.append(rec)
     return out
 
 
@@ -444,8 +444,9 @@ class StudyJob:
         if self.writes:
             return
         if self.cache is not None:
-            for k, r in fresh:
-                _save(self.cache, k, r)
+            with _store.Writer(self.cache) as writer:
+                for k, r in fresh:
+                    _save(writer, k, r)
         self.tick(len(fresh))
 
     def _chunks(self, i: int, pending: list[Pending]) -> list[Task]:
