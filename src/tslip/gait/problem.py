@@ -79,8 +79,8 @@ def checked_replace(obj: _T, **changes: Any) -> _T:
     change (a choice, a controller of another type) and any other class take
     ``dataclasses.replace``.
     """
-    cls = type(obj)
-    if cls.__post_init__ not in (Params.__post_init__, Controller.__post_init__):  # type: ignore[attr-defined]
+    cls: Any = type(obj)
+    if cls.__post_init__ not in (Params.__post_init__, Controller.__post_init__):
         return dataclasses.replace(obj, **changes)  # type: ignore[type-var]
     fields = _fields(cls)
     prefix = "" if cls is Params else f"{cls.__name__}."
