@@ -18,8 +18,8 @@ them with the versions of Python and the numerical libraries
 (:func:`tslip.sweeps.point.code_version`), so
 
 * an interrupted study resumes with only the missing points, and ends
-  bit-identical to an uninterrupted run (a line replays its cached points;
-  a line torn by a kill is computed again),
+  bit-identical to an uninterrupted run (a continuation line replays its
+  cached points; a point whose record a kill tore is computed again),
 * a finished study reruns instantly,
 * changing a parameter, or the code behind an analysis, recomputes the
   points it affects and no others.
@@ -137,7 +137,10 @@ def study_file(spec: StudySpec, out_dir: str | Path) -> Path:
 
 
 def _cached_names(cache: Path | None) -> set[str]:
-    """File names in the cache; removes temporary files of interrupted writes."""
+    """File names in the cache; removes temporary files of interrupted writes.
+
+    (The viability runner's chunk files; a study's points are in :func:`study_file`.)
+    """
     if cache is None or not cache.is_dir():
         return set()
     names = set()
