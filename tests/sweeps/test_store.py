@@ -5,8 +5,7 @@ import json
 import pandas as pd
 
 import tslip
-from tslip.sweeps import Axis, StudySpec, run_study
-from tslip.sweeps import _store
+from tslip.sweeps import Axis, StudySpec, _store, run_study
 from tslip.sweeps.run import saved_points, study_file
 
 
