@@ -16,6 +16,7 @@ import pytest
 import tslip
 from tslip.sweeps import Axis, StudySpec, run_study
 from tslip.sweeps._lock import FolderLocked, folder_lock, folder_locks
+from tslip.sweeps.run import saved_points
 
 # a 2-D study of 5 lines of 13 points: the line at the base value v0 = 5 first, then
 # two continuation chains (v0 = 4.5; v0 = 5.5, 6, 6.5) in two workers, one soon idle
@@ -70,10 +71,8 @@ def _wait_for(cond, timeout=240.0):
 
 
 def _n_cached(out: Path) -> int:
-    cache = out / "cache"
-    # not ".<key>.json.<random>.json": a write that the kill interrupted
-    return len([f for f in cache.glob("*.json") if not f.name.startswith(".")]) \
-        if cache.is_dir() else 0
+    """Points saved in the study's cache file (a line torn by the kill not counted)."""
+    return saved_points(StudySpec.from_toml(out.parent / "grid.toml"), out)
 
 
 def _wait_gone(procs, seconds=10.0):

@@ -210,7 +210,7 @@ def test_parallel_reproduction_equals_serial_bit_for_bit(serial_tiny, tmp_path):
     for name, spec in specs.items():
         assert data[name].meta["computed"] == spec.n_points
         assert data[name].meta["workers"] == 2
-        assert len(list((tmp_path / "studies" / name / "cache").glob("*.json"))) == spec.n_points
+        assert saved_points(spec, tmp_path / "studies" / name) == spec.n_points
     assert {k[2] for k in timing if k[:2] == ("figure", "E")} >= {"e2_floquet",
                                                                   "converged_floquet"}
 

@@ -43,8 +43,8 @@ from .._results import Result, with_units
 from ..model.parameters import PARAMETER_TABLE, Params
 from ..model.units import COLUMN_UNITS, param_unit
 from ..simulation.options import IntegratorOptions
-from .fixed_point import Gait, GaitProblem, find_gait
-from .problem import Fix, Section, nominal_energy
+from .fixed_point import Gait, GaitProblem, _search, find_gait
+from .problem import Fix, Section, checked_replace, nominal_energy
 from .section import apex_section_ok
 from .stability import floquet
 
@@ -110,6 +110,8 @@ def set_param(params: Params, name: str, value: float) -> Params:
     Returns
     -------
     Params
+        Only the changed value is checked (``params`` was checked when built;
+        :func:`~tslip.gait.problem.checked_replace`).
 
     Raises
     ------
@@ -123,10 +125,9 @@ def set_param(params: Params, name: str, value: float) -> Params:
         return params.with_omega_r_bar(value)
     if name.startswith("controller."):
         gain: dict[str, Any] = {name.split(".", 1)[1]: value}
-        return dataclasses.replace(params, controller=dataclasses.replace(params.controller,
-                                                                          **gain))
+        return checked_replace(params, controller=checked_replace(params.controller, **gain))
     change: dict[str, Any] = {name: value}
-    return dataclasses.replace(params, **change)
+    return checked_replace(params, **change)
 
 
 # ---------------------------------------------------------------------------
@@ -304,12 +305,12 @@ def _solve_point(
         starts.append(("neighbour", z1))
     best: Gait | None = None
     for how, z in starts:
-        g = find_gait(p, guess=z, tol=tol, options=options, **hold)
+        g = _search(prob, z, tol)
         if g.converged:
             return g, f"{g.message} (warm start: {how})"
         if best is None or g.residual < best.residual:
             best = g
-    g = find_gait(p, tol=tol, options=options, **hold)
+    g = _search(prob, None, tol)
     if g.converged or best is None or g.residual < best.residual:
         best = g
     how = "automatic guess" + (" after the warm start failed" if starts else "")

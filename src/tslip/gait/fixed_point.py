@@ -287,17 +287,17 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
     except ValueError:
         return None, math.inf
     z = z0
-    nrm = float(np.linalg.norm(r))
+    nrm = _norm(r)
     for it in range(_NEWTON_MAX_ITER + 1):
-        if not (np.all(np.isfinite(J)) and math.isfinite(nrm)):
+        if not (math.isfinite(nrm) and np.isfinite(J).all()):
             return None, math.inf
-        err = float(np.max(np.abs(r)))
+        err = max(map(abs, r.tolist()))  # r is finite here (its norm is)
+        if err <= 1e-2 * tol:  # done (the map's Jacobian at z is kept for floquet)
+            return z, err
         if err > tol and it == _NEWTON_MAX_ITER:
             return None, math.inf
         dz = np.linalg.lstsq(J, -r, rcond=None)[0]
         if err <= tol:
-            if err <= 1e-2 * tol:  # done (the map's Jacobian at z is kept for floquet)
-                return z, err
             try:  # one polishing step with the Jacobian at hand
                 rp = residual(z + dz)
             except ValueError:
@@ -316,7 +316,7 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
                     rn, Jn = fj(zn)
                 else:
                     rn, Jn = residual(zn), None
-                nn = float(np.linalg.norm(rn))
+                nn = _norm(rn)
             except ValueError:
                 nn = math.inf
             if nn <= (1.0 - 1e-4 * t) * nrm:
@@ -331,6 +331,11 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
                 return None, math.inf
         z, r, J, nrm = zn, rn, Jn, nn
     return None, math.inf  # not reached
+
+
+def _norm(r: np.ndarray) -> float:
+    """``np.linalg.norm(r)`` of a float vector, without its generality (the same bits)."""
+    return math.sqrt(float(r.dot(r)))
 
 
 # ---------------------------------------------------------------------------
@@ -398,6 +403,17 @@ def _newton_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float,
     return _make_gait(prob, z, tol, msg)
 
 
+def _search(prob: GaitProblem, guess: np.ndarray | None = None, tol: float = 1e-10) -> Gait:
+    """:func:`find_gait`'s Newton search on a problem built by the caller.
+
+    From ``guess`` (``prob.names``, the right length) or, without one, from
+    the automatic guesses; continuation builds the problem once per point.
+    """
+    if guess is None:
+        return _newton_gait(prob, prob.guesses(), tol, _MAX_STARTS)
+    return _newton_gait(prob, [guess], tol, None)
+
+
 def _cma_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float, seed: int | None,
               max_evals: int, polish: bool, jacobian: Literal["fd", "exact"]) -> Gait:
     if seed is None:
@@ -447,8 +463,10 @@ def _held_pitch_guess(prob: GaitProblem, z0: np.ndarray) -> np.ndarray:
     docs/conventions.md, "Held pitch"). The old form is accepted, with a
     ``DeprecationWarning``, until 0.5.
     """
+    if z0.ndim != 1 or z0.size == prob.size:
+        return z0
     full = ("delta", "phi", "phid", *prob.names[prob.names.index("alpha_r"):])
-    if z0.ndim != 1 or z0.size == prob.size or z0.size != len(full):
+    if z0.size != len(full):
         return z0
     held = [n for n in full if n not in prob.names]
     warnings.warn(
@@ -559,16 +577,15 @@ def find_gait(
             beta0=params.beta0 if beta0 is None else beta0,
         )
     prob = GaitProblem.from_params(params, options, fix=fix, section=section, energy=energy)
+    z0 = None
     if guess is not None:
         z0 = _held_pitch_guess(prob, np.asarray(guess, dtype=float))
         if z0.shape != (prob.size,):
             raise ValueError(f"guess must have {prob.size} entries {list(prob.names)}, "
                              f"got {z0.size}")
-        starts: Iterable[np.ndarray] = [z0]
-    else:
-        starts = prob.guesses()
     if method == "cma":
         if max_evals < 1:
             raise ValueError(f"max_evals must be >= 1, got {max_evals!r}")
+        starts = prob.guesses() if z0 is None else [z0]
         return _cma_gait(prob, starts, tol, seed, max_evals, polish, jacobian)
-    return _newton_gait(prob, starts, tol, None if guess is not None else _MAX_STARTS)
+    return _search(prob, z0, tol)

@@ -15,16 +15,17 @@ touch-down speed ``v0``, or the apex's forward speed) or the total energy
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal, TypeVar
 
 import numpy as np
 
 from .._checks import check_number
 from ..model import _pack as pk
-from ..model.controllers import ConstantTorque, LocalVelocity
+from ..model.controllers import ConstantTorque, Controller, LocalVelocity
 from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..simulation import _packed
@@ -52,6 +53,60 @@ TIGHT = IntegratorOptions.tight("dop853")
 
 _FALL_PENALTY = 10.0
 _TWO_PI = 2.0 * math.pi
+
+_T = TypeVar("_T")
+
+
+# ---------------------------------------------------------------------------
+# copies of checked parameters, checking only what changes
+# ---------------------------------------------------------------------------
+
+
+@functools.cache
+def _fields(cls: type) -> dict[str, dataclasses.Field[Any]]:
+    return {f.name: f for f in dataclasses.fields(cls)}
+
+
+def checked_replace(obj: _T, **changes: Any) -> _T:
+    """``dataclasses.replace`` of ``Params`` and controllers, checking only the changes.
+
+    Both check each numeric field on its own, by its metadata
+    (:func:`tslip._checks.check_fields`), in ``__post_init__``; the fields of
+    ``obj`` were checked when it was built. So a changed numeric field is
+    checked here exactly as ``check_fields`` checks it (the same ``ValueError``)
+    and the copy is made without checking the others again: the gait search
+    and continuation patch a few fields of parameters checked once. Any other
+    change (a choice, a controller of another type) and any other class take
+    ``dataclasses.replace``.
+    """
+    cls: Any = type(obj)
+    if cls.__post_init__ not in (Params.__post_init__, Controller.__post_init__):
+        return dataclasses.replace(obj, **changes)  # type: ignore[type-var]
+    fields = _fields(cls)
+    prefix = "" if cls is Params else f"{cls.__name__}."
+    checked = {}
+    for name, value in changes.items():
+        md = fields[name].metadata if name in fields else {}
+        if "lower" in md:
+            lo, hi = md["lower"], md.get("upper", math.inf)
+            if (type(value) is float and fields[name].type not in (int, "int")
+                    and (lo < value if md.get("lower_open") else lo <= value)
+                    and (value < hi if md.get("upper_open") else value <= hi)
+                    and math.isfinite(value)):
+                checked[name] = value  # what check_number returns for it
+                continue
+            checked[name] = check_number(  # the rest, and the error message
+                value, f"{prefix}{name}", unit=md.get("unit", ""), lower=lo, upper=hi,
+                lower_open=md.get("lower_open", False), upper_open=md.get("upper_open", False),
+                integer=fields[name].type in (int, "int"))
+        elif name == "controller" and type(value) is type(getattr(obj, name)):
+            checked[name] = value  # a controller is checked when built
+        else:
+            return dataclasses.replace(obj, **changes)  # type: ignore[type-var]
+    new = object.__new__(cls)
+    for name in fields:
+        object.__setattr__(new, name, checked[name] if name in checked else getattr(obj, name))
+    return new
 
 
 # ---------------------------------------------------------------------------
@@ -84,10 +139,13 @@ def _unknown_names(params: Params) -> tuple[str, ...]:
     return tuple(names)
 
 
-def _allowed_names() -> set[tuple[str, ...]]:
-    return {("delta", *mid, "alpha_r", *ext)
-            for mid in ((), ("phi",), ("phid",), ("phi", "phid"))
-            for ext in ((), ("alphad_ref",), ("tau_c",))}
+#: The forms ``GaitProblem.names`` may take.
+_ALLOWED_NAMES = frozenset(("delta", *mid, "alpha_r", *ext)
+                           for mid in ((), ("phi",), ("phid",), ("phi", "phid"))
+                           for ext in ((), ("alphad_ref",), ("tau_c",)))
+#: What a stride's output vector and Jacobian hold before the kernel fills them.
+_NAN_OUT = np.full(pk.NOUT, math.nan)
+_NAN_J = np.full((5, 5), math.nan)
 
 
 def nominal_energy(params: Params) -> float:
@@ -205,11 +263,12 @@ class GaitProblem:
     _O: np.ndarray = field(init=False, repr=False, compare=False)
     _ref_gain: float = field(init=False, repr=False, compare=False)
     _idx: dict[str, int] = field(init=False, repr=False, compare=False)
+    _at: tuple[int, int, int, int, int] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not self.names:
             object.__setattr__(self, "names", _unknown_names(self.params))
-        if tuple(self.names) not in _allowed_names():
+        if tuple(self.names) not in _ALLOWED_NAMES:
             raise ValueError("names must be ('delta', ['phi'], ['phid'], 'alpha_r') and at most "
                              f"one of 'alphad_ref', 'tau_c', got {self.names}")
         if self.fix not in ("speed", "energy"):
@@ -224,7 +283,11 @@ class GaitProblem:
             if not self.energy > e_min:
                 raise ValueError(f"energy must be in ({e_min:.6g}, inf) MgL (above the "
                                  f"touch-down potential at beta0), got {self.energy!r}")
-        object.__setattr__(self, "_idx", {n: i for i, n in enumerate(self.names)})
+        idx = {n: i for i, n in enumerate(self.names)}
+        object.__setattr__(self, "_idx", idx)
+        ref = self.names[-1] if self.names[-1] in ("alphad_ref", "tau_c") else ""
+        object.__setattr__(self, "_at", tuple(idx.get(n, -1) for n in (
+            "delta", "phi", "phid", "alpha_r", ref)))
         # as pack_params(decode(z)[0]) but for alpha_r and the reference, which
         # _stride writes in: tau = P[P_C0] + ..., P_C0 = Kd * alphad_ref (eq. 2.14)
         # or tau_c (eq. 2.15; 0 without damping, as in decode)
@@ -280,30 +343,34 @@ class GaitProblem:
     def exists(self, z: Sequence[float] | np.ndarray) -> bool:
         """Whether a touch-down state exists at ``z`` (the energy held can reach it)."""
         try:
-            values = self._values(z)
+            delta, phi, phid, _, _ = self._unpack(z)
         except ValueError:
             return False
-        return math.isfinite(self.speed(values["delta"], values["phi"], values["phid"]))
+        return math.isfinite(self.speed(delta, phi, phid))
 
     def _speed_gradient(self, delta: float, phi: float, phid: float, v: float
-                        ) -> dict[str, float]:
-        """``d speed / d(delta, phi, phid)`` (the names it depends on)."""
+                        ) -> list[tuple[int, float]]:
+        """``d speed / d z`` by position in ``z``: the free ones of ``(delta, phi, phid)``."""
         p = self.params
         if self.fix == "speed":
-            return {} if self.section == "touchdown" else {"delta": v * math.tan(delta)}
-        return {"phi": -p.g * p.r * math.sin(phi) / v, "phid": -p.J * phid / (p.m * v)}
+            grad = [] if self.section == "touchdown" else [(0, v * math.tan(delta))]
+        else:
+            grad = [(1, -p.g * p.r * math.sin(phi) / v), (2, -p.J * phid / (p.m * v))]
+        return [(self._at[k], g) for k, g in grad if self._at[k] >= 0]
 
-    def _values(self, z: Sequence[float] | np.ndarray) -> dict[str, float]:
-        """``z`` by name, with the held pitch (0) filled in."""
+    def _unpack(self, z: Sequence[float] | np.ndarray
+                ) -> tuple[float, float, float, float, float]:
+        """``(delta, phi, phid, alpha_r, reference)`` of ``z``; held values 0, no reference NaN."""
         if len(z) != self.size:
             raise ValueError(f"guess must have {self.size} entries {list(self.names)}, "
                              f"got {len(z)}")
-        zf = [float(v) for v in z]
+        zf = [float(v) for v in (z.tolist() if isinstance(z, np.ndarray) else z)]
         if not all(map(math.isfinite, zf)):
             raise ValueError(f"z must be finite, got {zf}")
-        values = {"phi": 0.0, "phid": 0.0}
-        values.update(zip(self.names, zf))
-        return values
+        i_delta, i_phi, i_phid, i_alpha, i_ref = self._at
+        return (zf[i_delta], zf[i_phi] if i_phi >= 0 else 0.0,
+                zf[i_phid] if i_phid >= 0 else 0.0, zf[i_alpha],
+                zf[i_ref] if i_ref >= 0 else math.nan)
 
     # -- z <-> (params, state) ------------------------------------------------
     def decode(self, z: Sequence[float] | np.ndarray) -> tuple[Params, TouchdownState]:
@@ -311,22 +378,22 @@ class GaitProblem:
 
         ``params.v0`` is the touch-down speed of ``z`` (:meth:`speed`).
         """
-        values = self._values(z)
-        v = self.speed(values["delta"], values["phi"], values["phid"])
+        delta, phi, phid, alpha_r, ref = self._unpack(z)
+        v = self.speed(delta, phi, phid)
         if not math.isfinite(v):
+            values = {"phi": 0.0, "phid": 0.0, **dict(zip(self.names, map(float, z)))}
             raise ValueError(f"no touch-down state at energy {self.energy:g} MgL with "
-                             f"{dict(values)}")
+                             f"{values}")
         ctrl = self.params.controller
-        if "alphad_ref" in values and isinstance(ctrl, LocalVelocity):  # (the name implies it)
-            ctrl = dataclasses.replace(ctrl, alphad_ref=values["alphad_ref"])
-        if "tau_c" in values and isinstance(ctrl, ConstantTorque):
-            ctrl = dataclasses.replace(ctrl, tau_c=values["tau_c"])
+        ref_name = self.names[-1]
+        if ref_name == "alphad_ref" and isinstance(ctrl, LocalVelocity):  # (the name implies it)
+            ctrl = checked_replace(ctrl, alphad_ref=ref)
+        if ref_name == "tau_c" and isinstance(ctrl, ConstantTorque):
+            ctrl = checked_replace(ctrl, tau_c=ref)
         elif isinstance(ctrl, ConstantTorque) and ctrl.tau_c != 0.0:
-            ctrl = dataclasses.replace(ctrl, tau_c=0.0)  # no damping: no torque
-        p = dataclasses.replace(self.params, alpha_r=values["alpha_r"], controller=ctrl, v0=v)
-        s = TouchdownState.from_velocity(
-            v=v, delta=values["delta"], beta=p.beta0, phi=values["phi"], phid=values["phid"]
-        )
+            ctrl = checked_replace(ctrl, tau_c=0.0)  # no damping: no torque
+        p = checked_replace(self.params, alpha_r=alpha_r, controller=ctrl, v0=v)
+        s = TouchdownState.from_velocity(v=v, delta=delta, beta=p.beta0, phi=phi, phid=phid)
         return p, s
 
     def encode(self, gait: Gait) -> np.ndarray:
@@ -341,25 +408,23 @@ class GaitProblem:
         return z
 
     # -- costs ----------------------------------------------------------------
-    def _stride(self, z: Sequence[float] | np.ndarray, jacobian: bool = False,
+    def _stride(self, x: tuple[float, float, float, float, float], jacobian: bool = False,
                 ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray | None, float]:
-        """``P``, section ``q``, one stride at ``z`` on the packed arrays, and the speed.
+        """``P``, section ``q``, a stride at ``x = _unpack(z)`` on the packed arrays, the speed.
 
         Writes ``alpha_r`` and the controller reference of ``z`` into ``P``
         exactly as :meth:`decode` followed by ``pack_params`` would. Where no
         state exists at ``z`` (energy too low) the stride is a ``NONFINITE``.
         """
-        values = self._values(z)
+        delta, phi, phid, alpha_r, ref = x
         P = self._P.copy()
-        P[pk.P_ALPHA] = values["alpha_r"]
-        ref = self.names[-1] if self.names[-1] in ("alphad_ref", "tau_c") else None
-        if ref is not None:
-            P[pk.P_C0] = self._ref_gain * values[ref]
-        delta, phi, phid = values["delta"], values["phi"], values["phid"]
+        P[pk.P_ALPHA] = alpha_r
+        if self._at[4] >= 0:
+            P[pk.P_C0] = self._ref_gain * ref
         v = self.speed(delta, phi, phid)
         q = np.array([self.params.beta0, phi, v * math.cos(delta), v * math.sin(delta), phid])
-        out = np.full(pk.NOUT, math.nan)
-        J = np.full((5, 5), math.nan) if jacobian else None
+        out = _NAN_OUT.copy()
+        J = _NAN_J.copy() if jacobian else None
         if not math.isfinite(v):
             return P, q, int(Status.NONFINITE), out, J, v
         if J is not None:
@@ -368,7 +433,7 @@ class GaitProblem:
 
     def evaluate(self, z: Sequence[float] | np.ndarray) -> tuple[np.ndarray, float, float]:
         """Residual, stance and flight time at ``z`` (see :func:`gait_residual`)."""
-        _, q, st, out, _, v = self._stride(z)
+        _, q, st, out, _, v = self._stride(self._unpack(z))
         return _section_residual(q, st, out, self.params, v)
 
     def residual_jacobian(self, z: Sequence[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -380,43 +445,37 @@ class GaitProblem:
         central difference (the reference acts in stance, outside the
         variational equations). After a fall the Jacobian is NaN.
         """
-        P, q, st, out, Jq, v = self._stride(z, jacobian=True)
+        x = self._unpack(z)
+        P, q, st, out, Jq, v = self._stride(x, jacobian=True)
         r, _, _ = _section_residual(q, st, out, self.params, v)
         n = self.size
-        if st != Status.OK or Jq is None or not np.all(np.isfinite(Jq)):
+        if st != Status.OK or Jq is None or not (Jq * 0.0).sum() == 0.0:  # a NaN or inf
             return r, np.full((5, n), math.nan)
-        values = self._values(z)
-        delta = values["delta"]
-        ix = self._idx
-        dv = {k: g for k, g in self._speed_gradient(delta, values["phi"], values["phid"],
-                                                     v).items() if k in ix}
+        delta, phi, phid, _, ref = x
+        i_delta, i_phi, i_phid, i_alpha, i_ref = self._at
+        dv = self._speed_gradient(delta, phi, phid, v)
         cd, sd = math.cos(delta), math.sin(delta)
         dq = np.zeros((5, n))  # dq/dz, q = (beta0, phi, v cos delta, v sin delta, phid)
-        dq[2, ix["delta"]], dq[3, ix["delta"]] = -v * sd, v * cd
-        for k, g in dv.items():  # the speed held by the section or the energy
-            dq[2, ix[k]] += cd * g
-            dq[3, ix[k]] += sd * g
-        if "phi" in ix:
-            dq[1, ix["phi"]] = 1.0
-        if "phid" in ix:
-            dq[4, ix["phid"]] = 1.0
+        dq[2, i_delta], dq[3, i_delta] = -v * sd, v * cd
+        for k, g in dv:  # the speed held by the section or the energy
+            dq[2, k] += cd * g
+            dq[3, k] += sd * g
+        if i_phi >= 0:
+            dq[1, i_phi] = 1.0
+        if i_phid >= 0:
+            dq[4, i_phid] = 1.0
         dqn = Jq @ dq  # dq'/dz through the state
-        dqn[:, ix["alpha_r"]] += _packed.alpha_r_column(P, out)
-        if self.names[-1] in ("alphad_ref", "tau_c"):
-            kr = n - 1
-            ref = float(z[kr])
+        dqn[:, i_alpha] += _packed.alpha_r_column(P, out)
+        if i_ref >= 0:
             h = 1e-5 * max(1.0, abs(ref))
-            cols = []
-            for sgn in (1.0, -1.0):
-                zz = np.array(z, dtype=float)
-                zz[kr] = ref + sgn * h
-                _, _, s2, o2, _, _ = self._stride(zz)
-                if s2 != Status.OK:
-                    return r, np.full((5, n), math.nan)
-                cols.append(o2[pk.OUT_TD : pk.OUT_TD + 5].copy())
-            dqn[:, kr] += (cols[0] - cols[1]) / (2.0 * h)
+            o_plus = self._stride((delta, phi, phid, x[3], ref + h))
+            o_minus = self._stride((delta, phi, phid, x[3], ref - h))
+            if o_plus[2] != Status.OK or o_minus[2] != Status.OK:
+                return r, np.full((5, n), math.nan)
+            dqn[:, i_ref] += (o_plus[3][pk.OUT_TD : pk.OUT_TD + 5]
+                              - o_minus[3][pk.OUT_TD : pk.OUT_TD + 5]) / (2.0 * h)
         # r = (beta', phi' - phi, phid' - phid, atan2(yd', xd') - delta, |v'| - v0)
-        _, _, xd, yd, _ = out[pk.OUT_TD : pk.OUT_TD + 5]
+        _, _, xd, yd, _ = out[pk.OUT_TD : pk.OUT_TD + 5].tolist()
         v2 = xd * xd + yd * yd
         v = math.sqrt(v2)
         D = np.zeros((5, 5))  # dr/dq'
@@ -424,13 +483,13 @@ class GaitProblem:
         D[3, 2], D[3, 3] = -yd / v2, xd / v2
         D[4, 2], D[4, 3] = xd / v, yd / v
         Jr = D @ dqn
-        if "phi" in ix:
-            Jr[1, ix["phi"]] -= 1.0
-        if "phid" in ix:
-            Jr[2, ix["phid"]] -= 1.0
-        Jr[3, ix["delta"]] -= 1.0
-        for k, g in dv.items():
-            Jr[4, ix[k]] -= g
+        if i_phi >= 0:
+            Jr[1, i_phi] -= 1.0
+        if i_phid >= 0:
+            Jr[2, i_phid] -= 1.0
+        Jr[3, i_delta] -= 1.0
+        for k, g in dv:
+            Jr[4, k] -= g
         return r, Jr
 
     def residual(self, z: Sequence[float] | np.ndarray) -> np.ndarray:

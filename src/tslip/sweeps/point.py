@@ -35,7 +35,6 @@ analysis, and only those.
 from __future__ import annotations
 
 import functools
-import json
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -46,8 +45,8 @@ from typing import Any
 import numpy as np
 
 from .._codehash import code_hash, module_digest
-from ..gait.continuation import _solve_point, get_param
-from ..gait.fixed_point import Gait, GaitProblem, find_gait
+from ..gait.continuation import _solve_point, get_param, set_param
+from ..gait.fixed_point import Gait, GaitProblem, _search, find_gait
 from ..gait.robustness import KINDS, robustness_report
 from ..gait.stability import floquet
 from ..gait.stride import stride_properties
@@ -107,20 +106,19 @@ def _num(x: Any) -> float:
 class _Seed:
     """A solved point as its neighbours see it: the record's unknowns.
 
-    Duck-types the two things a warm start reads from a :class:`Gait`:
-    ``state.delta/phi/phid`` and ``params`` (with the solved ``alpha_r`` and
-    controller reference).
+    Duck-types the two things a warm start (:meth:`GaitProblem.encode`) reads
+    from a :class:`Gait`: ``state.delta/phi/phid`` and, of ``params``, the
+    solved ``alpha_r`` and controller reference (``controller.alphad_ref`` or
+    ``controller.tau_c``): the record's numbers, which the gait's parameters
+    hold.
     """
 
-    def __init__(self, decode: Callable[[], Any], z: dict[str, float]) -> None:
-        self._decode = decode
+    def __init__(self, z: dict[str, float]) -> None:
         self.z = z
-        self.state = SimpleNamespace(**z)  # encode() reads gait.state.delta, phi, phid
-
-    @functools.cached_property
-    def params(self) -> Any:
-        """Decoded when first read: only the natural continuation's predictor reads it."""
-        return self._decode()
+        self.state = SimpleNamespace(**z)
+        self.params = SimpleNamespace(
+            alpha_r=z["alpha_r"],
+            controller=SimpleNamespace(alphad_ref=z["alphad_ref"], tau_c=z["tau_c"]))
 
 
 def seeds_from_records(records: Sequence[dict[str, Any] | None],
@@ -155,14 +153,11 @@ class _Line:
 
     # -- points -----------------------------------------------------------------
     def point_params(self, i: int) -> Any:
-        return self.spec.params_at({**self.assignment, self.inner: float(self.values[i])})
+        """``spec.params_at`` of point ``i``: the line's parameters with the inner value set."""
+        return set_param(self.params, self.inner, float(self.values[i]))
 
-    def seed(self, i: int, rec: dict[str, Any]) -> _Seed:
-        def decode() -> Any:
-            prob = GaitProblem.from_params(self.point_params(i))
-            return prob.decode([rec[n] for n in prob.names])[0]
-
-        return _Seed(decode, {n: _num(rec.get(n)) for n in UNKNOWNS})
+    def seed(self, rec: dict[str, Any]) -> _Seed:
+        return _Seed({n: _num(rec.get(n)) for n in UNKNOWNS})
 
     def attempt(self, i: int, solve: Callable[[], tuple[Gait, str]],
                 keep_failure: bool) -> _Seed | None:
@@ -184,17 +179,16 @@ class _Line:
             rec = self.finish(i, g, _num(g.residual), message)
         elif not (rec["converged"] and rec["_attempt"] == self.tries[i]):
             return None
-        self.gaits[i] = self.seed(i, rec)
+        self.gaits[i] = self.seed(rec)
         return self.gaits[i]
 
     def attempt_from(self, i: int, z: dict[str, float], message: str) -> bool:
         """Attempt point ``i`` from a neighbour's unknowns ``z``."""
-        p = self.point_params(i)
-        names = GaitProblem.from_params(p).names
-        guess = np.array([z.get(n, math.nan) for n in names], dtype=float)
+        prob = GaitProblem.from_params(self.point_params(i))
+        guess = np.array([z.get(n, math.nan) for n in prob.names], dtype=float)
         if not np.all(np.isfinite(guess)):
             return False
-        return self.attempt(i, lambda: (find_gait(p, guess=guess, tol=self.tol), message),
+        return self.attempt(i, lambda: (_search(prob, guess, self.tol), message),
                             keep_failure=False) is not None
 
     # -- strategies -------------------------------------------------------------
@@ -273,7 +267,7 @@ class _Line:
                                        self.spent[i]))
         self.pending[i] = Pending(i, point, g, _num(residual), message, self.tries[i],
                                   self.spent[i])
-        return json.loads(json.dumps({**point, "converged": True, **_unknowns(g)}))
+        return {**point, "converged": True, **_unknowns(g)}
 
     def record(self, item: Pending) -> dict[str, Any]:
         """Analyse one solved point and emit its record."""
@@ -344,14 +338,14 @@ def _unknowns(g: Gait) -> dict[str, float]:
 
 def analyse_point(spec: StudySpec, item: Pending, neutral_tol: float | None = None
                   ) -> dict[str, Any]:
-    """The record of one solved point (exactly what the cache holds)."""
+    """The record of one solved point (exactly what the cache holds: plain numbers and text)."""
     if neutral_tol is None:
         neutral_tol = floquet_tol(spec)
     t0 = time.perf_counter()
     rec = _analyse(spec, item.point, item.gait, item.residual, item.message, neutral_tol)
     rec["seconds"] = item.seconds + time.perf_counter() - t0
     rec["_attempt"] = item.attempt
-    return json.loads(json.dumps(rec))
+    return rec
 
 
 def _analyse(spec: StudySpec, point: dict[str, float], g: Gait | None, residual: float,
@@ -368,13 +362,14 @@ def _analyse(spec: StudySpec, point: dict[str, float], g: Gait | None, residual:
             fl = None
     rec["stability"] = fl.stability if fl is not None else ("unknown" if g is not None
                                                             else "none")
-    mags = np.sort(np.abs(fl.multipliers))[::-1] if fl is not None else np.full(5, np.nan)
+    mags = np.abs(fl.multipliers) if fl is not None else np.full(5, np.nan)
+    desc = np.sort(mags)[::-1].tolist()
     for j in range(5):
-        rec[f"abs_lambda_{j + 1}"] = _num(mags[j])
+        rec[f"abs_lambda_{j + 1}"] = desc[j]
     rec["max_nontrivial"] = _num(fl.max_nontrivial) if fl is not None else math.nan
-    rec["n_trivial"] = int(np.sum(fl.trivial)) if fl is not None else 0
-    nt = np.abs(fl.multipliers[~fl.trivial]) if fl is not None else np.array([])
-    rec["min_nontrivial"] = _num(nt.min()) if nt.size else math.nan
+    rec["n_trivial"] = int(fl.trivial.sum()) if fl is not None else 0
+    nt = mags[~fl.trivial] if fl is not None else mags[:0]
+    rec["min_nontrivial"] = float(nt.min()) if nt.size else math.nan
     rec["stance_time"] = _num(g.stance_time) if g is not None else math.nan
     rec["flight_time"] = _num(g.flight_time) if g is not None else math.nan
     if g is not None:

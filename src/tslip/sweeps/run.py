@@ -7,17 +7,19 @@ next line starts from them), and its points are analysed in chunks
 tasks and :mod:`tslip.sweeps._schedule` runs them, largest first, in worker
 processes (:mod:`tslip.sweeps._pool`; as many as the work pays for, up to
 all cores, unless ``workers`` is given), or on a Dask cluster given its
-address. Each point is written to ``cache/`` the moment it is final,
-atomically, by the process that computed it, and the progress callback
-advances with it. The cache key is a hash of everything that can change a
-point's numbers: the study's base parameters, its axes (every value: the
+address. Each point is appended to the study's file in ``cache/``
+(:mod:`tslip.sweeps._store`: one JSON line a point) the moment it is final,
+by the process that computed it, and the progress callback advances with
+it. The cache key is a hash of everything that can change a point's
+numbers: the study's base parameters, its axes (every value: the
 resolution), the point's axis values, the analyses, the gait and Floquet
 tolerances, the strides of a robustness run, and the code that computes
 them with the versions of Python and the numerical libraries
 (:func:`tslip.sweeps.point.code_version`), so
 
 * an interrupted study resumes with only the missing points, and ends
-  bit-identical to an uninterrupted run (a line replays its cached points),
+  bit-identical to an uninterrupted run (a continuation line replays its
+  cached points; a point whose record a kill tore is computed again),
 * a finished study reruns instantly,
 * changing a parameter, or the code behind an analysis, recomputes the
   points it affects and no others.
@@ -44,12 +46,12 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
-from .._io import atomic_write, git_hash, write_json, write_table
+from .._io import git_hash, write_json, write_table
 from .._results import Result, with_units
 from ..gait.continuation import get_param
 from ..gait.robustness import UNITS as ROBUSTNESS_UNITS
 from ..model.units import COLUMN_UNITS, UNIT, param_unit
-from . import _pool
+from . import _pool, _store
 from ._lock import folder_lock
 from ._schedule import Task, Timing, choose_workers, own_seconds, run_tasks
 from .point import (
@@ -69,7 +71,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 __all__ = ["StudyInterrupted", "StudyJob", "StudyResult", "run_study", "point_key",
-           "saved_points", "study_keys", "STUDY_UNITS"]
+           "saved_points", "study_file", "study_keys", "STUDY_UNITS"]
 
 Progress = Callable[[int, int], None]
 
@@ -124,8 +126,21 @@ def study_keys(spec: StudySpec) -> list[tuple[dict[str, float], list[float], lis
     return out
 
 
+def study_file(spec: StudySpec, out_dir: str | Path) -> Path:
+    """The file of the study's point records in ``out_dir/cache`` (:mod:`._store`).
+
+    Named by the hash its points' keys share (:func:`_key_prefix`), so another
+    code version, base or resolution has a file of its own.
+    """
+    name = _key_prefix(spec).hexdigest()[:24] + _store.SUFFIX
+    return Path(out_dir) / "cache" / name
+
+
 def _cached_names(cache: Path | None) -> set[str]:
-    """File names in the cache; removes temporary files of interrupted writes."""
+    """File names in the cache; removes temporary files of interrupted writes.
+
+    (The viability runner's chunk files; a study's points are in :func:`study_file`.)
+    """
     if cache is None or not cache.is_dir():
         return set()
     names = set()
@@ -139,13 +154,13 @@ def _cached_names(cache: Path | None) -> set[str]:
 
 def saved_points(spec: StudySpec, out_dir: str | Path) -> int:
     """How many of the study's points ``out_dir/cache`` holds."""
-    names = _cached_names(Path(out_dir) / "cache")
-    return sum(f"{k}.json" in names for _, _, keys in study_keys(spec) for k in keys)
+    stored = _store.read(study_file(spec, out_dir))
+    return sum(k in stored for _, _, keys in study_keys(spec) for k in keys)
 
 
-def _save(cache: Path, key: str, rec: dict[str, Any]) -> None:
-    text = json.dumps(rec)
-    atomic_write(cache / f"{key}.json", lambda tmp: Path(tmp).write_text(text))
+def _save(writer: _store.Writer, key: str, rec: dict[str, Any]) -> None:
+    """Cache one final point."""
+    writer.add(key, rec)
 
 
 def _solve_task(spec: StudySpec, assignment: dict[str, float], values: list[float],
@@ -154,13 +169,13 @@ def _solve_task(spec: StudySpec, assignment: dict[str, float], values: list[floa
                 tick: Callable[[int], None] | None = None) -> Solved:
     """Find one line's gaits; its points without a gait are cached as final (in workers)."""
     tick = tick or _pool.notify
+    with _store.Writer(cache) as writer:
 
-    def emit(i: int, rec: dict[str, Any]) -> None:
-        if cache is not None:
-            _save(Path(cache), keys[i], rec)
-        tick(1)
+        def emit(i: int, rec: dict[str, Any]) -> None:
+            _save(writer, keys[i], rec)
+            tick(1)
 
-    return solve_gaits(spec, assignment, values, seeds=seeds, cached=cached, emit=emit)
+        return solve_gaits(spec, assignment, values, seeds=seeds, cached=cached, emit=emit)
 
 
 def _analyse_task(spec: StudySpec, items: list[Pending], keys: list[str], cache: str | None,
@@ -168,12 +183,12 @@ def _analyse_task(spec: StudySpec, items: list[Pending], keys: list[str], cache:
     """Analyse solved points, caching each record as it is final (in workers)."""
     tick = tick or _pool.notify
     out = []
-    for item, key in zip(items, keys):
-        rec = analyse_point(spec, item)
-        if cache is not None:
-            _save(Path(cache), key, rec)
-        tick(1)
-        out.append(rec)
+    with _store.Writer(cache) as writer:
+        for item, key in zip(items, keys):
+            rec = analyse_point(spec, item)
+            _save(writer, key, rec)
+            tick(1)
+            out.append(rec)
     return out
 
 
@@ -251,7 +266,8 @@ def run_study(
     ----------
     spec : StudySpec
     out_dir : path, optional
-        Study folder: ``cache/`` (one JSON per point), ``results.parquet``
+        Study folder: ``cache/`` (a JSON line per point, :mod:`tslip.sweeps._store`),
+        ``results.parquet``
         (and ``results.csv`` with ``csv=True``), ``run.json`` and ``.lock``.
         Without it nothing is cached or written.
     workers : int, optional
@@ -328,27 +344,15 @@ class StudyJob:
                  writes: bool = True) -> None:
         t0 = time.perf_counter()
         self.spec, self.out, self.writes = spec, out, writes
-        self.cache = out / "cache" if out is not None else None
+        self.cache = study_file(spec, out) if out is not None else None
         self.plan = study_keys(spec)
         self.progress = progress
         self.n_total = spec.n_points
-        names = _cached_names(self.cache)
-        self.records: list[list[dict[str, Any] | None]] = []
-        n_cached = 0
-        for _, _, keys in self.plan:
-            line: list[dict[str, Any] | None] = []
-            for k in keys:
-                rec = None
-                if f"{k}.json" in names:
-                    try:
-                        rec = json.loads((self.cache / f"{k}.json").read_text())  # type: ignore[operator]
-                    except ValueError:  # unreadable: compute it again
-                        rec = None
-                line.append(rec)
-                n_cached += rec is not None
-                if progress and n_cached % 5000 == 1:
-                    progress(n_cached, self.n_total)
-            self.records.append(line)
+        # this run holds the folder's lock: a line torn by a killed run is cut off
+        stored = _store.read(self.cache, repair=True) if self.cache is not None else {}
+        self.records: list[list[dict[str, Any] | None]] = [
+            [stored.get(k) for k in keys] for _, _, keys in self.plan]
+        n_cached = sum(r is not None for line in self.records for r in line)
         self.n_cached = self.done = n_cached
         if progress:
             progress(n_cached, self.n_total)
@@ -443,8 +447,9 @@ class StudyJob:
         if self.writes:
             return
         if self.cache is not None:
-            for k, r in fresh:
-                _save(self.cache, k, r)
+            with _store.Writer(self.cache) as writer:
+                for k, r in fresh:
+                    _save(writer, k, r)
         self.tick(len(fresh))
 
     def _chunks(self, i: int, pending: list[Pending]) -> list[Task]:
