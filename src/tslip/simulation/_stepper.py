@@ -1,23 +1,36 @@
 """The stance integrator's steps: the :mod:`._rk` stage loop with the stance ``rhs``, events.
 
-Private (see :mod:`._kernels`). Small ``inline="always"`` functions taking the
-Runge-Kutta pair ``method`` as an argument: the stride kernels
-(:func:`._stride._make_stride`, which hold the step-size and event loop) pass it
-as a compile-time constant, so each compiled stride holds one method's stage loop.
-The two called once a stride or so, :func:`initial_step` and :func:`event_root`,
-compile on their own instead (``method`` a run-time argument; the same
-arithmetic): numba's type inference of the stride's body, most of a cold
-start, shrinks by their copies.
+Private (see :mod:`._kernels`). The stride kernel (:func:`._stride._make_stride`)
+is the loop; its named steps are here, in the order a step takes them:
+
+* :func:`rk_step`: one Runge-Kutta step (the stages, FSAL);
+* :func:`shrink_step` / :func:`grow_step`: error control, the next step size
+  after a rejected / an accepted step;
+* :func:`crossed`: event detection, a sign change of an event function
+  (thesis Section 2.3) over the accepted step;
+* :func:`dense_output`: the continuous extension of that step;
+* :func:`first_event`: event location, the earliest root on the dense output;
+* :func:`record_row`, :func:`append_row`, :func:`record_grid`: the stance record.
+
+The per-step functions are small and ``inline="always"``, taking the
+Runge-Kutta pair ``method`` as an argument: the stride passes it as a
+compile-time constant, so each compiled stride holds one method's stage loop.
+Those called once a stride or so (:func:`initial_step`, :func:`first_event`)
+or only when recording (:func:`append_row`, :func:`record_grid`) compile on
+their own instead (``method`` a run-time argument; the same arithmetic): numba's type
+inference of the stride's body, most of a cold start, shrinks by their copies.
 """
 
 from __future__ import annotations
+
+import math
 
 from numba import njit
 
 from .._kernel_cache import check as _check_cache
 from . import _rk
 from ._rk import _INLINE, _JIT
-from ._stance import NSTATE, event_values, grf, rhs
+from ._stance import NEVENTS, NSTATE, event_values, grf, rhs
 
 
 @njit(**_INLINE)
@@ -55,7 +68,7 @@ def initial_step(P, method, y, f0, rtol, atol, ytmp, f1):
     return _rk.initial_step(method, y, f0, f1, h0, d1, rtol, atol)
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def event_root(P, method, R, ev, g_lo, g_hi, ytmp, gv, st):
     """Root in theta of event ``ev`` on the dense output (Illinois method)."""
     _rk.root_start_inline(st, g_lo, g_hi)
@@ -68,11 +81,59 @@ def event_root(P, method, R, ev, g_lo, g_hi, ytmp, gv, st):
     return st[1]  # the earliest theta known to be at or past the crossing
 
 
+@njit(**_INLINE)
+def shrink_step(method, h, err):
+    """The step size after a rejected step (error ``err`` > 1 or not finite): a NaN or
+    infinite stage shrinks it tenfold, else :func:`._rk.step_factor`."""
+    if not math.isfinite(err):
+        return h * 0.1
+    return h * _rk.step_factor(method, err, 10.0)
+
+
+@njit(**_INLINE)
+def grow_step(method, h, err, last_rejected):
+    """The step size after an accepted step; it does not grow right after a rejection."""
+    fac = _rk.step_factor(method, err, 10.0)
+    if last_rejected:
+        fac = min(1.0, fac)
+    return h * fac
+
+
+@njit(**_INLINE)
+def crossed(gv_old, gv_new):
+    """Whether an event function went from > 0 to <= 0 over the step (events fire so)."""
+    for ev in range(NEVENTS):
+        if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
+            return True
+    return False
+
+
+@njit(**_JIT)
+def first_event(P, method, R, gv_old, gv_new, ytmp, gv_tmp, st):
+    """The earliest event in the step with dense output ``R``: ``(theta, ev)``.
+
+    ``theta`` is the fraction of the step at which event ``ev`` fires, ``(2.0, -1)``
+    if none does. Falls are searched first and lift-off wins only if strictly
+    earlier (``F_y = F_l sin(beta)`` and the hip height ``l sin(beta)`` vanish
+    together when ``beta`` reaches 0).
+    """
+    theta_ev = 2.0
+    first = -1
+    for j in range(NEVENTS):
+        ev = (1, 3, 2, 0)[j]
+        if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
+            theta = event_root(P, method, R, ev, gv_old[ev], gv_new[ev], ytmp, gv_tmp, st)
+            if theta < theta_ev - 1e-9:
+                theta_ev = theta
+                first = ev
+    return theta_ev, first
+
+
 @njit(**_JIT)
 def record_row(P, rec, row, t, y):
     """Stance record row ``row``: ``t, y, F_x, F_y, tau``.
 
-    Compiled on its own, not inlined: a recording stride writes rows from four places.
+    Compiled on its own, not inlined: :func:`append_row` and :func:`record_grid` call it.
     """
     rec[row, 0] = t
     for i in range(NSTATE):
@@ -81,6 +142,29 @@ def record_row(P, rec, row, t, y):
     rec[row, 7] = fx
     rec[row, 8] = fy
     rec[row, 9] = tau
+
+
+@njit(**_JIT)
+def append_row(P, rec, row, t, y):
+    """Record row ``row`` if ``rec`` has room: ``(rows used, 1.0 if it had none else 0.0)``."""
+    if row < rec.shape[0]:
+        record_row(P, rec, row, t, y)
+        return row + 1, 0.0
+    return row, 1.0
+
+
+@njit(**_JIT)
+def record_grid(P, method, R, rec, row, t, h, t_stop, t_next, dt, ytmp):
+    """Record the grid times ``t_next, t_next + dt, ...`` up to ``t_stop`` of the step
+    ``[t, t + h]`` from its dense output ``R``: ``(rows used, next grid time, overflow)``."""
+    while t_next <= t_stop:
+        if row >= rec.shape[0]:
+            return row, t_next, 1.0
+        _rk.dense_eval_inline(method, R, (t_next - t) / h, ytmp)
+        record_row(P, rec, row, t_next, ytmp)
+        row += 1
+        t_next += dt
+    return row, t_next, 0.0
 
 
 # numba does not notice when a kernel called from another file changes; drop

@@ -1,13 +1,15 @@
 """Compiled strides (touch-down -> lift-off -> touch-down), one kernel per integrator method.
 
 Private (see :mod:`._kernels`). One kernel holds a whole stride: the stance's
-step-size and event loop (its steps from :mod:`._stepper`), the lift-off state
-and the closed-form flight. The Runge-Kutta pair is a compile-time constant of
-each copy (:mod:`._specialise`), and only what a call uses compiles: a first
+step-size and event loop (its named steps from :mod:`._stepper` and below:
+Runge-Kutta step, error control, event detection, dense output, event location,
+following the thesis's Section 2.3), the lift-off state and the closed-form
+flight. The Runge-Kutta pair is a compile-time constant of each copy
+(:mod:`._specialise`), and only what a call uses compiles: a first
 :func:`tslip.step_map` compiles one stride kernel and the functions it calls
 (:func:`._stance.rhs`, :func:`._stance.event_values`,
 :func:`._flight.find_touchdown`, and, called once a stride, :func:`stride_finish`,
-:func:`._stepper.initial_step` and :func:`._stepper.event_root`), against 36
+:func:`._stepper.initial_step` and :func:`._stepper.first_event`), against 36
 when every helper was a kernel of its own and the method a run-time argument.
 Those three compile on their own because numba types every inlined copy with
 the body it lands in: inlined, a cold first step_map took 18.4-18.7 s, not 16.5-17.1 s.
@@ -76,7 +78,17 @@ from ._stance import (
     rhs,
     stance_initial,
 )
-from ._stepper import dense_output, event_root, initial_step, record_row, rk_step
+from ._stepper import (
+    append_row,
+    crossed,
+    dense_output,
+    first_event,
+    grow_step,
+    initial_step,
+    record_grid,
+    rk_step,
+    shrink_step,
+)
 
 #: numba's options for the ``prange`` batch kernels (compiled only when first used)
 _PAR = dict(_JIT, parallel=True)
@@ -158,6 +170,104 @@ def stride_finish(P, O, status, td, xf, y1, stats, tx, th, out):
     return ST_OK
 
 
+@njit(**_INLINE)
+def touchdown_fall(gv, y):
+    """The fall a stance starts in (``gv`` its event values, ``y`` its state), else ``ST_OK``:
+    the hip at the ground, moving backward, or the leg lengthening (``ld > 0``: the
+    spring would stretch past ``l0`` and pull on the ground; docs/conventions.md, "Events")."""
+    if gv[1] <= 0.0:
+        return ST_FALL_HIP_GROUND
+    if gv[2] < 0.0:
+        return ST_FALL_BACKWARD
+    if y[3] > 0.0:
+        return ST_FALL_LENGTHENING
+    return ST_OK
+
+
+@njit(**_INLINE)
+def step_guard(O, n_steps, t, h):
+    """``ST_OK`` if the stance may take another step, else the error that stops it."""
+    if n_steps >= int(O[O_MAXSTEPS]):
+        return ST_ERR_MAX_STEPS
+    if t >= O[O_TMAX_STANCE]:
+        return ST_ERR_STANCE_TIMEOUT
+    if h < O[O_HMIN]:
+        return ST_ERR_STEP_UNDERFLOW
+    return ST_OK
+
+
+@njit(**_INLINE)
+def event_status(ev):
+    """How a stance ends at event ``ev`` (:func:`._stance.event_values`): lift-off
+    (eq. 2.8) is ``ST_OK``; the hip at the ground (eq. 2.11, or the leg collapsed)
+    and moving backward (eq. 2.10) are falls."""
+    if ev == 0:
+        return ST_OK
+    if ev == 1 or ev == 3:
+        return ST_FALL_HIP_GROUND
+    return ST_FALL_BACKWARD
+
+
+@njit(**_INLINE)
+def stance_out(y, stats, out):
+    """``out`` of a stance alone: the final state, then ``stats``."""
+    for i in range(NSTATE):
+        out[i] = y[i]
+    for i in range(5):
+        out[NSTATE + i] = stats[i]
+
+
+@njit(**_INLINE)
+def record_start(P, rec, rec_dt, y):
+    """How a stance is recorded into ``rec``, and its first row: ``(on a grid, at each
+    step, rows used, overflow)`` (no recording if ``rec`` has no rows)."""
+    if rec.shape[0] == 0:
+        return False, False, 0, 0.0
+    nrec, overflow = append_row(P, rec, 0, 0.0, y)
+    return rec_dt > 0.0, rec_dt <= 0.0, nrec, overflow
+
+
+@njit(**_INLINE)
+def stance_begin(P, O, method, y, K, gv, ytmp):
+    """The stance's start at ``y``: ``(status, h)``, its event values into ``gv``,
+    ``K[0] = f(y)``; ``status`` from :func:`touchdown_fall`, ``h`` the first step
+    (``O_H0``, or estimated if that is 0 and the stance goes on)."""
+    event_values(P, y, gv)
+    rhs(P, y, K[0])
+    status = touchdown_fall(gv, y)
+    h = O[O_H0]
+    if h <= 0.0 and status == ST_OK:
+        h = initial_step(P, method, y, K[0], O[O_RTOL], O[O_ATOL], ytmp, K[1])
+    return status, h
+
+
+@njit(**_INLINE)
+def advance(method, y, ynew, K, gv_old, gv_new):
+    """Move on to the accepted step's end: ``y``, its ``f`` (FSAL) and event values."""
+    ns = _rk.n_stages(method)
+    for i in range(NSTATE):
+        y[i] = ynew[i]
+        K[0, i] = K[ns, i]
+    for i in range(NEVENTS):
+        gv_old[i] = gv_new[i]
+
+
+@njit(**_INLINE)
+def copy_state(y, src):
+    """``y[:] = src[:NSTATE]`` (a loop: a slice assignment costs numba more to compile)."""
+    for i in range(NSTATE):
+        y[i] = src[i]
+
+
+@njit(**_INLINE)
+def finite(y):
+    """Whether every component of the state ``y`` is finite."""
+    for i in range(NSTATE):
+        if not math.isfinite(y[i]):
+            return False
+    return True
+
+
 def _make_stride(method: int, fly: bool = True) -> Callable:
     def stride(P, O, td, tx, th, rec, rec_dt, out):
         """One stride from the touch-down state ``td`` (7) to the next, with the pair ``method``.
@@ -166,192 +276,107 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         Without ``fly``, the stance alone from the stance state ``td`` (6): ``out``
         receives the final state and ``stats`` (below), and nothing else runs.
 
-        The stance: a stance that starts with the hip at the ground, ``xdot_m < 0``
-        or the leg lengthening (``ld > 0``: a spring leg cannot pull) ends at once
-        with that fall (docs/conventions.md, "Events"). If it has rows, ``rec``
-        (rows x NREC) receives ``t, y, F_x, F_y, tau``: at each accepted step if
-        ``rec_dt <= 0``, else on a uniform grid of spacing ``rec_dt`` from the dense
-        output; without, ``rec`` and ``rec_dt`` are not read. ``stats`` =
-        ``[t_end, n_accepted, n_rejected, n_recorded, overflow]``.
+        The stance (thesis Section 2.3): a stance that starts with the hip at the
+        ground, ``xdot_m < 0`` or the leg lengthening ends at once with that fall
+        (:func:`touchdown_fall`). Otherwise each pass of the loop takes one
+        Runge-Kutta step and either rejects it (error control: a smaller step) or
+        accepts it, looks for the sign changes of the event functions over it
+        (lift-off, eq. 2.8; falls, eqs 2.10-2.11), locates the earliest on the
+        step's dense output, and then ends the stance with one exact step to that
+        event (a full-order event state), or moves on to the next step.
+
+        If it has rows, ``rec`` (rows x NREC) receives ``t, y, F_x, F_y, tau``: at
+        each accepted step if ``rec_dt <= 0``, else on a uniform grid of spacing
+        ``rec_dt`` from the dense output; without, ``rec`` and ``rec_dt`` are not
+        read. ``stats`` = ``[t_end, n_accepted, n_rejected, n_recorded, overflow]``.
         """
-        y0 = np.empty(NSTATE)
-        yout = np.empty(NSTATE)
-        stats = np.empty(5)
+        y = np.empty(NSTATE)
         if fly:
-            xf = stride_start(P, td, y0, out)
+            xf = stride_start(P, td, y, out)
         else:
             xf = 0.0
-            for i in range(NSTATE):
-                y0[i] = td[i]
+            copy_state(y, td)
         rtol = O[O_RTOL]
         atol = O[O_ATOL]
-        max_steps = int(O[O_MAXSTEPS])
-        t_max = O[O_TMAX_STANCE]
-        h_min = O[O_HMIN]
-        ns = _rk.n_stages(method)
         K = np.empty((_rk.NK, NSTATE))
         R = np.empty((_rk.NR, NSTATE))
         st = np.empty(5)
-        y = np.empty(NSTATE)
         ynew = np.empty(NSTATE)
         ytmp = np.empty(NSTATE)
         gv_old = np.empty(NEVENTS)
         gv_new = np.empty(NEVENTS)
         gv_tmp = np.empty(NEVENTS)
-        for i in range(NSTATE):
-            y[i] = y0[i]
-        nrec_max = rec.shape[0]
-        nrec = 0
-        overflow = 0.0
+        on_grid, at_steps, nrec, overflow = record_start(P, rec, rec_dt, y)
         t = 0.0
-        event_values(P, y, gv_old)
-        status = ST_OK
-        rhs(P, y, K[0])
-        # record the first row
-        if nrec_max > 0:
-            record_row(P, rec, nrec, t, y)
-            nrec += 1
         t_next_rec = rec_dt
-        # fallen already at touch-down: hip at the ground, moving backward, or the leg
-        # lengthening (ld > 0: the spring would stretch past l0 and pull on the ground,
-        # docs/conventions.md "Events")
-        fallen = gv_old[1] <= 0.0 or gv_old[2] < 0.0 or y[3] > 0.0
-        if fallen:
-            if gv_old[1] <= 0.0:
-                status = ST_FALL_HIP_GROUND
-            elif gv_old[2] < 0.0:
-                status = ST_FALL_BACKWARD
-            else:
-                status = ST_FALL_LENGTHENING
-        h = O[O_H0]
-        if h <= 0.0 and not fallen:
-            h = initial_step(P, method, y, K[0], rtol, atol, ytmp, K[1])
+        status, h = stance_begin(P, O, method, y, K, gv_old, ytmp)
         n_acc = 0
         n_rej = 0
         last_rejected = False
-        done = fallen
-        # a step that finds an event is followed by one exact step to the event time
-        # (the next pass of the loop), for a full-order event state
-        to_event = False
-        first_ev = -1
-        h_ev = 0.0
-        while not done:
-            if not to_event:
-                if n_acc + n_rej >= max_steps:
-                    status = ST_ERR_MAX_STEPS
+        ev = -1  # the first event of the last accepted step, once located
+        ended = status != ST_OK
+        while not ended:
+            if ev < 0:
+                status = step_guard(O, n_acc + n_rej, t, h)
+                if status != ST_OK:
                     break
-                if t >= t_max:
-                    status = ST_ERR_STANCE_TIMEOUT
-                    break
-                if h < h_min:
-                    status = ST_ERR_STEP_UNDERFLOW
-                    break
-            if not to_event or h_ev > 0.0:
-                rk_step(P, method, y, h_ev if to_event else h, K, ytmp, ynew)
+            if ev < 0 or h > 0.0:
+                # one Runge-Kutta step (the one loop holds the stage arithmetic once)
+                rk_step(P, method, y, h, K, ytmp, ynew)
+            if ev >= 0:
+                # that was the exact step to the event: the stance ends
+                t += h
+                if h > 0.0:
+                    copy_state(y, ynew)
+                status = event_status(ev)
+                ended = True
             else:
-                for i in range(NSTATE):
-                    ynew[i] = y[i]
-            if to_event:
-                t += h_ev
-                for i in range(NSTATE):
-                    y[i] = ynew[i]
-                if first_ev == 0:
-                    status = ST_OK
-                elif first_ev == 1 or first_ev == 3:
-                    status = ST_FALL_HIP_GROUND
-                else:
-                    status = ST_FALL_BACKWARD
-                done = True
-            else:
+                # error control
                 err = _rk.error_norm(method, NSTATE, y, ynew, h, K, rtol, atol)
-                if not math.isfinite(err):
-                    # a NaN/inf stage: shrink hard, give up below h_min
-                    h *= 0.1
+                if not err <= 1.0:
+                    h = shrink_step(method, h, err)
                     n_rej += 1
                     last_rejected = True
                     continue
-                if err > 1.0:
-                    h *= _rk.step_factor(method, err, 10.0)
-                    n_rej += 1
-                    last_rejected = True
-                    continue
-                # accepted step: look for events, on the dense output (also the grid samples')
                 n_acc += 1
+                # event detection, dense output, event location (and grid samples)
                 event_values(P, ynew, gv_new)
-                dense = False
-                if rec_dt > 0.0 and nrec_max > 0:
-                    dense = True
-                for ev in range(NEVENTS):
-                    if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
-                        dense = True
-                if dense:
+                event = crossed(gv_old, gv_new)
+                if event or on_grid:
                     dense_output(P, method, y, ynew, h, K, R, ytmp)
-                theta_ev = 2.0
-                # falls first: lift-off wins only if strictly earlier (F_y = F_l sin(beta)
-                # and the hip height l sin(beta) vanish together when beta reaches 0)
-                for j in range(NEVENTS):
-                    ev = (1, 3, 2, 0)[j]
-                    if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
-                        theta = event_root(P, method, R, ev, gv_old[ev], gv_new[ev], ytmp,
-                                           gv_tmp, st)
-                        if theta < theta_ev - 1e-9:
-                            theta_ev = theta
-                            first_ev = ev
-                if rec_dt > 0.0 and nrec_max > 0:
-                    t_stop = t + h * min(theta_ev, 1.0)
-                    while t_next_rec <= t_stop:
-                        if nrec >= nrec_max:
-                            overflow = 1.0
-                            break
-                        _rk.dense_eval_inline(method, R, (t_next_rec - t) / h, ytmp)
-                        record_row(P, rec, nrec, t_next_rec, ytmp)
-                        nrec += 1
-                        t_next_rec += rec_dt
-                if first_ev >= 0:
-                    h_ev = theta_ev * h
-                    to_event = True
+                theta_ev, ev = (first_event(P, method, R, gv_old, gv_new, ytmp, gv_tmp, st)
+                                if event else (2.0, -1))
+                if on_grid:
+                    nrec, t_next_rec, ovf = record_grid(P, method, R, rec, nrec, t, h,
+                                                        t + h * min(theta_ev, 1.0),
+                                                        t_next_rec, rec_dt, ytmp)
+                    overflow = max(overflow, ovf)
+                if ev >= 0:
+                    h *= theta_ev  # the next pass steps to the event
                     continue
                 t += h
-                for i in range(NSTATE):
-                    y[i] = ynew[i]
-                    K[0, i] = K[ns, i]  # FSAL
-                for i in range(NEVENTS):
-                    gv_old[i] = gv_new[i]
-                fac = _rk.step_factor(method, err, 10.0)
-                if last_rejected:
-                    fac = min(1.0, fac)
-                h *= fac
+                advance(method, y, ynew, K, gv_old, gv_new)
+                h = grow_step(method, h, err, last_rejected)
                 last_rejected = False
-            for i in range(NSTATE):
-                if not math.isfinite(y[i]):
-                    status = ST_ERR_NONFINITE
-                    done = True
-            if rec_dt <= 0.0 and nrec_max > 0:
-                if nrec < nrec_max:
-                    record_row(P, rec, nrec, t, y)
-                    nrec += 1
-                else:
-                    overflow = 1.0
-        if rec_dt > 0.0 and nrec_max > 0 and status == ST_OK:
+            if not finite(y):
+                status = ST_ERR_NONFINITE
+                ended = True
+            if at_steps:
+                nrec, ovf = append_row(P, rec, nrec, t, y)
+                overflow = max(overflow, ovf)
+        if on_grid and status == ST_OK:
             # always close the record with the lift-off row
-            if nrec < nrec_max:
-                record_row(P, rec, nrec, t, y)
-                nrec += 1
-            else:
-                overflow = 1.0
-        for i in range(NSTATE):
-            yout[i] = y[i]
+            nrec, ovf = append_row(P, rec, nrec, t, y)
+            overflow = max(overflow, ovf)
+        stats = np.empty(5)
         stats[0] = t
         stats[1] = n_acc
         stats[2] = n_rej
         stats[3] = nrec
         stats[4] = overflow
         if fly:
-            return stride_finish(P, O, status, td, xf, yout, stats, tx, th, out)
-        for i in range(NSTATE):
-            out[i] = yout[i]
-        for i in range(5):
-            out[NSTATE + i] = stats[i]
+            return stride_finish(P, O, status, td, xf, y, stats, tx, th, out)
+        stance_out(y, stats, out)
         return status
 
     return stride
