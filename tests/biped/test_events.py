@@ -180,3 +180,29 @@ def test_method_field():
         BipedOptions(method="rk4")
     with pytest.raises(ValueError, match="BipedOptions.max_steps"):
         BipedOptions(max_steps=2.5)
+
+
+def test_a_touch_down_anchors_the_foot_on_the_ground_and_a_lift_off_releases_it():
+    """The contact switch of the stride loop (eqs E.23-E.24: displacements from the
+    touch-down position, ``z_f,TD = 0`` on the ground); the foot's ``x_f`` is eq. E.8
+    written out here."""
+    p = BipedParams()
+    P = pk.pack_params(p)
+    y = BipedState.thesis().to_array()
+    trig = np.empty(6)
+    kn.state_trig(y, trig)
+    for leg in range(2):
+        gam = y[2] + y[5 + 3 * leg]
+        x = y[0] + p.r_1 * np.sin(y[2]) - (y[3 + 3 * leg] + y[4 + 3 * leg]) * np.sin(gam)
+        z, _ = foot(p, y, leg)
+        cs = np.array([0.0, 0.0, 7.0, 7.0, 7.0, 7.0])
+        kind, xf, zf = kn.contact_switch(P, y, cs, leg, trig)
+        assert kind == pk.EV_TD_R + leg
+        assert (xf, zf) == pytest.approx((x, z), abs=1e-14)
+        assert cs[pk.CS_ON_R + leg] == 1.0 and cs[pk.CS_ON_R + 1 - leg] == 0.0
+        assert cs[pk.CS_XR + 2 * leg] == pytest.approx(x, abs=1e-14)
+        assert cs[pk.CS_ZR + 2 * leg] == 0.0
+        assert cs[pk.CS_XR + 2 - 2 * leg] == 7.0  # the other leg's anchor untouched
+        kind, _, _ = kn.contact_switch(P, y, cs, leg, trig)
+        assert kind == pk.EV_LO_R + leg
+        assert cs[pk.CS_ON_R + leg] == 0.0

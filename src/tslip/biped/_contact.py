@@ -11,7 +11,19 @@ from numba import njit
 
 from .._kernel_cache import check as _check_cache
 from ._jit import FAST, INLINE
-from ._pack import CS_ON_R, CS_XR, CS_ZR, P_CONTACT, P_CX, P_CZ, P_KX, P_KZ, P_R1
+from ._pack import (
+    CS_ON_R,
+    CS_XR,
+    CS_ZR,
+    EV_LO_R,
+    EV_TD_R,
+    P_CONTACT,
+    P_CX,
+    P_CZ,
+    P_KX,
+    P_KZ,
+    P_R1,
+)
 
 
 @njit(**INLINE)
@@ -75,6 +87,25 @@ def contact_law(P, foot, cs, leg, clamp):
     if not clamp or (fz > 0.0 and z <= zt):
         return P[P_KX] * (xt - x) - P[P_CX] * xd, fz, fz
     return 0.0, 0.0, fz
+
+
+@njit(**INLINE)
+def contact_switch(P, y, cs, leg, trig):
+    """Touch-down or lift-off of a leg at its located event: ``(kind, x_f, z_f)``.
+
+    A foot in flight touches down: the contact starts, anchored at the foot's
+    ``x_f`` on the ground (``x_f,TD`` and ``z_f,TD = 0`` of eqs E.23-E.24); a
+    foot in contact lifts off. ``kind`` is ``EV_TD_R + leg`` or ``EV_LO_R + leg``;
+    ``trig`` holds the sines and cosines of ``y`` (:func:`foot_state_of`).
+    """
+    x, z, _, _ = foot_state_of(P, y, leg, trig)
+    if cs[CS_ON_R + leg] == 0.0:
+        cs[CS_ON_R + leg] = 1.0
+        cs[CS_XR + 2 * leg] = x
+        cs[CS_ZR + 2 * leg] = 0.0
+        return EV_TD_R + leg, x, z
+    cs[CS_ON_R + leg] = 0.0
+    return EV_LO_R + leg, x, z
 
 
 @njit(**FAST)

@@ -20,6 +20,7 @@ from ._contact import (
     contact_force,
     contact_force_trig,
     contact_law,
+    contact_switch,
     foot_state,
     foot_state_of,
     foot_state_trig,
@@ -67,8 +68,8 @@ from ._tmt import (
 __all__ = [
     "FOOT", "K_CTL", "K_FALL", "N", "NB", "NBLK", "NEVK", "NRC", "PHASE_EPS", "actuation",
     "block_solve", "body_props", "contact_force", "contact_force_trig", "contact_law",
-    "ctl_phase", "ctl_switch", "ctl_switch_time", "dense_output", "energy", "event_g",
-    "event_value", "event_value_trig", "fall_check", "fall_value", "foot_state",
+    "contact_switch", "ctl_phase", "ctl_switch", "ctl_switch_time", "dense_output", "energy",
+    "event_g", "event_value", "event_value_trig", "fall_check", "fall_value", "foot_state",
     "foot_state_of", "foot_state_trig", "init_contact", "init_ctl", "kinematics", "leg_phase",
     "make_kin_workspace", "make_work", "make_workspace", "mass_matrix_and_bias", "references",
     "references_at", "references_branch", "rhs", "rk_step", "run", "state_trig", "tmt_blocks",

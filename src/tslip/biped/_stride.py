@@ -6,21 +6,47 @@ finding); only its stage loop is written here, with this model's right-hand
 side (the core cannot take the right-hand side as an argument and stay
 cacheable, see there).
 
-The right-hand side is smooth between discontinuities, which are events (see
-:mod:`._control`): after each accepted step the switching functions of
-:func:`._events.event_g` are checked for a crossing, the earliest crossing is
-located on the dense output (Illinois, to 1e-13 in time), the state there is
-taken, every event that occurs there is applied and the integration
-restarts. A fall is an event too: the run stops where the first fall margin
-of :func:`._events.fall_value` reaches zero.
+The right-hand side (eq. E.22) is smooth between discontinuities, which are
+events (see :mod:`._control`): a foot touches down or lifts off (eqs
+E.23-E.24), a leg's controller switches branch (eqs E.25-E.34), or the
+runner falls. The loop :func:`_integrate` is a few named steps, each a
+function below, in the order a step takes them (thesis Section 2.3 and
+E.2.5: an embedded Dormand-Prince pair at a tolerance of 1e-8, the right
+touch-down a switching condition that ends the stride):
+
+1. :func:`rk_step`: one Runge-Kutta step ``t -> t + h`` (its last stage the
+   next step's first, FSAL);
+2. :func:`_step_error`, :func:`_rejected`: error control; a rejected step is
+   retried shorter, an accepted one sets the next step size (Hairer's
+   controller, :func:`tslip.simulation._rk.step_factor`);
+3. :func:`_first_event`: event detection, a crossing of a switching function
+   of :func:`._events.event_g` from > 0 to <= 0 between the step's ends;
+4. :func:`_locate`: event location of each crossing on the dense output
+   (:func:`dense_output`; Illinois, to 1e-13 in time), the earliest one wins;
+5. :func:`_event_state`, :func:`_apply_events`, :func:`_restart`: the
+   integration stops at the event, every event that occurs there is applied
+   (contact :func:`._contact.contact_switch`, controller
+   :func:`._control.ctl_switch`, fall) and it restarts in the new discrete
+   state; :func:`_advance` moves to the step's end when there is none;
+6. :func:`_record`, :func:`_run_status`: a row of the trajectory, then the
+   checks that end a run (a fall: the first fall margin of
+   :func:`._events.fall_value` to reach zero; the time limits).
 
 Speed (``benchmarks/bench_biped.py``): the loop and everything it calls are
 compiled without numba's reference counting (:mod:`tslip._nrt`), so
 :func:`run` allocates every work array and passes it in; the loop is
 compiled once per Runge-Kutta pair (:func:`_integrate_dopri5`,
 :func:`_integrate_dop853`), only for the pair a run uses, so that the
-tableau is a constant; the switching functions at the end of a step read the
-sines and cosines the right-hand side has just computed there.
+tableau is a constant (numba types the pair's code as a literal and compiles
+each function that takes it once per pair); the switching functions at the
+end of a step read the sines and cosines the right-hand side has just
+computed there. The steps are ``inline="always"`` into the loop, each with
+one call site, so the loop compiles as one function, as it did when it was
+one body: each function compiled on its own costs a first run some 0.5 s
+of compilation (its own module, optimised again with everything it calls),
+and only :func:`rhs` (eq. E.22, called from every stage) and :func:`_record`
+(only when recording) are. Inlining :func:`rhs` too would make a stride
+faster but compile for over twice as long (see :func:`rk_step`).
 """
 
 from __future__ import annotations
@@ -33,17 +59,14 @@ from numba import njit
 from .._kernel_cache import check as _check_cache
 from ..model._pack import M_DOP853, M_DOPRI5
 from ..simulation import _rk
-from ._contact import contact_force_trig, foot_state_of
+from ._contact import contact_force_trig, contact_switch
 from ._control import actuation, ctl_switch, ctl_switch_time, init_ctl
 from ._events import K_CTL, K_FALL, NEVK, event_g, fall_check_trig, fall_value_trig, state_trig
 from ._jit import FAST, INLINE, N
 from ._pack import (
     CS_ON_L,
     CS_ON_R,
-    CS_XR,
-    CS_ZR,
     EV_FALL,
-    EV_LO_R,
     EV_TD_R,
     NCS,
     O_ATOL,
@@ -98,7 +121,7 @@ def rk_step(P, method, t, y, h, K, ytmp, ynew, cs, ctl, ws, aux):
         rhs(P, ts, ys, cs, ctl, False, K[s], ws, aux)
 
 
-@njit(**FAST)
+@njit(**INLINE)
 def dense_output(P, method, t, y, ynew, h, K, R, ytmp, cs, ctl, ws, aux):
     """Continuous extension of the step just taken; returns the extra rhs calls."""
     ns = _rk.n_stages(method)
@@ -108,26 +131,6 @@ def dense_output(P, method, t, y, ynew, h, K, R, ytmp, cs, ctl, ws, aux):
         rhs(P, t + _rk.stage_c(method, s) * h, ytmp, cs, ctl, False, K[s], ws, aux)
     _rk.dense_coeffs(method, y, ynew, h, K, R)
     return ne
-
-
-@njit(**FAST)
-def _record(P, rec, row, t, y, cs, ctl, ws):
-    """Row ``row`` of ``rec``; ``ws`` holds the right-hand side at ``(t, y)``."""
-    trig = ws[5]
-    rc = ws[6]
-    rec[row, 0] = t
-    for i in range(N):
-        rec[row, R_Y + i] = y[i]
-    rec[row, R_CON] = cs[CS_ON_R]
-    rec[row, R_CON + 1] = cs[CS_ON_L]
-    for leg in range(2):
-        fx, fz, _ = contact_force_trig(P, y, cs, leg, True, trig)
-        ft, fs, tau = actuation(P, t, y, ctl, leg, rc)
-        rec[row, R_F + 2 * leg] = fx
-        rec[row, R_F + 2 * leg + 1] = fz
-        rec[row, R_TAU + leg] = tau
-        rec[row, R_FT + leg] = ft
-        rec[row, R_FS + leg] = fs
 
 
 def make_work():
@@ -157,19 +160,20 @@ def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
                 make_work())
 
 
+# ---------------------------------------------------------------------------
+# The steps of the loop, in the order a step takes them (module docstring)
+# ---------------------------------------------------------------------------
+
+
 @njit(**INLINE)
-def _integrate(method, P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend, stats, work):
-    """The loop of :func:`run` with the Runge-Kutta pair ``method`` (a constant);
-    integrates ``y`` and ``cs`` in place."""
-    ws, aux, K, R, st, ytmp, ynew, yev, ctl, tsw, active, g_old, g_new, trig_ev = work
-    trig = ws[5]  # sines and cosines of the last right-hand side's state
-    rtol = O[O_RTOL]
-    atol = O[O_ATOL]
-    hmax = O[O_HMAX]
-    hmin = O[O_HMIN]
-    maxsteps = int(O[O_MAXSTEPS])
-    t_end = O[O_TEND]
-    ns = _rk.n_stages(method)
+def _start(P, O, t0, ctl, tsw, active):
+    """The discrete state at ``t0``; returns the first step size.
+
+    Each leg's controller branch and cycle at ``t0`` (phases, eqs E.25-E.27)
+    and the time its branch ends; which switching functions are armed:
+    contact (without ``P_CONTACT`` the feet never touch), controller (without
+    ``P_ACT`` no actuation, no switch) and falls (``O_FALLS``).
+    """
     init_ctl(P, t0, ctl)
     for leg in range(2):
         tsw[leg] = ctl_switch_time(P, ctl, leg)
@@ -177,161 +181,243 @@ def _integrate(method, P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend
         active[leg] = P[P_CONTACT] != 0.0
         active[K_CTL + leg] = P[P_ACT] != 0.0
     active[K_FALL] = O[O_FALLS] != 0.0
-    t = t0
-    nrec = 0
-    nev = 0
-    nstr = 0
-    nacc = 0
-    nrej = 0
-    nfev = 0
-    t_last_td = t0
-    status = ST_OK
-    nrec_cap = rec.shape[0]
-    rhs(P, t, y, cs, ctl, False, K[0], ws, aux)
-    nfev += 1
-    if nrec_cap > 0:
-        _record(P, rec, 0, t, y, cs, ctl, ws)
-        nrec = 1
     h = O[O_H0]
     if h <= 0.0:
-        h = min(1e-3, hmax)
+        h = min(1e-3, O[O_HMAX])
+    return h
+
+
+@njit(**INLINE)
+def _step_size(h, hmax, t, t_end):
+    """``(h_step, at_end)``: the next step, ``h`` capped at ``hmax`` and cut to end
+    at ``t_end``, and whether it was cut."""
+    hstep = min(h, hmax)
+    at_end = t + hstep >= t_end
+    if at_end:
+        hstep = t_end - t
+    return hstep, at_end
+
+
+@njit(**INLINE)
+def _step_error(method, y, ynew, h, K, rtol, atol):
+    """Error of the step ``y -> ynew`` in units of the tolerance (accept if <= 1);
+    a non-finite error counts as 1e10 (a rejection)."""
+    err = _rk.error_norm(method, N, y, ynew, h, K, rtol, atol)
+    if not math.isfinite(err):
+        err = 1e10
+    return err
+
+
+@njit(**INLINE)
+def _rejected(method, hstep, err, hmin, ynew):
+    """``(h, status)`` after a rejected step: a shorter step, or an error below ``hmin``."""
+    h = hstep * _rk.step_factor(method, err, 5.0)
+    if h < hmin:
+        return h, ST_ERR_UNDERFLOW if math.isfinite(ynew[0]) else ST_ERR_NONFINITE
+    return h, ST_OK
+
+
+@njit(**INLINE)
+def _locate(method, P, k, t, h, g_lo, g_hi, R, cs, tsw, yev, trig_ev, st):
+    """Event location: where in the step ``t -> t + h`` switching function ``k``
+    crosses from ``g_lo > 0`` to ``g_hi <= 0``.
+
+    Illinois on the dense output ``R`` (to 1e-13 in time, at most 100
+    evaluations); returns the earliest ``theta`` in (0, 1] known to be at or
+    past the crossing. ``yev``, ``trig_ev``, ``st`` are work arrays.
+    """
+    _rk.root_start(st, g_lo, g_hi)
+    for _ in range(100):
+        c = _rk.root_guess(st)
+        _rk.dense_eval(method, R, c, yev)
+        state_trig(yev, trig_ev)
+        gc = event_g(P, k, t + c * h, yev, cs, tsw, trig_ev)
+        if _rk.root_update(st, c, gc, 1e-13 / h):
+            break
+    return st[1]
+
+
+@njit(**INLINE)
+def _first_event(method, P, t, y, ynew, h, K, R, cs, ctl, tsw, active, g_old, g_new, yev,
+                 trig_ev, st, ws, aux):
+    """Event detection in the accepted step ``(t, y) -> (t + h, ynew)``: ``(k, theta, nfev)``.
+
+    The armed switching functions at the step's end go to ``g_new`` (their
+    values at its start are ``g_old``); each that crosses from > 0 to <= 0 is
+    located (:func:`_locate`) on the step's dense output, computed at the
+    first crossing (``nfev`` right-hand sides). ``k`` is the earliest event
+    (-1 if none) at ``t + theta h``.
+
+    ``ws[5]`` holds the sines and cosines of ``ynew`` (the step's last
+    right-hand side was there) until the dense output's extra stages
+    (dop853) overwrite it: the switching functions after the first crossing
+    then read those of the last extra stage.
+    """
+    trig = ws[5]
+    theta_ev = 2.0
+    k_ev = -1
+    nfev = 0
+    have_dense = False
+    for k in range(NEVK):
+        if not active[k]:
+            continue
+        g_new[k] = event_g(P, k, t + h, ynew, cs, tsw, trig)
+        if g_old[k] > 0.0 and g_new[k] <= 0.0:
+            if not have_dense:
+                nfev += dense_output(P, method, t, y, ynew, h, K, R, yev, cs, ctl, ws, aux)
+                have_dense = True
+            theta = _locate(method, P, k, t, h, g_old[k], g_new[k], R, cs, tsw, yev, trig_ev,
+                            st)
+            if theta < theta_ev:
+                theta_ev = theta
+                k_ev = k
+    return k_ev, theta_ev, nfev
+
+
+@njit(**INLINE)
+def _event_state(method, k_ev, theta, t, h, R, tsw, y, trig):
+    """Move to the located event: ``y`` (and its sines and cosines ``trig``) from
+    the dense output at ``theta``; returns the event's time, for a controller
+    switch its known time (the phase reaching d or 1, eqs E.25-E.27)."""
+    _rk.dense_eval(method, R, theta, y)
+    t_ev = t + theta * h
+    if K_CTL <= k_ev < K_FALL:
+        t_ev = tsw[k_ev - K_CTL]
+    state_trig(y, trig)
+    return t_ev
+
+
+@njit(**INLINE)
+def _log_event(ev, nev, t, kind, a, b):
+    """Row ``nev`` of the event rows ``ev``, ``(t, kind, a, b)``, while there is room;
+    returns the rows written."""
+    if nev < ev.shape[0]:
+        ev[nev, 0] = t
+        ev[nev, 1] = kind
+        ev[nev, 2] = a
+        ev[nev, 3] = b
+        nev += 1
+    return nev
+
+
+@njit(**INLINE)
+def _log_stride(strides, nstr, t, y, cs):
+    """Row ``nstr`` of ``strides``: ``t``, the state and the contact state just after
+    a right touch-down (while there is room); returns the strides counted."""
+    if nstr < strides.shape[0]:
+        strides[nstr, 0] = t
+        for i in range(N):
+            strides[nstr, 1 + i] = y[i]
+        for i in range(NCS):
+            strides[nstr, 1 + N + i] = cs[i]
+    return nstr + 1
+
+
+@njit(**INLINE)
+def _apply_events(P, t, y, cs, ctl, tsw, active, g_old, k_ev, trig, ev, nev, strides, nstr):
+    """Apply every event that occurs at the located event ``k_ev`` at ``(t, y)``:
+    ``(status, nev, nstr, right_td)``.
+
+    An armed switching function that was > 0 at the step's start and is now
+    <= 0 (or is ``k_ev`` itself) fires: a contact switch
+    (:func:`._contact.contact_switch`, logged in ``ev``; a right touch-down
+    also in ``strides``, it ends a stride, Section E.2.5), a controller switch
+    (the leg's next branch and its end time), or a fall (``status``, the
+    margin that reached zero).
+    """
+    status = ST_OK
+    right_td = False
+    for k in range(NEVK):
+        if not active[k] or not g_old[k] > 0.0:
+            continue
+        if k != k_ev and event_g(P, k, t, y, cs, tsw, trig) > 0.0:
+            continue
+        if k == K_FALL:
+            status = fall_value_trig(P, y, trig[1])[1]
+        elif k >= K_CTL:
+            ctl_switch(ctl, k - K_CTL)
+            tsw[k - K_CTL] = ctl_switch_time(P, ctl, k - K_CTL)
+        else:
+            kind, x, z = contact_switch(P, y, cs, k, trig)
+            nev = _log_event(ev, nev, t, kind, x, z)
+            if kind == EV_TD_R:
+                right_td = True
+                nstr = _log_stride(strides, nstr, t, y, cs)
+    return status, nev, nstr, right_td
+
+
+@njit(**INLINE)
+def _restart(P, t, y, cs, ctl, tsw, K, g_old, ws, aux):
+    """(Re)start the integration at ``(t, y)`` in the discrete state ``cs``, ``ctl``:
+    ``K[0] = f(t, y)`` (eq. E.22) and the switching functions there in ``g_old``."""
+    rhs(P, t, y, cs, ctl, False, K[0], ws, aux)
+    trig = ws[5]
     for k in range(NEVK):
         g_old[k] = event_g(P, k, t, y, cs, tsw, trig)
-    done = n_strides <= 0
-    while not done:
-        if nacc + nrej >= maxsteps:
-            status = ST_ERR_MAX_STEPS
-            break
-        hstep = min(h, hmax)
-        at_end = t + hstep >= t_end
-        if at_end:
-            hstep = t_end - t
-        rk_step(P, method, t, y, hstep, K, ytmp, ynew, cs, ctl, ws, aux)
-        nfev += ns
-        err = _rk.error_norm(method, N, y, ynew, hstep, K, rtol, atol)
-        if not math.isfinite(err):
-            err = 1e10
-        if err > 1.0:
-            nrej += 1
-            h = hstep * _rk.step_factor(method, err, 5.0)
-            if h < hmin:
-                status = ST_ERR_UNDERFLOW if math.isfinite(ynew[0]) else ST_ERR_NONFINITE
-                break
-            continue
-        nacc += 1
-        # accepted: the earliest crossing of a switching function in the step
-        # (trig holds ynew's: the step's last right-hand side was at ynew)
-        theta_ev = 2.0
-        k_ev = -1
-        have_dense = False
-        for k in range(NEVK):
-            if not active[k]:
-                continue
-            g_new[k] = event_g(P, k, t + hstep, ynew, cs, tsw, trig)
-            if g_old[k] > 0.0 and g_new[k] <= 0.0:
-                if not have_dense:  # (may overwrite trig: an event follows)
-                    nfev += dense_output(P, method, t, y, ynew, hstep, K, R, yev, cs, ctl, ws,
-                                         aux)
-                    have_dense = True
-                _rk.root_start(st, g_old[k], g_new[k])
-                for _ in range(100):
-                    c = _rk.root_guess(st)
-                    _rk.dense_eval(method, R, c, yev)
-                    state_trig(yev, trig_ev)
-                    gc = event_g(P, k, t + c * hstep, yev, cs, tsw, trig_ev)
-                    if _rk.root_update(st, c, gc, 1e-13 / hstep):
-                        break
-                if st[1] < theta_ev:
-                    theta_ev = st[1]
-                    k_ev = k
-        if k_ev >= 0:
-            _rk.dense_eval(method, R, theta_ev, ynew)
-            t_ev = t + theta_ev * hstep
-            if K_CTL <= k_ev < K_FALL:
-                t_ev = tsw[k_ev - K_CTL]  # a controller switch is at a known time
-            t = t_ev
-            for i in range(N):
-                y[i] = ynew[i]
-            state_trig(y, trig_ev)
-            # apply every event that has occurred at this point
-            for k in range(NEVK):
-                if not active[k] or not g_old[k] > 0.0:
-                    continue
-                if k != k_ev and event_g(P, k, t, y, cs, tsw, trig_ev) > 0.0:
-                    continue
-                if k == K_FALL:
-                    status = fall_value_trig(P, y, trig_ev[1])[1]
-                elif k >= K_CTL:
-                    ctl_switch(ctl, k - K_CTL)
-                    tsw[k - K_CTL] = ctl_switch_time(P, ctl, k - K_CTL)
-                else:
-                    x, z, _, _ = foot_state_of(P, y, k, trig_ev)
-                    if cs[CS_ON_R + k] == 0.0:
-                        cs[CS_ON_R + k] = 1.0
-                        cs[CS_XR + 2 * k] = x
-                        cs[CS_ZR + 2 * k] = 0.0
-                        kind = EV_TD_R + k
-                    else:
-                        cs[CS_ON_R + k] = 0.0
-                        kind = EV_LO_R + k
-                    if nev < ev.shape[0]:
-                        ev[nev, 0] = t
-                        ev[nev, 1] = kind
-                        ev[nev, 2] = x
-                        ev[nev, 3] = z
-                        nev += 1
-                    if kind == EV_TD_R:
-                        t_last_td = t
-                        if nstr < strides.shape[0]:
-                            strides[nstr, 0] = t
-                            for i in range(N):
-                                strides[nstr, 1 + i] = y[i]
-                            for i in range(NCS):
-                                strides[nstr, 1 + N + i] = cs[i]
-                        nstr += 1
-                        if nstr >= n_strides:
-                            done = True
-            rhs(P, t, y, cs, ctl, False, K[0], ws, aux)
-            nfev += 1
-            for k in range(NEVK):
-                g_old[k] = event_g(P, k, t, y, cs, tsw, trig)
-        else:
-            t = t_end if at_end else t + hstep
-            for i in range(N):
-                y[i] = ynew[i]
-                K[0, i] = K[ns, i]
-            for k in range(NEVK):
-                g_old[k] = g_new[k]
-        # here trig holds y's again
-        if nrec < nrec_cap:
-            _record(P, rec, nrec, t, y, cs, ctl, ws)
-            nrec += 1
-        elif nrec_cap > 0:
+
+
+@njit(**INLINE)
+def _advance(method, y, ynew, K, g_old, g_new):
+    """Move to the end of an accepted step without events: ``y``, ``K[0]`` (FSAL) and
+    the switching functions ``g_old`` take the step's end values."""
+    ns = _rk.n_stages(method)
+    for i in range(N):
+        y[i] = ynew[i]
+        K[0, i] = K[ns, i]
+    for k in range(NEVK):
+        g_old[k] = g_new[k]
+
+
+@njit(**FAST)
+def _record(P, rec, row, t, y, cs, ctl, ws, stats):
+    """Row ``row`` of ``rec`` (if it has room, else ``S_RECFULL`` is set); returns
+    the rows written. ``ws`` holds the right-hand side at ``(t, y)``."""
+    if row >= rec.shape[0]:
+        if rec.shape[0] > 0:
             stats[S_RECFULL] = 1.0
-        if status != ST_OK:  # fell at a located fall event
-            break
-        if not math.isfinite(y[0]):
-            status = ST_ERR_NONFINITE
-            break
-        if O[O_FALLS] != 0.0:
-            fs = fall_check_trig(P, y, trig[1])  # a margin that started at zero has no crossing
-            if fs != ST_OK:
-                status = fs
-                break
-            if t - t_last_td > O[O_TSTRIDE]:
-                status = ST_FALL_NO_TD
-                break
-        if t >= t_end and not done:
-            status = ST_TEND
-            break
-        # step-size control (Hairer)
-        h = hstep * _rk.step_factor(method, err, 5.0)
-    if status >= 10 and status < 20 and nev < ev.shape[0]:
-        ev[nev, 0] = t
-        ev[nev, 1] = EV_FALL
-        ev[nev, 2] = status
-        ev[nev, 3] = 0.0
-        nev += 1
+        return row
+    trig = ws[5]
+    rc = ws[6]
+    rec[row, 0] = t
+    for i in range(N):
+        rec[row, R_Y + i] = y[i]
+    rec[row, R_CON] = cs[CS_ON_R]
+    rec[row, R_CON + 1] = cs[CS_ON_L]
+    for leg in range(2):
+        fx, fz, _ = contact_force_trig(P, y, cs, leg, True, trig)
+        ft, fs, tau = actuation(P, t, y, ctl, leg, rc)
+        rec[row, R_F + 2 * leg] = fx
+        rec[row, R_F + 2 * leg + 1] = fz
+        rec[row, R_TAU + leg] = tau
+        rec[row, R_FT + leg] = ft
+        rec[row, R_FS + leg] = fs
+    return row + 1
+
+
+@njit(**INLINE)
+def _run_status(P, O, t, y, trig, t_last_td, done):
+    """Whether the run ends at ``(t, y)`` (``trig`` its sines and cosines): a
+    non-finite state, a fall (``O_FALLS``: a fall margin of
+    :func:`._events.fall_check` at or below zero, or no right touch-down within
+    ``O_TSTRIDE``), ``O_TEND`` reached before ``done``; else ``ST_OK``."""
+    if not math.isfinite(y[0]):
+        return ST_ERR_NONFINITE
+    if O[O_FALLS] != 0.0:
+        fs = fall_check_trig(P, y, trig[1])  # a margin that started at zero has no crossing
+        if fs != ST_OK:
+            return fs
+        if t - t_last_td > O[O_TSTRIDE]:
+            return ST_FALL_NO_TD
+    if t >= O[O_TEND] and not done:
+        return ST_TEND
+    return ST_OK
+
+
+@njit(**INLINE)
+def _finish(t, y, cs, status, ev, nev, yend, csend, stats, nrec, nstr, nacc, nrej, nfev):
+    """The end of a run: a fall's event row, the final state and the counts."""
+    if status >= 10 and status < 20:
+        nev = _log_event(ev, nev, t, EV_FALL, float(status), 0.0)
     for i in range(N):
         yend[i] = y[i]
     for i in range(NCS):
@@ -343,6 +429,76 @@ def _integrate(method, P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend
     stats[S_NREJ] = nrej
     stats[S_TEND] = t
     stats[S_NFEV] = nfev
+
+
+@njit(**INLINE)
+def _integrate(method, P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend, stats, work):
+    """The loop of :func:`run` with the Runge-Kutta pair ``method`` (a constant);
+    integrates ``y`` and ``cs`` in place. Its steps: see the module docstring."""
+    ws, aux, K, R, st, ytmp, ynew, yev, ctl, tsw, active, g_old, g_new, trig_ev = work
+    trig = ws[5]  # sines and cosines of the last right-hand side's state
+    rtol = O[O_RTOL]
+    atol = O[O_ATOL]
+    hmax = O[O_HMAX]
+    hmin = O[O_HMIN]
+    maxsteps = int(O[O_MAXSTEPS])
+    t_end = O[O_TEND]
+    ns = _rk.n_stages(method)
+    h = _start(P, O, t0, ctl, tsw, active)
+    t = t0
+    _restart(P, t, y, cs, ctl, tsw, K, g_old, ws, aux)
+    nfev = 1
+    nrec = _record(P, rec, 0, t, y, cs, ctl, ws, stats)
+    nev = 0
+    nstr = 0
+    nacc = 0
+    nrej = 0
+    t_last_td = t0
+    status = ST_OK
+    done = n_strides <= 0
+    while not done:
+        if nacc + nrej >= maxsteps:
+            status = ST_ERR_MAX_STEPS
+            break
+        # 1. one Runge-Kutta step
+        hstep, at_end = _step_size(h, hmax, t, t_end)
+        rk_step(P, method, t, y, hstep, K, ytmp, ynew, cs, ctl, ws, aux)
+        nfev += ns
+        # 2. error control
+        err = _step_error(method, y, ynew, hstep, K, rtol, atol)
+        if err > 1.0:
+            nrej += 1
+            h, status = _rejected(method, hstep, err, hmin, ynew)
+            if status != ST_OK:
+                break
+            continue
+        nacc += 1
+        # 3.-4. event detection and location
+        k_ev, theta, nfe = _first_event(method, P, t, y, ynew, hstep, K, R, cs, ctl, tsw,
+                                        active, g_old, g_new, yev, trig_ev, st, ws, aux)
+        nfev += nfe
+        # 5. stop at the event, apply it and restart; else to the step's end
+        if k_ev >= 0:
+            t = _event_state(method, k_ev, theta, t, hstep, R, tsw, y, trig_ev)
+            status, nev, nstr, right_td = _apply_events(P, t, y, cs, ctl, tsw, active, g_old,
+                                                        k_ev, trig_ev, ev, nev, strides, nstr)
+            if right_td:
+                t_last_td = t
+                done = nstr >= n_strides
+            _restart(P, t, y, cs, ctl, tsw, K, g_old, ws, aux)
+            nfev += 1
+        else:
+            t = t_end if at_end else t + hstep
+            _advance(method, y, ynew, K, g_old, g_new)
+        # 6. record (trig holds y's again), then the checks that end a run
+        nrec = _record(P, rec, nrec, t, y, cs, ctl, ws, stats)
+        if status == ST_OK:  # else fell at a located fall event
+            status = _run_status(P, O, t, y, trig, t_last_td, done)
+        if status != ST_OK:
+            break
+        # step-size control (Hairer)
+        h = hstep * _rk.step_factor(method, err, 5.0)
+    _finish(t, y, cs, status, ev, nev, yend, csend, stats, nrec, nstr, nacc, nrej, nfev)
     return status
 
 
