@@ -93,7 +93,7 @@ _STYLE = {"holds": "green", "holds under a stated reading": "yellow",
 
 @commands.command("reproduce")
 def reproduce_cmd(
-    quick: Annotated[bool, typer.Option("--quick", help="Coarse resolution (about 7 s "
+    quick: Annotated[bool, typer.Option("--quick", help="Coarse resolution (about 21 s "
                                         "once the kernels are compiled).")] = False,
     out: Annotated[Path, typer.Option("--out", help="Report folder.")] = Path("report"),
     workers: WorkersOpt = None,
