@@ -40,7 +40,8 @@ from typing import Any
 from .._checks import check_name, check_number
 from .._io import read_toml
 from ..gait.continuation import get_param, set_param
-from ..model.parameters import Params, preset
+from ..model.parameters import Params
+from .spec import name_list, spec_header
 
 __all__ = ["OBJECTIVES", "DesignSpec", "Variable"]
 
@@ -187,34 +188,16 @@ class DesignSpec:
     def from_dict(cls, data: dict[str, Any]) -> DesignSpec:
         """Build from the TOML form (see the module docstring)."""
         data = dict(data)
-        allowed = {"name", "description", "preset", "params", "variable", "objectives",
-                   "budget", "population", "seed", "n_steps"}
-        unknown = set(data) - allowed
-        if unknown:
-            raise ValueError(f"unknown design key {sorted(unknown)[0]!r}; allowed: "
-                             f"{sorted(allowed)}")
-        name = data.get("name", "design")
-        for key in ("name", "preset", "description"):
-            if key in data and not isinstance(data[key], str):
-                raise ValueError(f"design {key} must be a string, got {data[key]!r}")
-        overrides = data.get("params", {})
-        if not isinstance(overrides, dict):
-            raise ValueError("design [params] must be a table")
-        if "preset" in overrides:
-            raise ValueError(f"design {name}: give preset at the top level, not in [params]")
-        base = Params.from_dict(overrides, base=preset(data.get("preset", "table2.1")))
+        name, base = spec_header(data, "design", {"variable", "objectives", "budget",
+                                                  "population", "seed", "n_steps"})
         var_data = data.get("variable")
         if not isinstance(var_data, list) or not var_data:
             raise ValueError(f"design {name}: needs at least one [[variable]]")
-        objectives = data.get("objectives")
-        if isinstance(objectives, str):
-            objectives = [objectives]
-        if not isinstance(objectives, list) or not all(isinstance(o, str) for o in objectives):
-            raise ValueError(f"design {name}: objectives must be a list of names from "
-                             f"{list(OBJECTIVES)}, got {objectives!r}")
-        return cls(name=str(name), base=base,
+        objectives = name_list(data.get("objectives"), f"design {name}: objectives",
+                               list(OBJECTIVES))
+        return cls(name=name, base=base,
                    variables=tuple(Variable.from_dict(v) for v in var_data),
-                   objectives=tuple(objectives), budget=data.get("budget", 2000),
+                   objectives=objectives, budget=data.get("budget", 2000),
                    population=data.get("population", 40), seed=data.get("seed", 1),
                    n_steps=data.get("n_steps", 25),
                    description=str(data.get("description", "")))

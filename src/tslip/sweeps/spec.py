@@ -34,13 +34,47 @@ from .._io import read_toml
 from ..gait.continuation import get_param, set_param
 from ..model.parameters import Params, preset
 
-__all__ = ["Axis", "StudySpec", "ANALYSES"]
+__all__ = ["Axis", "StudySpec", "ANALYSES", "name_list", "spec_header"]
 
 #: Analyses a study can run at each point. ``floquet`` is always run.
 ANALYSES = ("floquet", "robustness", "stride")
 #: Memory one study point holds at least: its value and one result row (about 20 numbers
 #: and their labels in a table).
 _POINT_BYTES = 1000.0
+
+
+def spec_header(data: dict[str, Any], what: str, keys: set[str]) -> tuple[str, Params]:
+    """The name and base parameters of a spec's TOML form (a study's, a design search's).
+
+    ``keys``: the spec's own keys beside ``name``, ``description``, ``preset`` and
+    ``params``; any other key is a one-line error naming the allowed ones. The base is
+    ``preset`` (default ``table2.1``) with the ``[params]`` overrides.
+    """
+    allowed = {"name", "description", "preset", "params", *keys}
+    unknown = set(data) - allowed
+    if unknown:
+        raise ValueError(f"unknown {what} key {sorted(unknown)[0]!r}; allowed: "
+                         f"{sorted(allowed)}")
+    for key in ("name", "preset", "description"):
+        if key in data and not isinstance(data[key], str):
+            raise ValueError(f"{what} {key} must be a string, got {data[key]!r}")
+    name = str(data.get("name", what))
+    overrides = data.get("params", {})
+    if not isinstance(overrides, dict):
+        raise ValueError(f"{what} [params] must be a table")
+    if "preset" in overrides:
+        raise ValueError(f"{what} {name}: give preset at the top level, not in [params]")
+    return name, Params.from_dict(overrides, base=preset(data.get("preset", "table2.1")))
+
+
+def name_list(value: Any, field: str, allowed: Sequence[str]) -> tuple[str, ...]:
+    """A TOML list of names (or one name) as a tuple; anything else is a one-line error."""
+    if isinstance(value, str):
+        value = [value]
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise ValueError(f"{field} must be a list of names from {list(allowed)}, "
+                         f"got {value!r}")
+    return tuple(value)
 
 
 @dataclass(frozen=True, slots=True)
@@ -188,33 +222,14 @@ class StudySpec:
     def from_dict(cls, data: dict[str, Any]) -> StudySpec:
         """Build from the TOML form (see the module docstring)."""
         data = dict(data)
-        allowed = {"name", "description", "preset", "params", "axis", "analyses", "n_steps"}
-        unknown = set(data) - allowed
-        if unknown:
-            raise ValueError(f"unknown study key {sorted(unknown)[0]!r}; allowed: "
-                             f"{sorted(allowed)}")
-        name = data.get("name", "study")
-        for key in ("name", "preset", "description"):
-            if key in data and not isinstance(data[key], str):
-                raise ValueError(f"study {key} must be a string, got {data[key]!r}")
-        base = preset(data.get("preset", "table2.1"))
-        overrides = data.get("params", {})
-        if not isinstance(overrides, dict):
-            raise ValueError("study [params] must be a table")
-        if "preset" in overrides:
-            raise ValueError(f"study {name}: give preset at the top level, not in [params]")
-        base = Params.from_dict(overrides, base=base)
+        name, base = spec_header(data, "study", {"axis", "analyses", "n_steps"})
         axes_data = data.get("axis")
         if not isinstance(axes_data, list) or not axes_data:
             raise ValueError(f"study {name}: needs at least one [[axis]]")
         axes = tuple(Axis.from_dict(a) for a in axes_data)
-        analyses = data.get("analyses", ["floquet"])
-        if isinstance(analyses, str):
-            analyses = [analyses]
-        if not isinstance(analyses, list) or not all(isinstance(a, str) for a in analyses):
-            raise ValueError(f"study {name}: analyses must be a list of names from "
-                             f"{list(ANALYSES)}, got {analyses!r}")
-        return cls(name=str(name), base=base, axes=axes, analyses=tuple(analyses),
+        analyses = name_list(data.get("analyses", ["floquet"]), f"study {name}: analyses",
+                             ANALYSES)
+        return cls(name=name, base=base, axes=axes, analyses=analyses,
                    n_steps=data.get("n_steps", 25),
                    description=str(data.get("description", "")))
 
