@@ -58,7 +58,8 @@ from ._io import atomic_write, git_hash, write_table
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["Result", "load", "with_units", "frame", "run_record", "encode", "decode", "FORMAT"]
+__all__ = ["Result", "FrameTable", "load", "with_units", "frame", "run_record", "encode", "decode",
+           "FORMAT"]
 
 #: Name and version of the file format, stored in every file.
 FORMAT_NAME, FORMAT_VERSION = "tslip-result", 1
@@ -180,6 +181,21 @@ class Result:
         if not isinstance(obj, cls):
             raise ValueError(f"{str(path)!r} holds a {type(obj).__name__}, not a {cls.__name__}")
         return obj
+
+
+class FrameTable:
+    """Mixin of a :class:`Result` whose table is its DataFrame field ``frame`` (a study's
+    points, a design search's evaluations): saved as the ``.parquet``/``.csv`` table,
+    read back without the units in ``attrs`` (``to_dataframe`` adds them)."""
+
+    def _table_fields(self) -> tuple[str, ...]:
+        return ("frame",)
+
+    @classmethod
+    def _from_table(cls, df: pd.DataFrame, fields: dict[str, Any]) -> dict[str, Any]:
+        df = df.copy()
+        df.attrs = {}
+        return {**fields, "frame": df}
 
 
 class _Shape:

@@ -19,8 +19,8 @@ commands = typer.Typer()
 
 @commands.command("design")
 def design_cmd(
-    spec_path: Annotated[Path, typer.Argument(help="Design spec (TOML; see docs/design.md).",
-                                              metavar="SPEC.toml")],
+    spec_path: Annotated[Path, typer.Argument(
+        help="Design spec (TOML; see docs/analyses/design.md).", metavar="SPEC.toml")],
     out: Annotated[Path | None, typer.Option("--out", help="Output folder (default: "
                                              "designs/<name>).")] = None,
     workers: WorkersOpt = None,

@@ -38,10 +38,9 @@ from pathlib import Path
 from typing import Any
 
 from .._checks import check_name, check_number
-from .._io import read_toml
 from ..gait.continuation import get_param, set_param
 from ..model.parameters import Params
-from .spec import name_list, spec_header
+from .spec import name_list, read_spec, spec_header
 
 __all__ = ["OBJECTIVES", "DesignSpec", "Variable"]
 
@@ -205,6 +204,4 @@ class DesignSpec:
     @classmethod
     def from_toml(cls, path: str | Path) -> DesignSpec:
         """Read a design search from a TOML file."""
-        data = read_toml(path, "design file")
-        data.setdefault("name", Path(path).stem)
-        return cls.from_dict(data)
+        return cls.from_dict(read_spec(path, "design file"))

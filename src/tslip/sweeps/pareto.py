@@ -49,7 +49,7 @@ import numpy as np
 
 from .._codehash import code_hash
 from .._io import git_hash, write_json
-from .._results import Result, with_units
+from .._results import FrameTable, Result, with_units
 from ..model.units import param_unit
 from ._lock import folder_lock
 from ._schedule import Task, choose_workers, run_tasks
@@ -176,10 +176,15 @@ def pareto_mask(costs: np.ndarray) -> np.ndarray:
     return mask
 
 
+def _sign(objective: str) -> float:
+    """-1 for an objective whose magnitude is maximised, +1 for a minimised one: the
+    objective times this is a cost to minimise."""
+    return -1.0 if OBJECTIVES[objective][0] > 0 else 1.0
+
+
 def _costs(frame: pd.DataFrame, objectives: Sequence[str]) -> np.ndarray:
     """Objectives as costs to minimise (maximised ones negated); NaN where infeasible."""
-    cols = [-frame[o].to_numpy(float) if OBJECTIVES[o][0] > 0 else frame[o].to_numpy(float)
-            for o in objectives]
+    cols = [_sign(o) * frame[o].to_numpy(float) for o in objectives]
     c = np.column_stack(cols) if cols else np.empty((len(frame), 0))
     c[~frame["feasible"].to_numpy(bool)] = np.nan
     return c
@@ -191,7 +196,7 @@ def _costs(frame: pd.DataFrame, objectives: Sequence[str]) -> np.ndarray:
 
 
 @dataclass(frozen=True, eq=False, repr=False)
-class DesignResult(Result):
+class DesignResult(FrameTable, Result):
     """A design search: every evaluated candidate, and its Pareto front.
 
     Attributes
@@ -233,25 +238,13 @@ class DesignResult(Result):
 
     def gait(self, i: int) -> Gait:
         """The periodic gait of front design ``i`` (recomputed; deterministic)."""
-        from ..gait import find_gait
-
-        row = self.front.iloc[int(i)]
-        return find_gait(self.spec.params_at({n: float(row[n]) for n in self.spec.names}))
+        return _front_gait(self.spec, self.front.iloc[int(i)])
 
     def plot(self, ax: Axes | None = None) -> Figure:
         """The first two objectives of every feasible design, the front highlighted."""
         from ..plotting.design import plot_design
 
         return plot_design(self, ax)
-
-    def _table_fields(self) -> tuple[str, ...]:
-        return ("frame",)
-
-    @classmethod
-    def _from_table(cls, df: pd.DataFrame, fields: dict[str, Any]) -> dict[str, Any]:
-        df = df.copy()
-        df.attrs = {}
-        return {**fields, "frame": df}
 
 
 # ---------------------------------------------------------------------------
@@ -369,8 +362,8 @@ def design(
         pop, xs = state["pop"], state["xs"]
         gen_rows = [dict(store.rows[x], generation=state["gen"]) for x in xs]
         rows.extend(gen_rows)
-        f = np.array([[(-r[o] if OBJECTIVES[o][0] > 0 else r[o]) if r["feasible"] else 0.0
-                       for o in spec.objectives] for r in gen_rows])
+        f = np.array([[_sign(o) * r[o] if r["feasible"] else 0.0 for o in spec.objectives]
+                      for r in gen_rows])
         pop.set("F", f)
         pop.set("G", np.array([[r["violation"]] for r in gen_rows]))
         algorithm.tell(infills=pop)
@@ -421,6 +414,13 @@ def design(
     return result
 
 
+def _front_gait(spec: DesignSpec, row: pd.Series) -> Gait:
+    """The periodic gait of a design (a row with the variables), found again."""
+    from ..gait import find_gait
+
+    return find_gait(spec.params_at({n: float(row[n]) for n in spec.names}))
+
+
 def _frame(spec: DesignSpec, rows: list[dict[str, Any]]) -> pd.DataFrame:
     import pandas as pd
 
@@ -438,8 +438,8 @@ def _write(result: DesignResult, out: Path) -> None:
     front.to_csv(out / "front.csv", index=False)
     gaits = out / "gaits"
     gaits.mkdir(exist_ok=True)
-    for i in range(len(front)):
-        result.gait(i).save(gaits / f"front-{i:03d}.json")
+    for i, (_, row) in enumerate(front.iterrows()):
+        _front_gait(result.spec, row).save(gaits / f"front-{i:03d}.json")
     write_json(out / "run.json", {"spec": result.spec.to_dict(), **result.meta,
                                   "evaluations": len(result.frame),
                                   "front": len(front)})

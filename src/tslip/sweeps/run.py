@@ -47,7 +47,7 @@ import pandas as pd
 
 from .. import __version__
 from .._io import git_hash, write_json, write_table
-from .._results import Result, with_units
+from .._results import FrameTable, Result, with_units
 from ..gait.continuation import get_param
 from ..gait.robustness import UNITS as ROBUSTNESS_UNITS
 from ..model.units import COLUMN_UNITS, UNIT, param_unit
@@ -208,7 +208,7 @@ STUDY_UNITS: dict[str, str] = {
 
 
 @dataclass(frozen=True, repr=False)
-class StudyResult(Result):
+class StudyResult(FrameTable, Result):
     """A study's tidy results: one row per point, axes first."""
 
     spec: StudySpec
@@ -231,15 +231,6 @@ class StudyResult(Result):
         from ..plotting.studies import plot_study_multipliers
 
         return plot_study_multipliers(self, ax)
-
-    def _table_fields(self) -> tuple[str, ...]:
-        return ("frame",)
-
-    @classmethod
-    def _from_table(cls, df: pd.DataFrame, fields: dict[str, Any]) -> dict[str, Any]:
-        df = df.copy()
-        df.attrs = {}
-        return {**fields, "frame": df}
 
     def column(self, name: str) -> np.ndarray:
         """One result column as an array."""

@@ -34,13 +34,20 @@ from .._io import read_toml
 from ..gait.continuation import get_param, set_param
 from ..model.parameters import Params, preset
 
-__all__ = ["Axis", "StudySpec", "ANALYSES", "name_list", "spec_header"]
+__all__ = ["Axis", "StudySpec", "ANALYSES", "name_list", "read_spec", "spec_header"]
 
 #: Analyses a study can run at each point. ``floquet`` is always run.
 ANALYSES = ("floquet", "robustness", "stride")
 #: Memory one study point holds at least: its value and one result row (about 20 numbers
 #: and their labels in a table).
 _POINT_BYTES = 1000.0
+
+
+def read_spec(path: str | Path, what: str) -> dict[str, Any]:
+    """A spec's TOML file as data, its ``name`` defaulting to the file's stem."""
+    data = read_toml(path, what)
+    data.setdefault("name", Path(path).stem)
+    return data
 
 
 def spec_header(data: dict[str, Any], what: str, keys: set[str]) -> tuple[str, Params]:
@@ -236,6 +243,4 @@ class StudySpec:
     @classmethod
     def from_toml(cls, path: str | Path) -> StudySpec:
         """Read a study from a TOML file."""
-        data = read_toml(path, "study file")
-        data.setdefault("name", Path(path).stem)
-        return cls.from_dict(data)
+        return cls.from_dict(read_spec(path, "study file"))

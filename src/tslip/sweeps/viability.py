@@ -70,7 +70,7 @@ import numpy as np
 from .. import __version__
 from .._checks import check_name, check_number
 from .._codehash import code_hash
-from .._io import atomic_write, git_hash, read_toml, write_json
+from .._io import atomic_write, git_hash, write_json
 from ..gait._viable import RULES
 from ..gait.viability import StateActionMap, Viability, check_map_inputs, map_cells, viability
 from ..model.parameters import Params, preset
@@ -79,7 +79,7 @@ from . import _pool
 from ._lock import folder_lock
 from ._schedule import Task, choose_workers, run_tasks
 from .run import StudyInterrupted, _cached_names
-from .spec import Axis
+from .spec import Axis, read_spec
 
 __all__ = ["CHUNK_CELLS", "ViabilityInterrupted", "ViabilitySpec", "chunk_keys", "run_viability",
            "saved_cells", "read_chunk"]
@@ -200,9 +200,7 @@ class ViabilitySpec:
 
     @classmethod
     def from_toml(cls, path: str | Path) -> ViabilitySpec:
-        data = read_toml(path, "viability spec")
-        data.setdefault("name", Path(path).stem)
-        return cls.from_dict(data)
+        return cls.from_dict(read_spec(path, "viability spec"))
 
 
 _TIGHT = {"rtol": 1e-12, "atol": 1e-12, "method": "dop853"}
