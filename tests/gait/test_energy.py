@@ -110,3 +110,76 @@ def test_plots(passive):
 def test_docstring_examples():
     result = doctest.testmod(energy_module, optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0
+
+
+# -- one stride's energy balance (stride_work) ----------------------------------
+
+
+def _stance_work_scipy(gait):
+    """Hip work, damper loss and lift-off state by an independent integration.
+
+    The stance of the readable reference equations (tslip.model.dynamics, eq. A.14)
+    with two more states accumulating the hip power tau (phid + betad) and the
+    damper power c_l ld^2, solved by scipy's DOP853 at rtol 1e-12 to the lift-off
+    event F_y = 0 (eq. 2.8); the touch-down stance state from eq. A.5 inverted here.
+    """
+    from scipy.integrate import solve_ivp
+
+    from tslip.model import dynamics
+
+    p, s = gait.params, gait.state
+    u = s.xd - p.r * math.cos(s.phi) * s.phid
+    w = s.yd - p.r * math.sin(s.phi) * s.phid
+    y0 = [p.l0, s.beta, s.phi, -u * math.cos(s.beta) + w * math.sin(s.beta),
+          (u * math.sin(s.beta) + w * math.cos(s.beta)) / p.l0, s.phid, 0.0, 0.0]
+
+    def rhs(_t, z):
+        y = z[:6]
+        q, qd = y[:3], y[3:]
+        tau = dynamics.hip_torque(p, q, qd)
+        return [*dynamics.stance_rhs(p, y), tau * (y[5] + y[4]), p.c_l * y[3] ** 2]
+
+    def lift_off(_t, z):
+        return dynamics.ground_reaction_force(p, z[:6])[1]
+
+    lift_off.terminal, lift_off.direction = True, -1
+    sol = solve_ivp(rhs, (0.0, 5.0), y0, method="DOP853", rtol=1e-12, atol=1e-12,
+                    events=lift_off)
+    z = sol.y_events[0][0]
+    return z[6], z[7], z[:6]
+
+
+def test_stride_work_balances_on_the_powered_table61_gait():
+    """Hip work = damper loss + the spring energy left at lift-off (a periodic gait).
+
+    Table 6.1 (local velocity control, c_l = 0.32): lift-off (F_y = 0) comes while the
+    leg is still compressed, so the hip puts in more than the damper takes out. Each
+    term against the independent integration above; the spring energy from the
+    lift-off leg length, 0.5 k (l0 - l)^2, not from the energy column.
+    """
+    g = tslip.find_gait(tslip.preset("table6.1"))
+    w = tslip.gait.stride_work(g)
+    hip, damper, y_lo = _stance_work_scipy(g)
+    p = g.params
+    assert w.hip == pytest.approx(hip, rel=1e-7)
+    assert w.damper == pytest.approx(damper, rel=1e-7)
+    # (rel 1e-6: the kernel locates lift-off at its own tolerance, 1e-8 relative in time)
+    assert w.liftoff == pytest.approx(0.5 * p.k * (p.l0 - y_lo[0]) ** 2, rel=1e-6)
+    # the balance: a periodic gait ends a stride with the energy it started with
+    assert abs(w.change) < 1e-6 and abs(w.residual) < 1e-6
+    assert w.hip == pytest.approx(w.damper + w.liftoff, abs=1e-6)
+    # ... and the lift-off loss is not negligible (what made hip work != damper loss)
+    assert w.liftoff > 0.1 * w.hip > 0.01
+
+
+def test_stride_work_is_zero_for_the_passive_undamped_gait_and_refuses_a_fall(passive):
+    w = tslip.gait.stride_work(passive)
+    assert w.hip == 0.0 and w.damper == 0.0
+    assert abs(w.liftoff) < 1e-12 and abs(w.change) < 1e-6
+    with pytest.raises(ValueError, match="samples must be >= 100"):
+        tslip.gait.stride_work(passive, samples=10)
+    import dataclasses
+
+    falls = dataclasses.replace(passive, state=dataclasses.replace(passive.state, xd=-1.0))
+    with pytest.raises(ValueError, match="not a touch-down"):
+        tslip.gait.stride_work(falls)

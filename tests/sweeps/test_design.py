@@ -94,6 +94,19 @@ def test_evaluation_equals_the_analyses_called_directly():
     assert 1.5 < row["peak_leg_force"] < 4.0
 
 
+def test_energy_per_stride_is_the_hip_work_of_the_powered_gait():
+    """Table 6.1 (local velocity control, leg damping): the hip's net work per stride."""
+    base = tslip.preset("table6.1")
+    spec = _spec(base=base, variables=(Variable("controller.Kd", 0.2, 0.6),),
+                 objectives=("energy_per_stride",))
+    row = evaluate(spec, {"controller.Kd": 0.4})
+    w = tslip.gait.stride_work(tslip.find_gait(base))
+    assert row["feasible"] and row["energy_per_stride"] == w.hip
+    # what the hip puts in, the damper and the lift-off spring take out
+    assert row["energy_per_stride"] == pytest.approx(w.damper + w.liftoff, abs=1e-6)
+    assert OBJECTIVES["energy_per_stride"][0] == -1  # minimised
+
+
 def test_no_gait_and_unstable_gaits_are_infeasible_with_their_reason():
     spec = _spec()
     # below r = 0 the passive Table 2.1 runner is unstable (thesis Figure 4.14)

@@ -14,9 +14,11 @@ from .continuation import Branch, continue_gait, get_param, set_param, stability
 from .energy import (
     HeightChangeResult,
     StepDownResponse,
+    StrideWork,
     VelocityAngleCase,
     expected_velocity_change,
     step_down_response,
+    stride_work,
     velocity_after_height_change,
     velocity_angle_effect,
 )
@@ -67,7 +69,8 @@ __all__ = [
     "GaitSet", "StableRegion", "all_gaits", "stable_region", "nominal_energy", "apex_jacobian",
     "Branch", "continue_gait", "get_param", "set_param", "stability_boundaries",
     "HeightChangeResult", "StepDownResponse", "VelocityAngleCase", "expected_velocity_change",
-    "step_down_response", "velocity_after_height_change", "velocity_angle_effect",
+    "step_down_response", "StrideWork", "stride_work", "velocity_after_height_change",
+    "velocity_angle_effect",
     "CMAReport", "Gait", "GaitProblem", "cma_minimize", "find_gait", "gait_residual",
     "Impulse", "ImpulseLinearisation", "PitchResponse", "impulse_linearisation",
     "pitch_disturbance_response", "stance_impulse", "analyse", "GaitReport",

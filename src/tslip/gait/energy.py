@@ -43,6 +43,8 @@ __all__ = [
     "velocity_after_height_change",
     "StepDownResponse",
     "step_down_response",
+    "StrideWork",
+    "stride_work",
     "VelocityAngleCase",
     "velocity_angle_effect",
 ]
@@ -438,3 +440,72 @@ def velocity_angle_effect(
             impulse=_impulse_from_run(traj, dt), trajectory=traj,
         ))
     return tuple(out)
+
+
+# ---------------------------------------------------------------------------
+# one stride's energy balance (powered gaits)
+# ---------------------------------------------------------------------------
+
+#: Rows of the recorded stance in :func:`stride_work` (trapezoid rule: the
+#: integrals' relative error is about ``1 / STRIDE_WORK_SAMPLES**2``).
+STRIDE_WORK_SAMPLES = 20_000
+
+
+@dataclass(frozen=True)
+class StrideWork:
+    """The energy balance of one stride from touch-down to the next [M g L].
+
+    The total energy ``E`` (kinetic + gravity + leg spring, the ``energy``
+    column of :func:`tslip.simulate`) changes in stance by the hip's work and
+    the leg damper's loss, and drops at lift-off by the spring energy the leg
+    still holds: lift-off is ``F_y = 0`` (eq. 2.8), which with leg damping or
+    a hip torque comes before the leg is back at its rest length, and the
+    massless leg then returns to ``l0`` without doing work on the body. In
+    flight ``E`` is constant. So ``change = hip - damper - liftoff`` up to the
+    quadrature error (:attr:`residual`), and a periodic gait has
+    ``hip = damper + liftoff``: what the hip actuator puts in per stride.
+    """
+
+    hip: float  #: hip actuator's net work, the integral of ``tau (phid + betad)`` over stance
+    damper: float  #: leg damper's loss, the integral of ``c_l ld^2`` over stance
+    liftoff: float  #: spring energy left in the leg at lift-off, lost with it
+    change: float  #: ``E`` at the next touch-down minus ``E`` at this one
+
+    @property
+    def residual(self) -> float:
+        """``change - (hip - damper - liftoff)``: the quadrature error (0 in exact arithmetic)."""
+        return self.change - (self.hip - self.damper - self.liftoff)
+
+
+def stride_work(gait: Gait, *, samples: int = STRIDE_WORK_SAMPLES) -> StrideWork:
+    """The hip's work, the damper's loss and the lift-off loss over one stride of ``gait``.
+
+    Integrated by the trapezoid rule over ``samples`` rows of the recorded
+    stance (:func:`tslip.simulate`); see :class:`StrideWork` for the balance.
+    The hip power ``tau (phid + betad)`` is the torque times the rate of the
+    hip angle between leg and trunk (eqs 2.12-2.16 give ``tau``). Raises a
+    one-line ``ValueError`` if the stride does not end in a touch-down.
+
+    Examples
+    --------
+    >>> from tslip import Params, find_gait
+    >>> w = stride_work(find_gait(Params()))  # Table 2.1: passive, undamped
+    >>> abs(w.hip) < 1e-12 and abs(w.damper) < 1e-12 and abs(w.liftoff) < 1e-9
+    True
+    """
+    if samples < 100:
+        raise ValueError(f"samples must be >= 100, got {samples}")
+    run = simulate(gait.params, gait.state, 1, dt=gait.stance_time / samples)
+    if run.status is not Status.OK:
+        raise ValueError(f"the stride from this gait's state ends in {run.status.name}, "
+                         "not a touch-down")
+    st = run["stance"] > 0
+    t = run["t"][st]
+    hip_power = run["tau"][st] * (run["phid"][st] + run["betad"][st])
+    damper_power = gait.params.c_l * run["ld"][st] ** 2
+    last = int(np.flatnonzero(st)[-1])  # the lift-off row; the next is the same state in flight
+    energy = run["energy"]
+    return StrideWork(hip=float(np.trapezoid(hip_power, t)),
+                      damper=float(np.trapezoid(damper_power, t)),
+                      liftoff=float(energy[last] - energy[last + 1]),
+                      change=float(energy[-1] - energy[0]))

@@ -28,7 +28,8 @@ variables the gait search solves for (``alpha_r``, ``controller.alphad_ref``,
 Objectives and their senses (:data:`OBJECTIVES`): the magnitudes of the
 step-down, push and pitch-rate limits (:func:`tslip.robustness`, the thesis's
 25 strides) are maximised; the largest non-trivial Floquet multiplier, the
-stance time and the peak leg force are minimised.
+stance time, the peak leg force and the energy per stride (the hip's net work,
+:func:`tslip.gait.stride_work`; zero for a passive gait) are minimised.
 """
 
 from __future__ import annotations
@@ -52,6 +53,7 @@ OBJECTIVES: dict[str, tuple[int, str, str]] = {
     "max_multiplier": (-1, "-", "largest non-trivial Floquet multiplier |lambda|"),
     "stance_time": (-1, "g^-1/2 L^1/2", "stance time t_s"),
     "peak_leg_force": (-1, "m g", "peak axial leg force k (l0 - l) - c_l ld over stance"),
+    "energy_per_stride": (-1, "M g L", "hip's net work per stride (tslip.gait.stride_work)"),
 }
 #: Limits of the search's settings (a search of more evaluations is a study of its own).
 MAX_BUDGET = 1_000_000

@@ -111,7 +111,7 @@ def evaluate(spec: DesignSpec, values: dict[str, float]) -> dict[str, Any]:
     ``violation`` (0 when feasible; see the module docstring) and ``reason``
     (empty when feasible).
     """
-    from ..gait import find_gait, floquet, robustness
+    from ..gait import find_gait, floquet, robustness, stride_work
 
     row: dict[str, Any] = {n: float(values[n]) for n in spec.names}
     row.update(dict.fromkeys(spec.objectives, math.nan))
@@ -131,6 +131,8 @@ def evaluate(spec: DesignSpec, values: dict[str, float]) -> dict[str, Any]:
     found = {"max_multiplier": m, "stance_time": float(gait.stance_time)}
     if "peak_leg_force" in spec.objectives:
         found["peak_leg_force"] = _peak_leg_force(gait)
+    if "energy_per_stride" in spec.objectives:
+        found["energy_per_stride"] = stride_work(gait).hip
     for kind in _ROBUSTNESS:
         if kind in spec.objectives:
             found[kind] = abs(float(robustness(gait, kind, n_steps=spec.n_steps)))
