@@ -137,30 +137,31 @@ def limit_search(
         rungs = rungs[rungs < max_magnitude]
         if len(rungs) < ladder:
             rungs = np.append(rungs, max_magnitude)
-        ok = ask(rungs)
-        fail = np.flatnonzero(~ok)
-        if fail.size:
-            i = int(fail[0])
-            hi = float(rungs[i])
-            lo = float(rungs[i - 1]) if i > 0 else lo
-        else:
-            lo = float(rungs[-1])
-            if lo >= max_magnitude:
-                return _done(math.inf, math.inf, mags, oks)
+        lo, hi = _bracket(lo, rungs, ask(rungs))
+        if lo >= max_magnitude:
+            return _done(math.inf, math.inf, mags, oks)
     while hi - lo > tol:  # k-section: k interior points per call
         pts = lo + (hi - lo) * np.arange(1, int(k) + 1) / (k + 1)
         pts = pts[(pts > lo) & (pts < hi)]  # guard against rounding at tiny brackets
         if pts.size == 0:
             break
-        ok = ask(pts)
-        fail = np.flatnonzero(~ok)
-        if fail.size:
-            i = int(fail[0])
-            hi = float(pts[i])
-            lo = float(pts[i - 1]) if i > 0 else lo
-        else:
-            lo = float(pts[-1])
+        lo, hi = _bracket(lo, pts, ask(pts), hi)
     return _done(lo, hi, mags, oks)
+
+
+def _bracket(lo: float, pts: np.ndarray, ok: np.ndarray, hi: float = math.inf,
+             ) -> tuple[float, float]:
+    """The bracket ``(lo, hi)`` after asking the increasing ``pts`` above ``lo``.
+
+    The first failure among them is the new ``hi`` and the point before it
+    (or the old ``lo``) the new ``lo``; if all survive, ``lo`` is the last and
+    ``hi`` stays. The one update of both the grid scan and the k-section.
+    """
+    fail = np.flatnonzero(~ok)
+    if not fail.size:
+        return float(pts[-1]), hi
+    i = int(fail[0])
+    return (float(pts[i - 1]) if i > 0 else lo), float(pts[i])
 
 
 def _deprecated_start(start: float | None, stacklevel: int = 4) -> float | None:
