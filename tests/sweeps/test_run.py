@@ -56,7 +56,9 @@ def test_missing_gait_is_recorded_not_raised(tmp_path):
      ('[[axis]]\nparam = "k"\nfrom = -5\nto = 20\npoints = 3\n', "k ["),
      ('[params]\nk = -3\n[[axis]]\nparam = "r"\nfrom = 0\nto = 1\npoints = 3\n', "k ["),
      ('analyses = ["magic"]\n[[axis]]\nparam = "r"\nvalues = [0.1]\n', "magic"),
-     ('colour = 1\n[[axis]]\nparam = "r"\nvalues = [0.1]\n', "colour")],
+     ('colour = 1\n[[axis]]\nparam = "r"\nvalues = [0.1]\n', "colour"),
+     ('tol = 0.5\n[[axis]]\nparam = "r"\nvalues = [0.1]\n', "tol must be a number in"),
+     ('neutral_tol = "1e-6"\n[[axis]]\nparam = "r"\nvalues = [0.1]\n', "neutral_tol")],
 )
 def test_bad_spec_rejected_with_one_line(tmp_path, toml, needle):
     f = tmp_path / "s.toml"
@@ -74,6 +76,25 @@ def test_toml_roundtrip(tmp_path):
     spec = StudySpec.from_toml(f)
     assert spec.base.k == 30.0 and spec.shape == (5,) and spec.axes[0].values[-1] == 0.5
     assert StudySpec.from_dict(spec.to_dict()) == spec
+
+
+def test_toml_tolerances_reach_the_run_and_its_cache_key(tmp_path):
+    """``tol`` and ``neutral_tol`` in a study's TOML: kept, used, and part of the cache key."""
+    f = tmp_path / "s.toml"
+    f.write_text('name = "tols"\ntol = 1e-7\nneutral_tol = 1e-4\n'
+                 '[[axis]]\nparam = "r"\nvalues = [0.2, 0.3]\n')
+    spec = StudySpec.from_toml(f)
+    assert spec.meta == {"tol": 1e-7, "neutral_tol": 1e-4}
+    assert StudySpec.from_dict(spec.to_dict()).meta == spec.meta
+    res = run_study(spec, tmp_path / "out", workers=1)
+    assert res.meta["tol"] == 1e-7 and res.meta["study"]["neutral_tol"] == 1e-4
+    assert (res.frame["residual"] <= 1e-7).all()
+    # the default tolerance is another study: nothing of the first is reused
+    plain = StudySpec.from_dict({k: v for k, v in spec.to_dict().items()
+                                 if k not in ("tol", "neutral_tol")})
+    assert plain.meta == {}
+    assert run_study(plain, tmp_path / "out", workers=1).meta["computed"] == 2
+    assert run_study(spec, tmp_path / "out", workers=1).meta["computed"] == 0
 
 
 def test_dask_cluster_gives_the_same_results(tmp_path):

@@ -8,6 +8,8 @@ the last axis per value of the first). Specs come from code or from TOML::
     preset = "table2.1"            # base parameters
     analyses = ["floquet", "robustness"]
     n_steps = 25                   # strides a disturbed run must survive
+    tol = 1e-10                    # optional: the gait search's tolerance (default 1e-10)
+    neutral_tol = 1e-6             # optional: Floquet's neutral band (default 1e-6)
 
     [params]                       # overrides of the preset
     k = 25.0
@@ -38,6 +40,9 @@ __all__ = ["Axis", "StudySpec", "ANALYSES", "name_list", "read_spec", "spec_head
 
 #: Analyses a study can run at each point. ``floquet`` is always run.
 ANALYSES = ("floquet", "robustness", "stride")
+#: The tolerances a TOML study may set (kept in ``StudySpec.meta``, read by
+#: :func:`tslip.sweeps.point.gait_tol` and ``floquet_tol``), with their allowed ranges.
+TOLERANCES: dict[str, tuple[float, float]] = {"tol": (1e-14, 1e-4), "neutral_tol": (1e-12, 0.1)}
 #: Memory one study point holds at least: its value and one result row (about 20 numbers
 #: and their labels in a table).
 _POINT_BYTES = 1000.0
@@ -221,6 +226,7 @@ class StudySpec:
         return {
             "name": self.name, "description": self.description,
             "analyses": list(self.analyses), "n_steps": self.n_steps,
+            **{k: self.meta[k] for k in TOLERANCES if k in self.meta},
             "params": self.base.to_dict(),
             "axis": [{"param": a.param, "values": list(a.values)} for a in self.axes],
         }
@@ -229,7 +235,9 @@ class StudySpec:
     def from_dict(cls, data: dict[str, Any]) -> StudySpec:
         """Build from the TOML form (see the module docstring)."""
         data = dict(data)
-        name, base = spec_header(data, "study", {"axis", "analyses", "n_steps"})
+        name, base = spec_header(data, "study", {"axis", "analyses", "n_steps", *TOLERANCES})
+        meta = {k: check_number(data[k], f"study {name}: {k}", lower=lo, upper=hi)
+                for k, (lo, hi) in TOLERANCES.items() if k in data}
         axes_data = data.get("axis")
         if not isinstance(axes_data, list) or not axes_data:
             raise ValueError(f"study {name}: needs at least one [[axis]]")
@@ -238,7 +246,7 @@ class StudySpec:
                              ANALYSES)
         return cls(name=name, base=base, axes=axes, analyses=analyses,
                    n_steps=data.get("n_steps", 25),
-                   description=str(data.get("description", "")))
+                   description=str(data.get("description", "")), meta=meta)
 
     @classmethod
     def from_toml(cls, path: str | Path) -> StudySpec:
