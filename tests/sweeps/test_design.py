@@ -207,6 +207,19 @@ def test_an_interrupted_search_resumes_to_the_identical_designs(tmp_path):
     assert again.meta["computed"] == 0 and again.frame.equals(whole.frame)
 
 
+def test_a_dask_cluster_finds_the_identical_designs(tmp_path):
+    """``scheduler=ADDRESS``: the evaluations run on a Dask cluster (here a local one)."""
+    from dask.distributed import Client, LocalCluster
+
+    spec = _spec(budget=20, population=10)
+    local = tslip.design(spec, None, workers=1)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster, Client(cluster):
+        dask = tslip.design(spec, tmp_path / "d", scheduler=cluster.scheduler_address)
+    assert dask.meta["computed"] == 20
+    assert dask.frame.equals(local.frame)
+
+
 def test_store_ignores_other_code_and_non_data_lines(tmp_path):
     path = tmp_path / "evaluations.jsonl"
     path.write_text(json.dumps({"code": "old", "x": [1.0], "row": {"k": 1.0}}) + "\n"
