@@ -248,21 +248,20 @@ def _first_event(method, P, t, y, ynew, h, K, R, cs, ctl, tsw, active, g_old, g_
     first crossing (``nfev`` right-hand sides). ``k`` is the earliest event
     (-1 if none) at ``t + theta h``.
 
-    ``ws[5]`` holds the sines and cosines of ``ynew`` (the step's last
-    right-hand side was there) until the dense output's extra stages
-    (dop853) overwrite it: the switching functions after the first crossing
-    then read those of the last extra stage.
+    ``g_new`` is complete before any crossing is located: it reads the sines
+    and cosines of ``ynew`` in ``ws[5]`` (the step's last right-hand side was
+    there), which the dense output's extra stages (dop853) overwrite.
     """
     trig = ws[5]
+    for k in range(NEVK):
+        if active[k]:
+            g_new[k] = event_g(P, k, t + h, ynew, cs, tsw, trig)
     theta_ev = 2.0
     k_ev = -1
     nfev = 0
     have_dense = False
     for k in range(NEVK):
-        if not active[k]:
-            continue
-        g_new[k] = event_g(P, k, t + h, ynew, cs, tsw, trig)
-        if g_old[k] > 0.0 and g_new[k] <= 0.0:
+        if active[k] and g_old[k] > 0.0 and g_new[k] <= 0.0:
             if not have_dense:
                 nfev += dense_output(P, method, t, y, ynew, h, K, R, yev, cs, ctl, ws, aux)
                 have_dense = True
