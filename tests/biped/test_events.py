@@ -206,3 +206,67 @@ def test_a_touch_down_anchors_the_foot_on_the_ground_and_a_lift_off_releases_it(
         kind, _, _ = kn.contact_switch(P, y, cs, leg, trig)
         assert kind == pk.EV_LO_R + leg
         assert cs[pk.CS_ON_R + leg] == 0.0
+
+
+
+def _flight_rhs(P, cs, ctl):
+    ws, aux = kn._make_ws(), np.empty(10)
+
+    def f(t, y):
+        out = np.empty(18)
+        kn.rhs(P, t, y, cs, ctl, False, out, ws, aux)
+        return out
+    return f
+
+
+def test_the_first_event_of_a_step_with_two_crossings_is_the_earlier_one():
+    """Event detection in one DOP853 step in which both feet, in flight, cross the
+    ground: the left one first (its leg swinging back, 0.6 -> 0.3 rad), the right
+    one 0.04 of the step later.
+
+    The dense output's extra stages (dop853) call the right-hand side, which keeps
+    its state's sines and cosines in ``ws[5]``, where the switching functions at the
+    step's end read them. Those must be the feet's heights at the step's end
+    (eq. E.8, written out in ``_foot``), and the event the left touch-down at the
+    left foot's crossing, as scipy's DOP853 at 1e-12 with its own event finder
+    locates it on the same right-hand side.
+    """
+    from tslip.biped import _stride
+    from tslip.model._pack import M_DOP853
+
+    p = BipedParams(actuated=False)
+    P = pk.pack_params(p)
+    cs = np.zeros(pk.NCS)  # both feet in flight
+    ctl = np.empty(4)
+    kn.init_ctl(P, 0.0, ctl)
+    y = BipedState.thesis().to_array()
+    y[1], y[2], y[5], y[8] = 0.4048, 0.0, -0.8572, 0.6
+    y[9:] = 0.0
+    y[10], y[17] = -1.0, -6.0  # the hip sinks, the left leg swings back
+    h = 0.05
+    ws, aux = kn._make_ws(), np.empty(10)
+    K, ynew = np.zeros((16, 18)), np.empty(18)
+    kn.rhs(P, 0.0, y, cs, ctl, False, K[0], ws, aux)
+    _stride.rk_step(P, M_DOP853, 0.0, y, h, K, np.empty(18), ynew, cs, ctl, ws, aux)
+
+    def touch_down(leg):
+        def g(t, y):
+            return foot(p, y, leg)[0]
+        g.direction = -1
+        return g
+
+    ref = solve_ivp(_flight_rhs(P, cs, ctl), (0.0, h), y, method="DOP853", rtol=1e-12,
+                    atol=1e-12, events=[touch_down(0), touch_down(1)])
+    t_r, t_l = ref.t_events[0][0], ref.t_events[1][0]
+    assert t_l < t_r - 0.02 * h
+
+    g_old = np.array([foot(p, y, 0)[0], foot(p, y, 1)[0], 1.0, 1.0, 1.0])
+    g_new = np.full(5, np.nan)
+    active = np.array([True, True, False, False, False])
+    k, theta, nfev = _stride._first_event(
+        M_DOP853, P, 0.0, y, ynew, h, K, np.empty((8, 18)), cs, ctl, np.full(2, np.inf),
+        active, g_old, g_new, np.empty(18), np.empty(6), np.empty(5), ws, aux)
+    assert (k, nfev) == (1, 3)
+    assert theta * h == pytest.approx(t_l, abs=1e-6)  # one step of 0.05: 9e-8 off scipy's
+    for leg in range(2):
+        assert g_new[leg] == pytest.approx(foot(p, ynew, leg)[0], abs=1e-14)

@@ -44,9 +44,12 @@ computed there. The steps are ``inline="always"`` into the loop, each with
 one call site, so the loop compiles as one function, as it did when it was
 one body: each function compiled on its own costs a first run some 0.5 s
 of compilation (its own module, optimised again with everything it calls),
-and only :func:`rhs` (eq. E.22, called from every stage) and :func:`_record`
-(only when recording) are. Inlining :func:`rhs` too would make a stride
-faster but compile for over twice as long (see :func:`rk_step`).
+and only :func:`rhs` (eq. E.22, called from every stage), :func:`_record`
+(only when recording) and :func:`dense_output` are. Inlining :func:`rhs` too
+would make a stride faster but compile for over twice as long (see
+:func:`rk_step`); inlining :func:`dense_output` (its extra stages call
+:func:`rhs`) cost some 6 s more compile CPU for the two pairs than compiling
+it on its own.
 """
 
 from __future__ import annotations
@@ -121,7 +124,7 @@ def rk_step(P, method, t, y, h, K, ytmp, ynew, cs, ctl, ws, aux):
         rhs(P, ts, ys, cs, ctl, False, K[s], ws, aux)
 
 
-@njit(**INLINE)
+@njit(**FAST)
 def dense_output(P, method, t, y, ynew, h, K, R, ytmp, cs, ctl, ws, aux):
     """Continuous extension of the step just taken; returns the extra rhs calls."""
     ns = _rk.n_stages(method)
@@ -248,21 +251,20 @@ def _first_event(method, P, t, y, ynew, h, K, R, cs, ctl, tsw, active, g_old, g_
     first crossing (``nfev`` right-hand sides). ``k`` is the earliest event
     (-1 if none) at ``t + theta h``.
 
-    ``ws[5]`` holds the sines and cosines of ``ynew`` (the step's last
-    right-hand side was there) until the dense output's extra stages
-    (dop853) overwrite it: the switching functions after the first crossing
-    then read those of the last extra stage.
+    ``g_new`` is complete before any crossing is located: it reads the sines
+    and cosines of ``ynew`` in ``ws[5]`` (the step's last right-hand side was
+    there), which the dense output's extra stages (dop853) overwrite.
     """
     trig = ws[5]
+    for k in range(NEVK):
+        if active[k]:
+            g_new[k] = event_g(P, k, t + h, ynew, cs, tsw, trig)
     theta_ev = 2.0
     k_ev = -1
     nfev = 0
     have_dense = False
     for k in range(NEVK):
-        if not active[k]:
-            continue
-        g_new[k] = event_g(P, k, t + h, ynew, cs, tsw, trig)
-        if g_old[k] > 0.0 and g_new[k] <= 0.0:
+        if active[k] and g_old[k] > 0.0 and g_new[k] <= 0.0:
             if not have_dense:
                 nfev += dense_output(P, method, t, y, ynew, h, K, R, yev, cs, ctl, ws, aux)
                 have_dense = True
