@@ -153,7 +153,7 @@ def test_results_round_trip_bit_for_bit(tmp_path):
 @pytest.mark.parametrize(("kwargs", "match"), [
     ({"states": {"x": [1.0, 0.0]}}, "strictly increasing"),
     ({"states": {}}, "one to three grids"),
-    ({"actions": {"a": [0.0], "b": [1.0]}}, "dict of one"),
+    ({"actions": {"a": [0.0], "b": [1.0], "c": [2.0]}}, "one or two"),
     ({"actions": "a"}, r"\(name, grid\)"),
     ({"rule": "closest"}, "rule must be one of"),
 ])
