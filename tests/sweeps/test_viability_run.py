@@ -197,3 +197,23 @@ def test_peak_memory_of_a_stored_run_does_not_grow_with_the_map(tmp_path, monkey
         assert res.q.size == 20 * n and res.q.any() and (~res.q).any()
     grown = peaks[800] - peaks[200]
     assert grown < 3 * 20 * 600, (peaks, grown / (20 * 600))
+
+
+def test_a_spec_with_two_actions(tmp_path):
+    """Two ``[actions.<name>]`` tables: the run's map has the two action axes in the order
+    written and equals the in-memory two-action map; the cache keys differ from either
+    action alone."""
+    two = "[actions.alpha_r]\nvalues = [1.1, 1.2, 1.3]\n[actions.k]\nvalues = [20.0, 30.0]\n"
+    path = tmp_path / "two.toml"
+    path.write_text(SLIP.format(n=12).split("[action]")[0] + two)
+    spec = sv.ViabilitySpec.from_toml(path)
+    assert spec.shape == (12, 3, 2) and [a.param for a in spec.action_axes] == ["alpha_r", "k"]
+    res = sv.run_viability(spec, tmp_path / "run", workers=1)
+    assert res.map.action == ("alpha_r", "k") and res.q.shape == (12, 3, 2)
+    ref = viability(state_action_map(spec.base, {"y": spec.states[0].values},
+                                     {"alpha_r": [1.1, 1.2, 1.3], "k": [20.0, 30.0]},
+                                     energy=spec.energy, options=spec.options))
+    _same(ref, res)
+    assert sv.ViabilitySpec.from_dict(spec.to_dict()).action == spec.action
+    path.write_text(SLIP.format(n=12).split("[action]")[0] + two.split("[actions.k]")[0])
+    assert not set(sv.chunk_keys(sv.ViabilitySpec.from_toml(path))) & set(sv.chunk_keys(spec))

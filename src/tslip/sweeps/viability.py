@@ -247,13 +247,18 @@ def _axis_dict(a: Axis) -> dict[str, Any]:
 
 
 def _action(data: dict[str, Any]) -> Axis | tuple[Axis, ...]:
-    """The action: ``[action]`` (with a name), or one or two ``[actions.<name>]`` tables
+    """The action: ``[action]`` (with a name), one or two ``[[action]]`` tables (as
+    :meth:`ViabilitySpec.to_dict` writes two), or one or two ``[actions.<name>]`` tables
     (two: a tuple of axes, in the order written)."""
     if ("action" in data) == ("actions" in data):
         raise ValueError("give the action as [action] (name and values) or as "
                          "[actions.<name>] (values), one of the two")
     if "action" in data:
-        return _grid(data["action"], "[action]")
+        act = data["action"]
+        if isinstance(act, list) and 1 <= len(act) <= 2:  # [[action]] tables, as to_dict
+            axes = tuple(_grid(a, "[[action]]") for a in act)
+            return axes[0] if len(axes) == 1 else axes
+        return _grid(act, "[action]")
     acts = data["actions"]
     if not isinstance(acts, dict) or not 1 <= len(acts) <= 2:
         got = len(acts) if isinstance(acts, dict) else repr(acts)
