@@ -12,6 +12,9 @@ Run by hand (not in CI), one mode at a time:
     each r and cell rule: the share of strides that do not fail, the viable
     volume (share of the state grid), and the slice at phi = 0 / phid = 0 and
     projections, as :class:`tslip.gait.viability.ViableSection` fractions.
+``python benchmarks/bench_viability_3d.py study --n 31 --out DIR``
+    The same on the scale grid below (n^3 states x 41 actions), each r's map
+    out of core in ``DIR/r<r>`` (resumable), on two worker processes.
 ``python benchmarks/bench_viability_3d.py scale --n 20 [--engines pool1,pool2,dask2] [--out DIR]``
     An n x n x n state grid (y in [0.4, 1.4], phi in [-0.2, 0.2], phid in
     [-0.5, 0.5]) x 41 actions (alpha_r in [0.85, 1.25]) at r = 0.3 through
@@ -52,31 +55,36 @@ def params(r: float):  # noqa: ANN201
     return dataclasses.replace(tslip.preset("table2.1"), omega_r=0.0, r=r)
 
 
-def study() -> None:
+def study(n: int | None = None, out: str | None = None) -> None:
     from tslip.gait.viability import state_action_map, viability
 
-    g = grid(26, 11, 11)
-    acts = ("alpha_r", np.linspace(0.85, 1.25, 21))
-    print(f"E = {E} MgL; y {g['y'][0]}..{g['y'][-1]} ({len(g['y'])}), phi ±0.2 (11), "
-          f"phid ±0.5 (11), alpha_r 0.85..1.25 (21)")
     print(f"{'r':>5} {'rule':>8} {'no fall':>8} {'volume':>7} {'pairs':>7} "
           f"{'phi=0':>7} {'phid=0':>7} {'proj phi':>8} {'proj phid':>9} {'sweeps':>6}")
     for r in (-0.3, 0.0, 0.3, 0.6):
-        m = state_action_map(params(r), g, acts, energy=E)
+        if n is None:
+            g = grid(26, 11, 11)
+            m = state_action_map(params(r), g, ("alpha_r", np.linspace(0.85, 1.25, 21)),
+                                 energy=E)
+        else:  # the scale grid, out of core, one folder per r
+            from tslip.sweeps.viability import run_viability
+
+            m = run_viability(_spec(n, r), f"{out}/r{r:+.1f}" if out else None,
+                              workers=2).map
+        failed = m.failed
         for rule in ("bracket", "nearest", "vibly"):
             v = viability(m, rule)
-            print(f"{r:5.1f} {rule:>8} {1 - m.failed.mean():8.4f} {v.volume_fraction:7.4f} "
+            print(f"{r:5.1f} {rule:>8} {1 - failed.mean():8.4f} {v.volume_fraction:7.4f} "
                   f"{v.viable_fraction:7.4f} {v.slice('phi').fraction:7.4f} "
                   f"{v.slice('phid').fraction:7.4f} {v.projection('phi').fraction:8.4f} "
                   f"{v.projection('phid').fraction:9.4f} {v.sweeps:6d}", flush=True)
 
 
-def _spec(n: int):  # noqa: ANN202
+def _spec(n: int, r: float = 0.3):  # noqa: ANN202
     from tslip.sweeps.spec import Axis
     from tslip.sweeps.viability import ViabilitySpec
 
     g = grid(n, n, n)
-    return ViabilitySpec(name=f"scale{n}", base=params(0.3),
+    return ViabilitySpec(name=f"scale{n}", base=params(r),
                          states=tuple(Axis(k, tuple(float(x) for x in v)) for k, v in g.items()),
                          action=Axis("alpha_r", tuple(float(x) for x in
                                                       np.linspace(0.85, 1.25, 41))),
@@ -179,17 +187,19 @@ def _own_peak() -> float:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("mode", choices=("study", "scale"))
-    ap.add_argument("--n", type=int, default=20, help="state grid points per axis (scale)")
+    ap.add_argument("--n", type=int, default=None,
+                    help="state grid points per axis (scale: default 20; study: default the "
+                         "26 x 11 x 11 grid in memory)")
     ap.add_argument("--engines", default="pool1,pool2,dask2",
                     help="comma-separated: poolN (N worker processes), dask2 (scale)")
     ap.add_argument("--out", default=None,
-                    help="keep each engine's run in OUT/<engine> (rerun to resume after an "
-                         "interruption; default: a temporary folder)")
+                    help="keep each run in OUT/<engine> (scale) or OUT/r<r> (study): rerun "
+                         "to resume after an interruption (default: a temporary folder)")
     args = ap.parse_args()
     if args.mode == "study":
-        study()
+        study(args.n, args.out)
     else:
-        run_scale(args.n, args.engines.split(","), args.out)
+        run_scale(args.n or 20, args.engines.split(","), args.out)
 
 
 if __name__ == "__main__":

@@ -144,8 +144,13 @@ class ViabilitySpec:
         if self.rule not in RULES:
             raise ValueError(f"rule must be one of {list(RULES)}, got {self.rule!r}")
         check_number(self.energy, "energy [MgL]", lower=0.0, lower_open=True)
-        if isinstance(self.action, tuple) and not 1 <= len(self.action) <= 2:
-            raise ValueError(f"action must be one or two axes, got {len(self.action)}")
+        if isinstance(self.action, tuple):
+            names = [a.param for a in self.action]
+            if not 1 <= len(names) <= 2 or len(set(names)) != len(names):
+                raise ValueError(f"action must be one or two axes of different parameters, "
+                                 f"got {names}")
+            if len(names) == 1:
+                object.__setattr__(self, "action", self.action[0])
         check_map_inputs(self.base, {a.param: a.values for a in self.states},
                          self.actions(), self.energy)
 
