@@ -261,8 +261,7 @@ def _action(data: dict[str, Any]) -> Axis | tuple[Axis, ...]:
     if "action" in data:
         act = data["action"]
         if isinstance(act, list) and 1 <= len(act) <= 2:  # [[action]] tables, as to_dict
-            axes = tuple(_grid(a, "[[action]]") for a in act)
-            return axes[0] if len(axes) == 1 else axes
+            return tuple(_grid(a, "[[action]]") for a in act)  # one: the spec's Axis
         return _grid(act, "[action]")
     acts = data["actions"]
     if not isinstance(acts, dict) or not 1 <= len(acts) <= 2:
