@@ -153,7 +153,7 @@ def test_results_round_trip_bit_for_bit(tmp_path):
 @pytest.mark.parametrize(("kwargs", "match"), [
     ({"states": {"x": [1.0, 0.0]}}, "strictly increasing"),
     ({"states": {}}, "one to three grids"),
-    ({"actions": {"a": [0.0], "b": [1.0]}}, "dict of one"),
+    ({"actions": {"a": [0.0], "b": [1.0], "c": [2.0]}}, "one or two"),
     ({"actions": "a"}, r"\(name, grid\)"),
     ({"rule": "closest"}, "rule must be one of"),
 ])
@@ -389,3 +389,78 @@ def test_basin_over_two_section_variables_keeps_the_slip_pitch_rate():
     assert two.steps.shape == (6, 3)
     assert np.array_equal(two.steps[:, 1], one.steps) and one.converged.any()
     assert not two.converged[:, [0, 2]].any()
+
+
+def _bracket_needs(grid: np.ndarray, x: float) -> set[int] | None:
+    """The grid points a successor ``x`` needs viable under the bracket rule, written out:
+    on a grid point (within 1e-9 of a spacing) that point, between two points both, NaN or
+    outside the grid never (None)."""
+    if math.isnan(x) or x < grid[0] - 1e-9 * (grid[1] - grid[0]) or x > grid[-1]:
+        return None
+    near = [i for i, g in enumerate(grid) if abs(x - g) <= 1e-9 * (grid[1] - grid[0])]
+    if near:
+        return {near[0]}
+    i = int(np.searchsorted(grid, x))
+    return {i - 1, i}
+
+
+def test_two_actions_against_scipy_and_a_brute_force_kernel():
+    """Two actions, the leg angle and the stiffness (issue 28): every cell of a small SLIP
+    map over y x alpha_r x k equals the scipy stride above (to 1e-9, with the stiffness of
+    its column; failures agree), and the viable pairs equal a greatest fixed point found by
+    brute force in plain Python over the scipy successors (the bracket rule written out)."""
+    import dataclasses
+
+    import tslip
+    from tslip.gait.viability import state_action_map
+
+    p = tslip.preset("slip")
+    ys, alphas, ks = np.linspace(0.9, 2.2, 10), np.linspace(1.05, 1.4, 5), [20.0, 30.0]
+    m = state_action_map(p, {"y": ys}, {"alpha_r": alphas, "k": ks}, energy=E_SLIP)
+    assert m.shape == (10, 5, 2) and m.action == ("alpha_r", "k") and m.n_actions == 10
+    want = np.array([[[scipy_slip_apex(dataclasses.replace(p, k=k), y, a, E_SLIP) for k in ks]
+                      for a in alphas] for y in ys])
+    assert np.array_equal(np.isnan(want), m.failed)
+    assert np.nanmax(np.abs(m.next[..., 0] - want)) < 1e-9
+    live = {c for c in itertools.product(range(10), range(5), range(2))
+            if _bracket_needs(ys, want[c]) is not None}
+    while True:
+        states = {c[0] for c in live}
+        kept = {c for c in live if _bracket_needs(ys, want[c]) <= states}  # type: ignore[operator]
+        if kept == live:
+            break
+        live = kept
+    q = np.zeros(m.shape, dtype=bool)
+    for c in live:
+        q[c] = True
+    v = viability(m, "bracket")
+    assert 0 < q.sum() < (~m.failed).sum()  # some pairs viable, some surviving pairs not
+    assert np.array_equal(v.q, q) and np.array_equal(v.s, q.any(axis=(1, 2)))
+
+
+def test_omega_r_with_the_apex_clock_as_a_second_action():
+    """``{"alpha_r": ..., "omega_r": ...}`` with ``retraction="apex"``: each omega_r column
+    of the map is the one-action map at that retraction rate, bit for bit (the action axes
+    in the order given); the lift-off clock is refused, since it is not an apex section."""
+    import dataclasses
+
+    import tslip
+    from tslip.gait.viability import state_action_map
+
+    p = dataclasses.replace(tslip.preset("table2.1"), retraction="apex")
+    grid = {"y": [1.0, 1.2], "phid": [0.0, 0.3]}
+    alphas, rates = [1.0, 1.1, 1.2], [0.0, 2.0]
+    m = state_action_map(p, grid, {"alpha_r": alphas, "omega_r": rates}, energy=14.0)
+    assert m.shape == (2, 2, 3, 2)
+    for j, w in enumerate(rates):
+        one = state_action_map(dataclasses.replace(p, omega_r=w), grid, ("alpha_r", alphas),
+                               energy=14.0)
+        assert m.next[..., j, :].tobytes() == one.next.tobytes()
+        assert np.array_equal(m.status[..., j], one.status)
+    assert not np.array_equal(m.next[..., 0, :], m.next[..., 1, :], equal_nan=True)
+    swapped = state_action_map(p, grid, {"omega_r": rates, "alpha_r": alphas}, energy=14.0)
+    assert swapped.next.tobytes() == np.swapaxes(m.next, 2, 3).tobytes()
+    with pytest.raises(ValueError, match="Poincare section") as exc:
+        state_action_map(dataclasses.replace(p, retraction="liftoff"), grid,
+                         {"alpha_r": alphas, "omega_r": rates}, energy=14.0)
+    assert "\n" not in str(exc.value)

@@ -42,8 +42,9 @@ def viability_cmd(
     "nearest"); optional \\[params] overrides and \\[options] (IntegratorOptions);
     one to three \\[\\[state]] apex variables (the height "y", and "phi" and/or
     "phid"; each a name with from/to/points or values) and one \\[action] (a
-    parameter, e.g. name = "alpha_r", with its values), or \\[actions.alpha_r]
-    with its values.
+    parameter, e.g. name = "alpha_r", with its values), or one or two
+    \\[actions.<name>] tables with their values (e.g. \\[actions.alpha_r] and
+    \\[actions.omega_r]).
     Example and meaning: the documentation page "Viability and basins of
     attraction" (docs/analyses/viability.md).
 

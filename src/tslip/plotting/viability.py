@@ -3,8 +3,8 @@
 :func:`plot_viability` draws the state-action grid as vibly does: each cell
 coloured by whether its stride fails at once, survives it but leads out of
 the viable set, or is viable; for two state variables, the viable states
-coloured by the share of viable actions; for three, the projection over the
-last (:meth:`tslip.gait.viability.Viability.projection`).
+coloured by the share of viable actions (of action pairs, for two actions);
+for three, the projection over the last (:meth:`tslip.gait.viability.Viability.projection`).
 :func:`plot_section` draws a 3-D result's slice or projection, labelled as
 which it is. :func:`plot_basin` draws the
 strides to reach the gait over the start grid, falls marked.
@@ -69,20 +69,28 @@ def plot_viability(result: Viability, ax: Axes | None = None) -> Figure:
         return plot_section(result.projection(m.names[2]), ax=ax)
     fig, ax = _fig(ax)
     energy = "" if np.isnan(m.energy) else f" at E = {m.energy:.4g} MgL"
+    first = m.action_names[0]
     if len(m.names) == 1:
-        cls = np.where(m.failed, 0, np.where(result.q, 2, 1))
-        ax.pcolormesh(_edges(m.actions), _edges(m.grid[0]), cls, cmap=_CELLS, vmin=0, vmax=2)
-        ax.set_xlabel(_label(m.action))
+        # two actions: a cell over the first is viable for some value of the second, and
+        # fails at once if it does for every value
+        over = tuple(range(2, result.q.ndim))
+        failed, q = m.failed.all(axis=over), result.q.any(axis=over)
+        cls = np.where(failed, 0, np.where(q, 2, 1))
+        ax.pcolormesh(_edges(m.action_grids[0]), _edges(m.grid[0]), cls, cmap=_CELLS, vmin=0,
+                      vmax=2)
+        more = m.action_names[1:]
+        ax.set_xlabel(_label(first) + (f" (for some {more[0]})" if more else ""))
         ax.set_ylabel(_label(m.names[0]))
         kinds = ("fails at once", "not viable (fails later or leaves the grid)", "viable")
         ax.legend(handles=[Patch(color=_CELLS(i), label=t) for i, t in enumerate(kinds)],
                   loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=3, fontsize=8,
                   frameon=False)  # below the cells, never on them
     else:
-        share = np.where(result.s, result.q.mean(axis=-1), np.nan)
+        share = np.where(result.s, result.q.reshape(result.s.shape + (-1,)).mean(axis=-1),
+                         np.nan)
         mesh = ax.pcolormesh(_edges(m.grid[1]), _edges(m.grid[0]), share, cmap="Greens",
                              vmin=0, vmax=1)
-        fig.colorbar(mesh, ax=ax, label=f"share of viable {m.action}")
+        fig.colorbar(mesh, ax=ax, label=f"share of viable {' x '.join(m.action_names)}")
         ax.set_xlabel(_label(m.names[1]))
         ax.set_ylabel(_label(m.names[0]))
     ax.set_title(f"viability ({result.rule}){energy}: {100 * result.viable_fraction:.1f} % "

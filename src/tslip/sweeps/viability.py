@@ -16,11 +16,15 @@ else is computed again). The cache key
 hashes the base parameters, energy, options, the chunk's states and
 actions and the code behind them, so an interrupted run resumes with the
 missing chunks, a finished one reruns instantly, and any worker count
-gives the same bytes (every cell is computed on its own). The viability
-iteration then runs here on the whole map (it is cheap) and the result is
-written to ``results.parquet`` and its record ``results.json``
-(:meth:`tslip.gait.viability.Viability.save`)
-with ``run.json``; one run at a time per folder (``.lock``)::
+gives the same bytes (every cell is computed on its own). The map then
+stays on disk: the result's ``map`` is a
+:class:`tslip.gait.viability.StoredMap` of ``cache/`` (chunks read on
+demand), the viability iteration sweeps its int32 successor cells through a
+memory-mapped file, and the result is written to ``results.parquet`` (a
+block of chunks at a time) and its record ``results.json``
+(:meth:`tslip.gait.viability.Viability.save`) with ``run.json``: this
+process holds the viable pairs (one byte a pair), never the map. One run at
+a time per folder (``.lock``)::
 
     name = "slip"
     preset = "slip"
@@ -49,7 +53,9 @@ with ``run.json``; one run at a time per folder (``.lock``)::
     points = 100
 
 The action may also be written ``[actions.alpha_r]`` with ``values = [...]``
-or ``from``/``to``/``points`` (one action).
+or ``from``/``to``/``points``; two such tables give two actions (the map's
+last axes, in the order written), e.g. ``[actions.alpha_r]`` and
+``[actions.omega_r]`` with ``[params] retraction = "apex"``.
 """
 
 from __future__ import annotations
@@ -59,7 +65,6 @@ import hashlib
 import io
 import json
 import time
-import zipfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -72,7 +77,15 @@ from .._checks import check_name, check_number
 from .._codehash import code_hash
 from .._io import atomic_write, git_hash, write_json
 from ..gait._viable import RULES
-from ..gait.viability import StateActionMap, Viability, check_map_inputs, map_cells, viability
+from ..gait.viability import (
+    StateActionMap,
+    StoredMap,
+    Viability,
+    check_map_inputs,
+    map_cells,
+    read_chunk,
+    viability,
+)
 from ..model.parameters import Params, preset
 from ..simulation.options import IntegratorOptions
 from . import _pool
@@ -120,7 +133,7 @@ class ViabilitySpec:
     name: str
     base: Params
     states: tuple[Axis, ...]
-    action: Axis
+    action: Axis | tuple[Axis, ...]
     energy: float
     rule: str = "bracket"
     options: IntegratorOptions = field(default_factory=lambda: IntegratorOptions.tight("dop853"))
@@ -131,27 +144,54 @@ class ViabilitySpec:
         if self.rule not in RULES:
             raise ValueError(f"rule must be one of {list(RULES)}, got {self.rule!r}")
         check_number(self.energy, "energy [MgL]", lower=0.0, lower_open=True)
+        if isinstance(self.action, tuple):
+            names = [a.param for a in self.action]
+            if not 1 <= len(names) <= 2 or len(set(names)) != len(names):
+                raise ValueError(f"action must be one or two axes of different parameters, "
+                                 f"got {names}")
+            if len(names) == 1:
+                object.__setattr__(self, "action", self.action[0])
         check_map_inputs(self.base, {a.param: a.values for a in self.states},
-                         (self.action.param, self.action.values), self.energy)
+                         self.actions(), self.energy)
+
+    @property
+    def action_axes(self) -> tuple[Axis, ...]:
+        """The actions (one or two), in the order of the map's action axes."""
+        return self.action if isinstance(self.action, tuple) else (self.action,)
+
+    def actions(self) -> dict[str, np.ndarray]:
+        """The actions as :func:`tslip.gait.viability.state_action_map` takes them."""
+        return {a.param: np.asarray(a.values, dtype=float) for a in self.action_axes}
 
     @property
     def shape(self) -> tuple[int, ...]:
-        """(*state grid shape, n_actions)."""
-        return tuple(len(a.values) for a in self.states) + (len(self.action.values),)
+        """(*state grid shape, *action grid shape)."""
+        return tuple(len(a.values) for a in self.states + self.action_axes)
 
     @property
     def n_cells(self) -> int:
         return int(np.prod(self.shape))
 
-    def points(self) -> np.ndarray:
-        """Every state point of the grid, C order, shape (n_states, n_names)."""
-        mesh = np.meshgrid(*[np.asarray(a.values) for a in self.states], indexing="ij")
-        return np.stack([m.ravel() for m in mesh], axis=1)
+    @property
+    def n_actions(self) -> int:
+        """Action grid points (the product over the actions)."""
+        return int(np.prod([len(a.values) for a in self.action_axes]))
+
+    @property
+    def n_states(self) -> int:
+        return int(np.prod([len(a.values) for a in self.states]))
+
+    def points(self, rows: slice | None = None) -> np.ndarray:
+        """State points of the grid, C order, shape (n, n_names): all, or the ``rows``."""
+        shape = tuple(len(a.values) for a in self.states)
+        idx = np.unravel_index(np.arange(self.n_states)[rows or slice(None)], shape)
+        return np.stack([np.asarray(a.values, dtype=float)[i]
+                         for a, i in zip(self.states, idx)], axis=1)
 
     def chunks(self) -> list[slice]:
         """Slices of :meth:`points`, about :data:`CHUNK_CELLS` cells each."""
-        n = len(self.points())
-        per = max(1, CHUNK_CELLS // len(self.action.values))
+        n = self.n_states
+        per = max(1, CHUNK_CELLS // self.n_actions)
         return [slice(i, min(i + per, n)) for i in range(0, n, per)]
 
     def to_dict(self) -> dict[str, Any]:
@@ -159,7 +199,8 @@ class ViabilitySpec:
                 "rule": self.rule, "params": self.base.to_dict(),
                 "options": dataclasses.asdict(self.options),
                 "state": [{"name": a.param, "values": list(a.values)} for a in self.states],
-                "action": {"name": self.action.param, "values": list(self.action.values)}}
+                "action": (_axis_dict(self.action) if isinstance(self.action, Axis) else
+                           [_axis_dict(a) for a in self.action])}
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> ViabilitySpec:
@@ -206,22 +247,32 @@ class ViabilitySpec:
 _TIGHT = {"rtol": 1e-12, "atol": 1e-12, "method": "dop853"}
 
 
-def _action(data: dict[str, Any]) -> Axis:
-    """The action: ``[action]`` (with a name) or ``[actions.<name>]`` (one entry)."""
+def _axis_dict(a: Axis) -> dict[str, Any]:
+    return {"name": a.param, "values": list(a.values)}
+
+
+def _action(data: dict[str, Any]) -> Axis | tuple[Axis, ...]:
+    """The action: ``[action]`` (with a name), one or two ``[[action]]`` tables (as
+    :meth:`ViabilitySpec.to_dict` writes two), or one or two ``[actions.<name>]`` tables
+    (two: a tuple of axes, in the order written)."""
     if ("action" in data) == ("actions" in data):
         raise ValueError("give the action as [action] (name and values) or as "
                          "[actions.<name>] (values), one of the two")
     if "action" in data:
-        return _grid(data["action"], "[action]")
+        act = data["action"]
+        if isinstance(act, list) and 1 <= len(act) <= 2:  # [[action]] tables, as to_dict
+            return tuple(_grid(a, "[[action]]") for a in act)  # one: the spec's Axis
+        return _grid(act, "[action]")
     acts = data["actions"]
-    if not isinstance(acts, dict) or len(acts) != 1:
+    if not isinstance(acts, dict) or not 1 <= len(acts) <= 2:
         got = len(acts) if isinstance(acts, dict) else repr(acts)
-        raise ValueError("[actions] must hold one [actions.<name>] table (two actions are "
-                         f"not supported yet), got {got}")
-    (name, table), = acts.items()
-    if not isinstance(table, dict) or "name" in table:
-        raise ValueError(f"[actions.{name}] must be a table of values or from/to/points")
-    return _grid({"name": name, **table}, f"[actions.{name}]")
+        raise ValueError(f"[actions] must hold one or two [actions.<name>] tables, got {got}")
+    axes = []
+    for name, table in acts.items():
+        if not isinstance(table, dict) or "name" in table:
+            raise ValueError(f"[actions.{name}] must be a table of values or from/to/points")
+        axes.append(_grid({"name": name, **table}, f"[actions.{name}]"))
+    return axes[0] if len(axes) == 1 else tuple(axes)
 
 
 def _prefix(spec: ViabilitySpec) -> Any:
@@ -234,11 +285,11 @@ def _prefix(spec: ViabilitySpec) -> Any:
 
 def chunk_keys(spec: ViabilitySpec) -> list[str]:
     """Cache key of each chunk of :meth:`ViabilitySpec.chunks`."""
-    prefix, pts = _prefix(spec), spec.points()
+    prefix = _prefix(spec)
     out = []
     for sl in spec.chunks():
         h = prefix.copy()
-        h.update(np.ascontiguousarray(pts[sl]).tobytes())
+        h.update(np.ascontiguousarray(spec.points(sl)).tobytes())
         out.append(h.hexdigest()[:24])
     return out
 
@@ -246,20 +297,21 @@ def chunk_keys(spec: ViabilitySpec) -> list[str]:
 def saved_cells(spec: ViabilitySpec, out_dir: str | Path) -> int:
     """How many of the spec's cells ``out_dir/cache`` holds."""
     names = _cached_names(Path(out_dir) / "cache")
-    n_a = len(spec.action.values)
-    return sum((sl.stop - sl.start) * n_a for sl, k in zip(spec.chunks(), chunk_keys(spec))
-               if f"{k}.npz" in names)
+    return sum((sl.stop - sl.start) * spec.n_actions
+               for sl, k in zip(spec.chunks(), chunk_keys(spec)) if f"{k}.npz" in names)
 
 
-def _chunk_task(spec: ViabilitySpec, points: np.ndarray, key: str, cache: str | None,
-                tick: Callable[[int], None] | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """One chunk's cells (in a worker or here), cached as soon as they are done."""
-    nxt, status = map_cells(spec.base, [a.param for a in spec.states], points,
-                            (spec.action.param, np.asarray(spec.action.values)), spec.energy,
-                            spec.options)
+def _chunk_task(spec: ViabilitySpec, rows: slice, key: str, cache: str | None,
+                tick: Callable[[int], None] | None = None
+                ) -> tuple[np.ndarray, np.ndarray] | None:
+    """One chunk's cells (in a worker or here): written to ``cache`` as soon as they are
+    done (then None comes back: the parent reads the store), else returned."""
+    nxt, status = map_cells(spec.base, [a.param for a in spec.states], spec.points(rows),
+                            spec.actions(), spec.energy, spec.options)
+    (tick or _pool.notify)(int(status.size))
     if cache is not None:
         _write_chunk(Path(cache) / f"{key}.npz", nxt, status)
-    (tick or _pool.notify)(int(status.size))
+        return None
     return nxt, status
 
 
@@ -270,34 +322,18 @@ def _write_chunk(path: Path, nxt: np.ndarray, status: np.ndarray) -> None:
     atomic_write(path, lambda tmp: Path(tmp).write_bytes(buf.getvalue()))
 
 
-def read_chunk(path: str | Path, n_points: int, n_actions: int,
-               n_names: int) -> tuple[np.ndarray, np.ndarray] | None:
-    """A cached chunk's ``(next, status)``, or None if it is not exactly that data.
-
-    Data only: read with ``allow_pickle=False`` (an object array is refused),
-    the two arrays and nothing else, ``next`` float64 of shape
-    ``(n_points, n_actions, n_names)`` and ``status`` an integer array of
-    shape ``(n_points, n_actions)``. Anything else (damaged, foreign, a
-    pickle) is None: the chunk is computed again.
-    """
-    try:
-        with open(path, "rb") as f, np.load(f, allow_pickle=False) as z:
-            if sorted(z.files) != ["next", "status"]:
-                return None
-            nxt, status = z["next"], z["status"]
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
-        return None
-    if (nxt.dtype != np.float64 or status.dtype.kind not in "iu"
-            or nxt.shape != (n_points, n_actions, n_names)
-            or status.shape != (n_points, n_actions)):
-        return None
-    return nxt, status.astype(np.int64)
-
-
 def run_viability(spec: ViabilitySpec, out_dir: str | Path | None = None, *,
                   workers: int | None = None, progress: Progress | None = None,
                   wait: bool = False, scheduler: str | None = None) -> Viability:
     """Compute (or resume) the spec's state-action map and its viability kernel.
+
+    With ``out_dir`` the map stays on disk: the result's ``map`` is a
+    :class:`tslip.gait.viability.StoredMap` of ``out_dir/cache`` (chunks read
+    on demand), the iteration sweeps the map's int32 cells from a memory-mapped
+    file, and ``results.parquet`` is written a block of chunks at a time, so
+    this process holds the viable pairs (one byte a pair) and a block's
+    temporaries, not the map. Without ``out_dir`` the map is held in memory
+    (a :class:`tslip.gait.viability.StateActionMap`), as for small grids.
 
     Parameters
     ----------
@@ -338,10 +374,9 @@ def _run(spec: ViabilitySpec, out: Path | None, n_workers: int | None,
     t0 = time.perf_counter()
     cache = out / "cache" if out is not None else None
     names = _cached_names(cache)
-    pts, n_a, total = spec.points(), len(spec.action.values), spec.n_cells
-    d = len(spec.states)
-    nxt = np.full((len(pts), n_a, d), np.nan)
-    status = np.zeros((len(pts), n_a), dtype=np.int64)
+    n_a, total, d = spec.n_actions, spec.n_cells, len(spec.states)
+    slices, keys = spec.chunks(), chunk_keys(spec)
+    held: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # the map, without a store only
     state = {"done": 0}
 
     def tick(n: int) -> None:
@@ -350,39 +385,52 @@ def _run(spec: ViabilitySpec, out: Path | None, n_workers: int | None,
             progress(min(state["done"], total), total)
 
     tasks = []
-    for sl, key in zip(spec.chunks(), chunk_keys(spec)):
-        got = (read_chunk(cache / f"{key}.npz", sl.stop - sl.start, n_a, d)  # type: ignore[operator]
-               if f"{key}.npz" in names else None)
-        if got is not None:
-            nxt[sl], status[sl] = got
-            state["done"] += got[1].size
-            continue
+    for i, (sl, key) in enumerate(zip(slices, keys)):
         n = (sl.stop - sl.start) * n_a
+        if cache is not None and f"{key}.npz" in names and read_chunk(
+                cache / f"{key}.npz", sl.stop - sl.start, n_a, d) is not None:
+            state["done"] += n
+            continue
         here = cache is not None and scheduler is None  # on Dask: cached here, on arrival
         tasks.append(Task((spec.name, sl.start), _chunk_task,
-                          (spec, pts[sl], key, str(cache) if here else None),
-                          cost=n * CELL_SECONDS, meta={"slice": sl, "key": key}))
+                          (spec, sl, key, str(cache) if here else None),
+                          cost=n * CELL_SECONDS, meta={"i": i, "key": key}))
     n_cached = state["done"]
     if progress:
         progress(n_cached, total)
 
-    def on_done(task: Task, result: tuple[np.ndarray, np.ndarray]) -> list[Task]:
-        sl = task.meta["slice"]
-        nxt[sl], status[sl] = result
+    def on_done(task: Task, result: tuple[np.ndarray, np.ndarray] | None) -> list[Task]:
+        if result is None:  # in the store already
+            return []
+        if cache is None:
+            held[task.meta["i"]] = result
+        else:
+            _write_chunk(cache / f"{task.meta['key']}.npz", *result)
         if scheduler is not None:
-            if cache is not None:
-                _write_chunk(cache / f"{task.meta['key']}.npz", *result)
             tick(int(result[1].size))
         return []
 
     workers = (1 if scheduler is not None else
                choose_workers(sum(t.cost for t in tasks), n_workers, width=len(tasks)))
     run_tasks(tasks, on_done, workers, tick=tick, scheduler=scheduler)
-    smap = StateActionMap(tuple(a.param for a in spec.states),
-                          tuple(np.asarray(a.values, dtype=float) for a in spec.states),
-                          spec.action.param, np.asarray(spec.action.values, dtype=float),
-                          nxt.reshape(spec.shape + (d,)), status.reshape(spec.shape),
-                          spec.energy, spec.base, {"options": spec.to_dict()["options"]})
+    grid = tuple(np.asarray(a.values, dtype=float) for a in spec.states)
+    anames = tuple(a.param for a in spec.action_axes)
+    agrids = tuple(np.asarray(a.values, dtype=float) for a in spec.action_axes)
+    action: Any = anames[0] if len(anames) == 1 else anames
+    actions: Any = agrids[0] if len(agrids) == 1 else agrids
+    meta = {"options": spec.to_dict()["options"]}
+    smap: StateActionMap | StoredMap
+    if cache is None:
+        parts = [held[i] for i in range(len(slices))]
+        smap = StateActionMap(tuple(a.param for a in spec.states), grid, action, actions,
+                              np.concatenate([p[0] for p in parts]).reshape(spec.shape + (d,)),
+                              np.concatenate([p[1] for p in parts]).reshape(spec.shape),
+                              spec.energy, spec.base, meta)
+    else:
+        smap = StoredMap(tuple(a.param for a in spec.states), grid, action, actions,
+                         cache, tuple(f"{k}.npz" for k in keys),
+                         tuple(sl.stop - sl.start for sl in slices), spec.energy, spec.base,
+                         meta)
     result = viability(smap, spec.rule)
     if out is not None:
         result.save(out / "results.parquet")
