@@ -468,12 +468,10 @@ class GaitProblem:
         dqn[:, i_alpha] += _packed.alpha_r_column(P, out)
         if i_ref >= 0:
             h = 1e-5 * max(1.0, abs(ref))
-            o_plus = self._stride((delta, phi, phid, x[3], ref + h))
-            o_minus = self._stride((delta, phi, phid, x[3], ref - h))
-            if o_plus[2] != Status.OK or o_minus[2] != Status.OK:
+            column = self._ref_column(P, q, ref, h)
+            if column is None:
                 return r, np.full((5, n), math.nan)
-            dqn[:, i_ref] += (o_plus[3][pk.OUT_TD : pk.OUT_TD + 5]
-                              - o_minus[3][pk.OUT_TD : pk.OUT_TD + 5]) / (2.0 * h)
+            dqn[:, i_ref] += column
         # r = (beta', phi' - phi, phid' - phid, atan2(yd', xd') - delta, |v'| - v0)
         _, _, xd, yd, _ = out[pk.OUT_TD : pk.OUT_TD + 5].tolist()
         v2 = xd * xd + yd * yd
@@ -491,6 +489,24 @@ class GaitProblem:
         for k, g in dv:
             Jr[4, k] -= g
         return r, Jr
+
+    def _ref_column(self, P: np.ndarray, q: np.ndarray, ref: float, h: float
+                    ) -> np.ndarray | None:
+        """``dq'/d ref`` by a central difference of step ``h``; None if a stride fails.
+
+        The strides start from the section ``q`` of the stride at ``ref`` with
+        ``P`` as :meth:`_stride` wrote it, only ``P_C0`` changed (as ``_stride``
+        writes it for ``ref +- h``).
+        """
+        Pd = P.copy()
+        ends = []
+        for value in (ref + h, ref - h):
+            Pd[pk.P_C0] = self._ref_gain * value
+            out = _NAN_OUT.copy()
+            if _packed.stride_map(Pd, self._O, q, 0.0, out) != Status.OK:
+                return None
+            ends.append(out[pk.OUT_TD : pk.OUT_TD + 5])
+        return (ends[0] - ends[1]) / (2.0 * h)
 
     def residual(self, z: Sequence[float] | np.ndarray) -> np.ndarray:
         """Periodicity residual (5,) at ``z``; the Newton search's function."""
