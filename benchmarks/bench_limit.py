@@ -25,9 +25,9 @@ Definitions:
   in a compiled loop. :data:`N_RHS` = 146 is frozen: the right-hand sides
   (accepted and rejected steps, 6 per dopri5 step, plus the initial-step
   estimate; no dense-output stages) that the kernel of revision 3b38fb1 spends
-  on this stride. Today's count is printed beside it (counted exactly by running
-  one stride as plain Python, ``NUMBA_DISABLE_JIT=1``, in a subprocess, with a
-  counting ``rhs``), so a kernel taking fewer steps shows as a gain.
+  on this stride. Today's count is printed beside it (counted exactly by
+  ``_rhs_count.py``: the stride as plain Python in a subprocess, every call of
+  ``rhs`` counted), so a kernel taking fewer steps shows as a gain.
 * **unrecorded strides**: the same ``--steps`` strides through the compiled
   batch kernel without recording, one :func:`tslip.run_batch` call.
 * **simulate**: :func:`tslip.simulate` of those strides at ``dt = --dt``;
@@ -45,15 +45,13 @@ Definitions:
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import subprocess
-import sys
 import time
 
 import numba
 import numpy as np
 from _baseline import ab
+from _rhs_count import rhs_per_stride
 from numba import njit
 
 import tslip
@@ -63,32 +61,6 @@ from tslip.simulation import _stance
 #: Right-hand sides of the Table 6.1 stride at dopri5 1e-8 with the kernel of
 #: revision 3b38fb1 (frozen: the limit does not move when the kernel takes fewer steps).
 N_RHS = 146
-
-_COUNT = """
-import json, sys, tslip
-from tslip.simulation import _stance
-calls = [0]
-rhs = _stance.rhs
-def counting(*a):
-    calls[0] += 1
-    rhs(*a)
-for name, mod in list(sys.modules.items()):
-    if name.startswith("tslip.simulation") and getattr(mod, "rhs", None) is rhs:
-        mod.rhs = counting
-g = tslip.find_gait(tslip.preset("table6.1"))
-calls[0] = 0
-tslip.step_map(g.params, g.state.section())
-print(json.dumps(calls[0]))
-"""
-
-
-def rhs_count() -> int:
-    """Stance right-hand sides of one stride of the gait today (plain Python, counted)."""
-    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
-    out = subprocess.run([sys.executable, "-c", _COUNT], env=env, capture_output=True,
-                         text=True, check=True).stdout
-    return int(json.loads(out.strip().splitlines()[-1]))
-
 
 @njit(cache=False)
 def _rhs_loop(P, Y, reps):  # noqa: N803
@@ -120,7 +92,7 @@ def main() -> None:
     q = s.section()
     P = pk.pack_params(p)
     Y = np.ascontiguousarray(tslip.step(p, s).stance[:, 1:7])
-    n_now = rhs_count()
+    n_now = round(rhs_per_stride([("dopri5", 1e-8)])["dopri5 1e-08"])
 
     def maps() -> None:
         for _ in range(a.maps):
