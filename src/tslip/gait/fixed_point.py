@@ -314,7 +314,7 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
         t = 1.0
         Jn = None
         while True:
-            zn = z + t * dz
+            zn = z + dz if t == 1.0 else z + t * dz  # (the same bits: 1.0 * dz is dz)
             try:
                 if t == 1.0:
                     rn, Jn = fj(zn)

@@ -146,6 +146,8 @@ _ALLOWED_NAMES = frozenset(("delta", *mid, "alpha_r", *ext)
 #: What a stride's output vector and Jacobian hold before the kernel fills them.
 _NAN_OUT = np.full(pk.NOUT, math.nan)
 _NAN_J = np.full((5, 5), math.nan)
+_ZEROS_J = np.zeros(25)
+_F64 = np.dtype(np.float64)
 
 
 def nominal_energy(params: Params) -> float:
@@ -364,7 +366,10 @@ class GaitProblem:
         if len(z) != self.size:
             raise ValueError(f"guess must have {self.size} entries {list(self.names)}, "
                              f"got {len(z)}")
-        zf = [float(v) for v in (z.tolist() if isinstance(z, np.ndarray) else z)]
+        if type(z) is np.ndarray and z.dtype == _F64:
+            zf = z.tolist()  # Python floats already
+        else:
+            zf = [float(v) for v in (z.tolist() if isinstance(z, np.ndarray) else z)]
         if not all(map(math.isfinite, zf)):
             raise ValueError(f"z must be finite, got {zf}")
         i_delta, i_phi, i_phid, i_alpha, i_ref = self._at
@@ -449,7 +454,8 @@ class GaitProblem:
         P, q, st, out, Jq, v = self._stride(x, jacobian=True)
         r, _, _ = _section_residual(q, st, out, self.params, v)
         n = self.size
-        if st != Status.OK or Jq is None or not (Jq * 0.0).sum() == 0.0:  # a NaN or inf
+        # 0 * x is 0 for every finite x, NaN for a NaN or an inf: a dot with zeros finds them
+        if st != Status.OK or Jq is None or not Jq.ravel().dot(_ZEROS_J) == 0.0:
             return r, np.full((5, n), math.nan)
         delta, phi, phid, _, ref = x
         i_delta, i_phi, i_phid, i_alpha, i_ref = self._at
