@@ -25,9 +25,9 @@ Definitions:
   in a compiled loop. :data:`N_RHS` = 146 is frozen: the right-hand sides
   (accepted and rejected steps, 6 per dopri5 step, plus the initial-step
   estimate; no dense-output stages) that the kernel of revision 3b38fb1 spends
-  on this stride. Today's count is printed beside it (counted exactly by running
-  one stride as plain Python, ``NUMBA_DISABLE_JIT=1``, in a subprocess, with a
-  counting ``rhs``), so a kernel taking fewer steps shows as a gain.
+  on this stride. Today's count is printed beside it (counted exactly by
+  ``_rhs_count.py``: the stride as plain Python in a subprocess, every call of
+  ``rhs`` counted), so a kernel taking fewer steps shows as a gain.
 * **unrecorded strides**: the same ``--steps`` strides through the compiled
   batch kernel without recording, one :func:`tslip.run_batch` call.
 * **simulate**: :func:`tslip.simulate` of those strides at ``dt = --dt``;
@@ -45,50 +45,24 @@ Definitions:
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import subprocess
-import sys
 import time
 
 import numba
 import numpy as np
 from _baseline import ab
+from _rhs_count import rhs_per_stride
 from numba import njit
 
 import tslip
 from tslip.model import _pack as pk
-from tslip.simulation import _stance
+from tslip.simulation import _kernels as kn
+from tslip.simulation import _rk, _stance
+from tslip.simulation._stepper import rk_step
 
 #: Right-hand sides of the Table 6.1 stride at dopri5 1e-8 with the kernel of
 #: revision 3b38fb1 (frozen: the limit does not move when the kernel takes fewer steps).
 N_RHS = 146
-
-_COUNT = """
-import json, sys, tslip
-from tslip.simulation import _stance
-calls = [0]
-rhs = _stance.rhs
-def counting(*a):
-    calls[0] += 1
-    rhs(*a)
-for name, mod in list(sys.modules.items()):
-    if name.startswith("tslip.simulation") and getattr(mod, "rhs", None) is rhs:
-        mod.rhs = counting
-g = tslip.find_gait(tslip.preset("table6.1"))
-calls[0] = 0
-tslip.step_map(g.params, g.state.section())
-print(json.dumps(calls[0]))
-"""
-
-
-def rhs_count() -> int:
-    """Stance right-hand sides of one stride of the gait today (plain Python, counted)."""
-    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
-    out = subprocess.run([sys.executable, "-c", _COUNT], env=env, capture_output=True,
-                         text=True, check=True).stdout
-    return int(json.loads(out.strip().splitlines()[-1]))
-
 
 @njit(cache=False)
 def _rhs_loop(P, Y, reps):  # noqa: N803
@@ -99,6 +73,45 @@ def _rhs_loop(P, Y, reps):  # noqa: N803
         for i in range(Y.shape[0]):
             _stance.rhs(P, Y[i], dy)
             acc += dy[3]
+    return acc
+
+
+#: The method of the loops below, a compile-time constant there (as in the kernels).
+_DOPRI5 = pk.M_DOPRI5
+
+
+@njit(cache=False)
+def _steps_loop(P, y0, hs, reps):  # noqa: N803
+    """``reps`` replays of the stance's steps (sizes ``hs``) from ``y0``: the stages and
+    their right-hand sides alone (plus ``f(y0)``), without error control, events or
+    step-size choice."""
+    ns = _rk.n_stages(_DOPRI5)
+    K = np.empty((_rk.NK, 6))
+    y, ytmp, ynew = np.empty(6), np.empty(6), np.empty(6)
+    acc = 0.0
+    for _ in range(reps):
+        for i in range(6):
+            y[i] = y0[i]
+        _stance.rhs(P, y, K[0])
+        for h in hs:
+            rk_step(P, _DOPRI5, y, h, K, ytmp, ynew)
+            for i in range(6):
+                y[i] = ynew[i]
+                K[0, i] = K[ns, i]
+        acc += y[0]
+    return acc
+
+
+@njit(cache=False)
+def _stance_loop(stance, P, O, y0, reps):  # noqa: N803
+    """``reps`` stances from ``y0`` through the stance kernel ``stance``, nothing recorded."""
+    rec = np.empty((0, pk.NREC))
+    tx = np.empty(0)
+    out = np.empty(11)
+    acc = 0.0
+    for _ in range(reps):
+        stance(P, O, y0, tx, tx, rec, 0.0, out)
+        acc += out[0]
     return acc
 
 
@@ -120,7 +133,15 @@ def main() -> None:
     q = s.section()
     P = pk.pack_params(p)
     Y = np.ascontiguousarray(tslip.step(p, s).stance[:, 1:7])
-    n_now = rhs_count()
+    n_now = round(rhs_per_stride([("dopri5", 1e-8)])["dopri5 1e-08"])
+    # the stance alone: its start, and its steps' sizes (recorded at each accepted step)
+    O = tslip.IntegratorOptions().packed()  # noqa: N806
+    y0, yout, stats = np.empty(6), np.empty(6), np.empty(5)
+    kn.stance_initial(P, np.r_[q, 0.0, 0.0], y0)
+    rec = np.empty((4096, pk.NREC))
+    kn.integrate_stance(P, O, y0, yout, rec, 0.0, stats)
+    hs = np.diff(rec[: int(stats[3]), pk.REC_T])
+    stance = kn.STANCE_REC[pk.M_DOPRI5]
 
     def maps() -> None:
         for _ in range(a.maps):
@@ -132,6 +153,8 @@ def main() -> None:
         "simulate": lambda: tslip.simulate(p, s, a.steps, dt=a.dt),
         "simulate + df": lambda: tslip.simulate(p, s, a.steps, dt=a.dt).to_dataframe(),
         "step_map": maps,
+        "steps": lambda: _steps_loop(P, y0, hs, a.reps),
+        "stance": lambda: _stance_loop(stance, P, O, y0, a.reps),
     }
     t = ab(fns, a.rounds, clock=clock).median
     rows = len(tslip.simulate(p, s, a.steps, dt=a.dt).data)
@@ -157,6 +180,13 @@ def main() -> None:
           f"{t['step_map'] / a.maps * 1e6:.2f} us a call; simulate {t['simulate'] * 1e3:.2f} ms, "
           f"+ to_dataframe {t['simulate + df'] * 1e3:.2f} ms ({a.steps} strides, {rows} rows, "
           f"dt {a.dt:g})")
+    t_steps, t_stance = t["steps"] / a.reps, t["stance"] / a.reps
+    n_steps_rhs = 1 + 6 * len(hs)
+    print(f"stride breakdown: right-hand sides {t_rhs * n_now * 1e6:.2f} us ({n_now}), stage "
+          f"arithmetic {(t_steps - t_rhs * n_steps_rhs) * 1e6:.2f} us ({len(hs)} steps replayed), "
+          f"per-step control (error norm, step size, events, initial step) "
+          f"{(t_stance - t_steps - t_rhs * (n_now - n_steps_rhs)) * 1e6:.2f} us, "
+          f"per-stride work (touch-down, flight, batch loop) {(stride - t_stance) * 1e6:.2f} us")
     if study is not None:
         print(f"study point {study[0] * 1e3:.3f} ms, its compiled kernel calls "
               f"{study[1] * 1e3:.3f} ms")

@@ -4,9 +4,9 @@ Run by hand (not in CI): ``python benchmarks/bench_rk.py``. On the Table 6.1
 gait, for ``dopri5`` and ``dop853`` at each tolerance, all timed in the same
 run (so the ratios are what counts on a shared, noisy machine):
 
-* ``rhs/stride``: stance right-hand sides of one stride, counted exactly by
-  running the kernels as plain Python (``NUMBA_DISABLE_JIT=1``, in a
-  subprocess) with a counting ``rhs``;
+* ``rhs/stride``: stance right-hand sides of one stride, counted exactly
+  (``_rhs_count.py``: the kernels as plain Python in a subprocess, every call
+  of ``rhs`` counted);
 * ``strides/s``: :func:`tslip.run_batch` on one core;
 * ``map/s``: :func:`tslip.step_map` calls (what Newton's gait search pays);
 * ``jac/s``: exact stride Jacobians (variational equations; Floquet, Newton);
@@ -16,48 +16,18 @@ run (so the ratios are what counts on a shared, noisy machine):
 from __future__ import annotations
 
 import argparse
-import json
-import os
-import subprocess
-import sys
 import time
 
 import numba
 import numpy as np
 from _baseline import best_of
+from _rhs_count import rhs_per_stride
 
 import tslip
 from tslip.gait.stability import map_jacobian
 
 METHODS = ("dopri5", "dop853")
 NMAP, NJAC = 300, 100  # step_map and Jacobian calls per timing
-COUNT = """
-import json, sys, tslip
-from tslip.simulation import _kernels as kn
-calls = [0]
-rhs = kn.rhs
-def counting(*a):
-    calls[0] += 1
-    rhs(*a)
-kn.rhs = counting
-g = tslip.find_gait(tslip.preset("table6.1"))
-out = {}
-for tol in TOLS:
-    for m in METHODS:
-        calls[0] = 0
-        tslip.run_batch(g.params, [g.state], NS, options=tslip.IntegratorOptions(
-            rtol=tol, atol=tol, method=m))
-        out[f"{m} {tol:g}"] = calls[0] / NS
-print(json.dumps(out))
-"""
-
-
-def rhs_per_stride(tols: list[float], n: int) -> dict[str, float]:
-    code = f"TOLS = {tols!r}\nMETHODS = {METHODS!r}\nNS = {n}\n" + COUNT
-    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
-    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
-                         check=True).stdout
-    return json.loads(out.strip().splitlines()[-1])
 
 
 def main() -> None:
@@ -68,7 +38,7 @@ def main() -> None:
     ap.add_argument("--count-strides", type=int, default=3)
     args = ap.parse_args()
 
-    counts = rhs_per_stride(args.tols, args.count_strides)
+    counts = rhs_per_stride([(m, t) for t in args.tols for m in METHODS], args.count_strides)
     gait = tslip.find_gait(tslip.preset("table6.1"))
     p, s = gait.params, gait.state
     q = s.section()

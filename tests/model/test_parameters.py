@@ -3,6 +3,7 @@
 import dataclasses
 import math
 
+import numpy as np
 import pytest
 
 import tslip
@@ -143,3 +144,15 @@ def test_touchdown_state_validation_and_section():
     assert tslip.TouchdownState.from_section(s.section()) == s
     with pytest.raises(ValueError, match="TouchdownState.xd must be finite"):
         tslip.TouchdownState(1.0, 0.0, math.nan, 0.0, 0.0)
+
+
+def test_touchdown_state_fields_are_plain_floats():
+    # the fields are checked one by one, and a finite float is kept as it is: any other
+    # number becomes a Python float, as check_number returns it; bools are refused
+    s = tslip.TouchdownState(np.float64(1.0), 0, np.float32(5.5), -0.3, np.int64(2), x=3)
+    assert [type(getattr(s, n)) for n in ("beta", "phi", "xd", "yd", "phid", "x", "h")] \
+        == [float] * 7
+    assert (s.beta, s.phi, s.xd, s.phid, s.x) == (1.0, 0.0, 5.5, 2.0, 3.0)
+    assert s.as_array().tolist() == [1.0, 0.0, 5.5, -0.3, 2.0, 3.0, 0.0]
+    with pytest.raises(ValueError, match="TouchdownState.phid must be a number"):
+        tslip.TouchdownState(1.0, 0.0, 5.0, -0.3, True)

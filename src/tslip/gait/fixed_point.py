@@ -47,6 +47,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
+from numpy.linalg import _umath_linalg
 from scipy.optimize import least_squares
 
 from .._results import Result, frame
@@ -91,6 +92,9 @@ Method = Literal["newton", "cma"]
 
 _MAX_STARTS = 13  # automatic guesses tried by Newton: the first 5 plus the 8 best of the scan
 _TWO_PI = 2.0 * math.pi
+_EPS = float(np.finfo(float).eps)
+#: numpy's least-squares gufunc (numpy >= 2.0; :func:`_lstsq`).
+_GELSD = getattr(_umath_linalg, "lstsq", None)
 
 
 @dataclass(frozen=True, slots=True, repr=False)
@@ -296,13 +300,13 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
             return z, err
         if err > tol and it == _NEWTON_MAX_ITER:
             return None, math.inf
-        dz = np.linalg.lstsq(J, -r, rcond=None)[0]
+        dz = _lstsq(J, -r)
         if err <= tol:
             try:  # one polishing step with the Jacobian at hand
                 rp = residual(z + dz)
             except ValueError:
                 return z, err
-            errp = float(np.max(np.abs(rp)))
+            errp = float(np.abs(rp).max())
             return (z + dz, errp) if errp < err else (z, err)
         # The full step, usually taken, is tried with its Jacobian; a shortened
         # one with the residual alone (a stride, not a variational stride), its
@@ -310,7 +314,7 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
         t = 1.0
         Jn = None
         while True:
-            zn = z + t * dz
+            zn = z + dz if t == 1.0 else z + t * dz  # (the same bits: 1.0 * dz is dz)
             try:
                 if t == 1.0:
                     rn, Jn = fj(zn)
@@ -331,6 +335,20 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
                 return None, math.inf
         z, r, J, nrm = zn, rn, Jn, nn
     return None, math.inf  # not reached
+
+
+def _lstsq(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.linalg.lstsq(a, b, rcond=None)[0]`` of a float matrix and vector (the same bits).
+
+    The same LAPACK call (``dgelsd`` through numpy's ``_umath_linalg.lstsq``)
+    without the argument handling around it, most of its cost on a 5 x 5.
+    Where LAPACK's SVD does not converge (never seen on a finite Jacobian) the
+    step is NaN, with numpy's ``RuntimeWarning``, and the line search rejects it.
+    numpy before 2.0 names the call otherwise: there ``np.linalg.lstsq`` itself.
+    """
+    if _GELSD is None:
+        return np.linalg.lstsq(a, b, rcond=None)[0]
+    return _GELSD(a, b[:, None], _EPS * max(a.shape), signature="ddd->ddid")[0][:, 0]
 
 
 def _norm(r: np.ndarray) -> float:
@@ -366,7 +384,7 @@ def _make_gait(prob: GaitProblem, z: np.ndarray, tol: float, message: str,
                method: str = "newton", cma: CMAReport | None = None) -> Gait:
     p, s = prob.decode(z)
     r, ts, tf = prob.evaluate(z)
-    err = float(np.max(np.abs(r)))
+    err = float(np.abs(r).max())
     return Gait(state=s, params=p, residual=err, stance_time=ts, flight_time=tf,
                 converged=bool(err <= tol), message=message, method=method, cma=cma,
                 fix=prob.fix, section=prob.section)

@@ -146,6 +146,8 @@ _ALLOWED_NAMES = frozenset(("delta", *mid, "alpha_r", *ext)
 #: What a stride's output vector and Jacobian hold before the kernel fills them.
 _NAN_OUT = np.full(pk.NOUT, math.nan)
 _NAN_J = np.full((5, 5), math.nan)
+_ZEROS_J = np.zeros(25)
+_F64 = np.dtype(np.float64)
 
 
 def nominal_energy(params: Params) -> float:
@@ -364,7 +366,10 @@ class GaitProblem:
         if len(z) != self.size:
             raise ValueError(f"guess must have {self.size} entries {list(self.names)}, "
                              f"got {len(z)}")
-        zf = [float(v) for v in (z.tolist() if isinstance(z, np.ndarray) else z)]
+        if type(z) is np.ndarray and z.dtype == _F64:
+            zf = z.tolist()  # Python floats already
+        else:
+            zf = [float(v) for v in (z.tolist() if isinstance(z, np.ndarray) else z)]
         if not all(map(math.isfinite, zf)):
             raise ValueError(f"z must be finite, got {zf}")
         i_delta, i_phi, i_phid, i_alpha, i_ref = self._at
@@ -449,7 +454,8 @@ class GaitProblem:
         P, q, st, out, Jq, v = self._stride(x, jacobian=True)
         r, _, _ = _section_residual(q, st, out, self.params, v)
         n = self.size
-        if st != Status.OK or Jq is None or not (Jq * 0.0).sum() == 0.0:  # a NaN or inf
+        # 0 * x is 0 for every finite x, NaN for a NaN or an inf: a dot with zeros finds them
+        if st != Status.OK or Jq is None or not Jq.ravel().dot(_ZEROS_J) == 0.0:
             return r, np.full((5, n), math.nan)
         delta, phi, phid, _, ref = x
         i_delta, i_phi, i_phid, i_alpha, i_ref = self._at
@@ -468,12 +474,10 @@ class GaitProblem:
         dqn[:, i_alpha] += _packed.alpha_r_column(P, out)
         if i_ref >= 0:
             h = 1e-5 * max(1.0, abs(ref))
-            o_plus = self._stride((delta, phi, phid, x[3], ref + h))
-            o_minus = self._stride((delta, phi, phid, x[3], ref - h))
-            if o_plus[2] != Status.OK or o_minus[2] != Status.OK:
+            column = self._ref_column(P, q, ref, h)
+            if column is None:
                 return r, np.full((5, n), math.nan)
-            dqn[:, i_ref] += (o_plus[3][pk.OUT_TD : pk.OUT_TD + 5]
-                              - o_minus[3][pk.OUT_TD : pk.OUT_TD + 5]) / (2.0 * h)
+            dqn[:, i_ref] += column
         # r = (beta', phi' - phi, phid' - phid, atan2(yd', xd') - delta, |v'| - v0)
         _, _, xd, yd, _ = out[pk.OUT_TD : pk.OUT_TD + 5].tolist()
         v2 = xd * xd + yd * yd
@@ -491,6 +495,24 @@ class GaitProblem:
         for k, g in dv:
             Jr[4, k] -= g
         return r, Jr
+
+    def _ref_column(self, P: np.ndarray, q: np.ndarray, ref: float, h: float
+                    ) -> np.ndarray | None:
+        """``dq'/d ref`` by a central difference of step ``h``; None if a stride fails.
+
+        The strides start from the section ``q`` of the stride at ``ref`` with
+        ``P`` as :meth:`_stride` wrote it, only ``P_C0`` changed (as ``_stride``
+        writes it for ``ref +- h``).
+        """
+        Pd = P.copy()
+        ends = []
+        for value in (ref + h, ref - h):
+            Pd[pk.P_C0] = self._ref_gain * value
+            out = _NAN_OUT.copy()
+            if _packed.stride_map(Pd, self._O, q, 0.0, out) != Status.OK:
+                return None
+            ends.append(out[pk.OUT_TD : pk.OUT_TD + 5])
+        return (ends[0] - ends[1]) / (2.0 * h)
 
     def residual(self, z: Sequence[float] | np.ndarray) -> np.ndarray:
         """Periodicity residual (5,) at ``z``; the Newton search's function."""

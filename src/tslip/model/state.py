@@ -9,7 +9,7 @@ and the horizontal position ``x``: ``y_m = h + l0 sin(beta) - r cos(phi)``
 from __future__ import annotations
 
 import math
-from dataclasses import astuple, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -19,6 +19,7 @@ __all__ = ["TouchdownState", "SECTION_NAMES"]
 
 #: Names of the 5-D Poincare-section vector, in order.
 SECTION_NAMES: tuple[str, ...] = ("beta", "phi", "xd", "yd", "phid")
+_FIELDS = (*SECTION_NAMES, "x", "h")
 
 
 @dataclass(frozen=True, slots=True)
@@ -50,8 +51,10 @@ class TouchdownState:
     h: float = 0.0
 
     def __post_init__(self) -> None:
-        for name, value in zip(("beta", "phi", "xd", "yd", "phid", "x", "h"), astuple(self)):
-            object.__setattr__(self, name, check_number(value, f"TouchdownState.{name}"))
+        for name in _FIELDS:
+            value = getattr(self, name)
+            if type(value) is not float or not math.isfinite(value):  # else check_number's own
+                object.__setattr__(self, name, check_number(value, f"TouchdownState.{name}"))
 
     @classmethod
     def from_velocity(
@@ -86,4 +89,4 @@ class TouchdownState:
 
     def as_array(self) -> np.ndarray:
         """All seven fields ``(beta, phi, xd, yd, phid, x, h)``."""
-        return np.array(astuple(self), dtype=float)
+        return np.array([getattr(self, name) for name in _FIELDS], dtype=float)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import threading
+from typing import Any
 
 import numpy as np
 
@@ -58,6 +59,17 @@ def stride_map(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E
 _JACOBIANS: dict[bytes, tuple[int, np.ndarray, np.ndarray]] = {}
 _JACOBIANS_KEPT = 64
 _JACOBIANS_LOCK = threading.Lock()
+_VA: Any = None  # _variational, once imported
+
+
+def _variational() -> Any:
+    """:mod:`._variational`, imported on first use (importing it loads its kernels)."""
+    global _VA
+    if _VA is None:
+        from . import _variational as va
+
+        _VA = va
+    return _VA
 
 
 def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E741
@@ -69,8 +81,6 @@ def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # no
     deterministic, so a call with the same inputs as one of the last
     ``_JACOBIANS_KEPT`` returns its stored result (identical bits).
     """
-    from . import _variational as va
-
     td = touchdown(q, h)
     key = P.tobytes() + O.tobytes() + td.tobytes()
     with _JACOBIANS_LOCK:
@@ -79,7 +89,7 @@ def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # no
         J[:] = hit[1]
         out[:] = hit[2]
         return hit[0]
-    st = int(va.stride_jacobian(P, O, td, _TX, np.array([h]), J, out))
+    st = int(_variational().stride_jacobian(P, O, td, _TX, np.array([h]), J, out))
     with _JACOBIANS_LOCK:
         if len(_JACOBIANS) >= _JACOBIANS_KEPT:
             del _JACOBIANS[next(iter(_JACOBIANS))]  # the oldest
