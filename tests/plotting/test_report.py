@@ -409,10 +409,20 @@ def test_reproduce_cli_prints_each_verdict_and_the_count_per_verdict(page, tmp_p
     from tslip.cli.main import app
 
     claims = page[0]
-    monkeypatch.setattr(report, "reproduce", lambda out, **kw: tmp_path / "index.html")
+
+    def run(out, progress, **kw):
+        progress("workers", "2", 0.0)
+        return tmp_path / "index.html"
+
+    monkeypatch.setattr(report, "reproduce", run)
     r = CliRunner().invoke(app, ["reproduce", "--quick", "--out", str(tmp_path)],
                            env={"COLUMNS": "200"})
     assert r.exit_code == 0, r.output
+    lines = r.output.splitlines()
+    assert lines[0] == f"reproducing the thesis at quick resolution into {tmp_path}"
+    n_figures = len(report.figure_inputs())
+    assert lines[1].endswith(f"] {len(catalogue.STUDIES)} studies, {n_figures} figures on "
+                             "2 workers")
     rows = [ln for ln in r.output.splitlines() if "claim number" in ln]
     assert len(rows) == len(claims)
     for c, row in zip(claims, rows, strict=True):
