@@ -109,15 +109,16 @@ def reproduce_cmd(
 
     from rich.text import Text
 
-    from ..sweeps._warmup import announce
-
     t0 = time.perf_counter()
     console = make_console()
     with errors():
         check_output(out / "index.html", "--out")  # before any work, naming the user's path
-    # at once, before the slower imports; a first run then says that it compiles
+    # at once, before the slower imports (tslip.sweeps imports the analyses and numba);
+    # a first run then says that it compiles
     console.print(f"reproducing the thesis at {'quick' if quick else 'full'} resolution into "
                   f"{out}")
+    from ..sweeps._warmup import announce
+
     compiling = ExitStack()
     compiling.enter_context(announce(console.print))
     from ..plotting.report import figure_inputs, read_claims, reproduce
