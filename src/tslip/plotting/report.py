@@ -15,6 +15,7 @@ key takes the file instead of drawing it again.
 from __future__ import annotations
 
 import base64
+import dataclasses
 import functools
 import hashlib
 import html
@@ -105,8 +106,24 @@ def _plotting_code() -> str:
     return f"{code_hash(*ReportPlots.modules)}|{libs}"
 
 
+def _items(kind: str, items: tuple[Any, ...]) -> None:
+    """What :class:`_Canonical` pickles a sequence type as (never called: nothing unpickles)."""
+
+
+class _Canonical(pickle.Pickler):
+    """A pickler that writes a sequence class other than list and tuple (e.g. a recorded
+    run's :class:`~tslip.simulation.result.StepList`, built on first read from arrays
+    whose unused rows are not initialised) as its type's name and its items."""
+
+    def reducer_override(self, obj: Any) -> Any:
+        if (isinstance(obj, Sequence) and not isinstance(obj, (list, tuple, str, bytes, range))
+                and not dataclasses.is_dataclass(obj)):
+            return _items, (type(obj).__qualname__, tuple(obj))
+        return NotImplemented
+
+
 def _data_digest(v: Any) -> str:
-    """SHA-256 of one figure input as the plotting task receives it (pickled).
+    """SHA-256 of one figure input as the plotting task receives it (pickled, :class:`_Canonical`).
 
     A study result by its spec and columns only: its run record and its
     ``seconds`` column are timings, which no figure draws. Pickling the same
@@ -117,7 +134,9 @@ def _data_digest(v: Any) -> str:
         f = v.frame.drop(columns=["seconds"], errors="ignore")
         v = ("study", v.spec, list(f.columns), [str(t) for t in f.dtypes], list(f.index),
              f.to_numpy(dtype=object))
-    return hashlib.sha256(pickle.dumps(v, protocol=5)).hexdigest()
+    buf = io.BytesIO()
+    _Canonical(buf, protocol=5).dump(v)
+    return hashlib.sha256(buf.getvalue()).hexdigest()
 
 
 def figure_key(fkey: str, inputs: Mapping[str, Any],
