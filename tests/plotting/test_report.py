@@ -594,3 +594,12 @@ def test_png_key_reads_the_text_chunk_only_of_a_png() -> None:
     assert report.png_key(png) == "abc123"
     assert report.png_key(base64.b64decode(report.figure_png(fig).split(",", 1)[1])) is None
     assert report.png_key(b"GIF89a") is None and report.png_key(png[:20]) is None
+
+
+def test_a_recorded_run_keeps_its_figure_key_between_computations() -> None:
+    """Figure 4.5's data computed twice (a rerun) give one key: a recorded run's step and
+    event lists are keyed by their items, not by their arrays' unused rows."""
+    first, second = catalogue.fig_step_down(n_steps=3), catalogue.fig_step_down(n_steps=3)
+    assert report.figure_key("4.5", {"4.5": first}) == report.figure_key("4.5", {"4.5": second})
+    changed = catalogue.fig_step_down(n_steps=4)
+    assert report.figure_key("4.5", {"4.5": changed}) != report.figure_key("4.5", {"4.5": first})
