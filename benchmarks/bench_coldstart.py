@@ -31,6 +31,18 @@ warm and checks that ``claims.json`` and every study's ``results.parquet``
 compile events in every process of the cold run (a ``sitecustomize`` on
 ``PYTHONPATH``) and prints the compile CPU seconds per process, per kernel
 family and per top-level kernel, and any signature compiled in two processes.
+
+``--warm`` measures warm runs instead (issue 25: quick within 4 s, full within
+8 s, first line within 5 s): ``tslip reproduce --quick --workers 2`` of this
+checkout and of ``--warm-rev`` (default ``ae943bb``, main before the warm-run
+work; ``--baseline-src PATH`` takes a source folder instead), kernels compiled
+by a first untimed run of each, then ``--rounds`` interleaved rounds (the order
+alternating) of a run into a new folder and a rerun into the same folder (every
+study, Appendix E and, on this checkout, every figure cached). It prints the
+median wall and CPU seconds (every process), the time to the first line and the
+1-minute load, each with the ratio new/old, and whether the claims and study
+columns of both revisions are equal. ``--full`` adds the full resolution: one
+run into a new folder, then ``--rounds`` reruns into it.
 """
 
 from __future__ import annotations
@@ -293,6 +305,58 @@ def first_run(reuse_venv: str | None, compile_log: bool, keep: bool) -> None:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
+def warm_runs(rounds: int, full: bool, rev: str, baseline_src: str | None,
+              workers: int) -> None:
+    """Interleaved warm ``tslip reproduce`` of this checkout and a baseline (``--warm``)."""
+    import statistics
+
+    from _baseline import source_at
+
+    _subreaper()
+    tmp = Path(tempfile.mkdtemp(prefix="tslip-warm-"))
+    srcs = {"new": source_at(None),
+            "old": Path(baseline_src) if baseline_src else source_at(rev)}
+    envs = {k: dict(os.environ, PYTHONPATH=str(src)) for k, src in srcs.items()}
+    print(f"new: {srcs['new']}; old: {srcs['old']}; folders in {tmp}", flush=True)
+
+    def run(k: str, res: str, out: Path) -> dict[str, float]:
+        cmd = [sys.executable, "-m", "tslip", "reproduce", "--workers", str(workers), "--out",
+               str(out)] + (["--quick"] if res == "quick" else [])
+        return timed_run(cmd, envs[k], tmp, tmp / f"{out.name}.log")
+
+    resolutions = ["quick", "full"] if full else ["quick"]
+    for res in resolutions:
+        rows: dict[tuple[str, str], list[dict[str, float]]] = defaultdict(list)
+        for k in srcs:  # compiles the kernels if needed; the first new folder of full
+            r = run(k, res, tmp / f"{res}-same-{k}")
+            if res == "full":
+                rows[(k, "new folder")].append(r)
+        if res == "quick" and not (diffs := same_results(tmp / "quick-same-new",
+                                                         tmp / "quick-same-old")):
+            print("quick: claims.json and every study's columns equal on both revisions")
+        elif res == "quick":
+            print(f"quick: results DIFFER between the revisions: {diffs}")
+        for i in range(rounds):
+            for k in (("new", "old") if i % 2 == 0 else ("old", "new")):
+                if res == "quick":
+                    rows[(k, "new folder")].append(run(k, res, tmp / f"{res}-{k}-{i}"))
+                rows[(k, "same folder")].append(run(k, res, tmp / f"{res}-same-{k}"))
+        for mode in ("new folder", "same folder"):
+            med = {k: {f: statistics.median(r[f] for r in rows[(k, mode)])
+                       for f in ("wall", "cpu", "first", "load")} for k in srcs}
+            n, o = med["new"], med["old"]
+            print(f"{res:5s} {mode:11s} wall {n['wall']:6.1f} s (old {o['wall']:6.1f}, ratio "
+                  f"{n['wall'] / o['wall']:.2f})  CPU {n['cpu']:6.1f} s (old {o['cpu']:6.1f}, "
+                  f"ratio {n['cpu'] / o['cpu']:.2f})  first line {n['first']:4.1f} s (old "
+                  f"{o['first']:4.1f})  load {n['load']:.1f}/{o['load']:.1f}  "
+                  f"[{len(rows[('new', mode)])} runs each]", flush=True)
+    print("targets (quiet machine, 1-min load < 0.5): quick <= 4 s, full <= 8 s, "
+          "first line <= 5 s")
+    import shutil
+
+    shutil.rmtree(tmp, ignore_errors=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5, help="fresh imports (best of)")
@@ -305,9 +369,20 @@ def main() -> None:
     ap.add_argument("--compile-log", action="store_true",
                     help="with --first-run: numba's compile events of every process")
     ap.add_argument("--keep", action="store_true", help="with --first-run: keep the folder")
+    ap.add_argument("--warm", action="store_true",
+                    help="warm `tslip reproduce` runs against a baseline instead")
+    ap.add_argument("--rounds", type=int, default=3, help="with --warm: interleaved rounds")
+    ap.add_argument("--full", action="store_true", help="with --warm: the full resolution too")
+    ap.add_argument("--warm-rev", default="ae943bb", help="with --warm: baseline revision")
+    ap.add_argument("--baseline-src", metavar="PATH",
+                    help="with --warm: the baseline's src folder instead of --warm-rev")
+    ap.add_argument("--workers", type=int, default=2, help="with --warm: worker processes")
     args = ap.parse_args()
     if args.first_run:
         first_run(args.reuse_venv, args.compile_log, args.keep)
+        return
+    if args.warm:
+        warm_runs(args.rounds, args.full, args.warm_rev, args.baseline_src, args.workers)
         return
     revs = {"new": None, "old": args.rev}
 

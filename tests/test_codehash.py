@@ -165,3 +165,76 @@ def test_the_key_holds_python_and_each_numerical_library(monkeypatch):
     monkeypatch.undo()
     ch.cache_clear()
     assert ch.code_hash("tslip.gait.stability") == before
+
+
+_SETS = (("tslip.gait.continuation", "tslip.gait.fixed_point", "tslip.gait.stability",
+          "tslip.gait.robustness"), ("tslip.sweeps.appendix_e",), ("tslip.gait.viability",))
+
+
+def test_the_disk_cache_gives_the_parsed_key_and_parses_nothing(tmp_path, monkeypatch):
+    """A warm process reads each source's facts from the disk cache: same keys, no parse."""
+    disk = tmp_path / "codehash.json"
+    monkeypatch.setattr(ch, "_disk_path", lambda: disk)
+    ch.cache_clear()
+    parsed = [ch.code_hash(*s) for s in _SETS]  # an empty cache: every source parsed
+    assert disk.is_file()
+    ch.cache_clear()
+
+    def no_parse(source):
+        raise AssertionError("parsed a source the disk cache holds")
+
+    monkeypatch.setattr(ch, "_scan", no_parse)
+    assert [ch.code_hash(*s) for s in _SETS] == parsed
+    monkeypatch.undo()
+    ch.cache_clear()
+
+
+def test_the_disk_cache_keys_on_the_source_bytes(tmp_path, monkeypatch):
+    """An edit that changes a number re-keys with a warm disk cache too; a comment does not."""
+    root = tmp_path / "tslip"
+    (root / "gait").mkdir(parents=True)
+    (root / "__init__.py").write_text("")
+    (root / "gait" / "__init__.py").write_text("")
+    (root / "gait" / "b.py").write_text(_MODULE)
+    monkeypatch.setattr(ch, "_ROOT", root)
+    monkeypatch.setattr(ch, "_disk_path", lambda: tmp_path / "codehash.json")
+
+    def key():
+        ch.cache_clear()
+        return ch.code_hash("tslip.gait.b")
+
+    try:
+        before = key()
+        assert key() == before  # from the disk cache
+        (root / "gait" / "b.py").write_text(_MODULE.replace("# why", "# because"))
+        assert key() == before
+        (root / "gait" / "b.py").write_text(_MODULE.replace("RATE = 1.5", "RATE = 1.25"))
+        assert key() != before
+        (root / "gait" / "b.py").write_text(_MODULE)
+        assert key() == before
+    finally:
+        ch.cache_clear()
+
+
+@pytest.mark.parametrize("content", ["{not json", '{"maker": "%s", "files": {"k": ["short", []]}}',
+                                     '{"maker": "%s", "files": {"k": ["%s", [[1]]]}}', "[]",
+                                     "another maker"])
+def test_a_damaged_or_foreign_disk_cache_is_ignored_and_rewritten(tmp_path, monkeypatch,
+                                                                   content):
+    disk = tmp_path / "codehash.json"
+    monkeypatch.setattr(ch, "_disk_path", lambda: disk)
+    ch.cache_clear()
+    import json
+
+    want = ch.code_hash("tslip.gait.stability")
+    if content == "another maker":  # another Python or hasher: its entries (here all wrong)
+        doc = json.loads(disk.read_text())
+        doc = {"maker": "another", "files": {k: ["0" * 64, v[1]]
+                                             for k, v in doc["files"].items()}}
+        disk.write_text(json.dumps(doc))
+    else:
+        disk.write_text(content.replace("%s", ch._MAKER, 1).replace("%s", "0" * 64))
+    ch.cache_clear()
+    assert ch.code_hash("tslip.gait.stability") == want
+    assert json.loads(disk.read_text())["maker"] == ch._MAKER  # rewritten whole
+    ch.cache_clear()

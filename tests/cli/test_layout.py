@@ -103,3 +103,29 @@ def test_the_cycle_finder_finds_the_old_layout(tmp_path):
     (tmp_path / "gait.py").write_text("from ._common import errors\n")
     assert find_cycle(import_graph(tmp_path)) is None
 
+
+
+#: What ``tslip --help`` must not wait for: each command imports its model code when it runs.
+HEAVY = ("numba", "numpy", "pandas", "scipy", "matplotlib", "tslip.model", "tslip.simulation",
+         "tslip.gait", "tslip.biped", "tslip.sweeps", "tslip.plotting", "tslip.experiment")
+
+
+def test_importing_the_cli_imports_no_model_code():
+    """``import tslip.cli.main`` (the console script) loads typer and rich, not the model.
+
+    In a fresh interpreter, so that nothing imported by other tests counts; a
+    top-level import of an analysis in any command module fails this.
+    """
+    import json
+    import subprocess
+    import sys
+
+    code = ("import json, sys, tslip.cli.main; "
+            "print(json.dumps(sorted(sys.modules)))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    loaded = set(json.loads(out))
+    assert "tslip.cli.biped" in loaded  # every command module was imported ...
+    heavy = sorted(m for m in loaded if m.split(".")[0] in HEAVY
+                   or ".".join(m.split(".")[:2]) in HEAVY)
+    assert heavy == []  # ... and none of them imported its analyses at the top

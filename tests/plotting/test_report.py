@@ -409,10 +409,20 @@ def test_reproduce_cli_prints_each_verdict_and_the_count_per_verdict(page, tmp_p
     from tslip.cli.main import app
 
     claims = page[0]
-    monkeypatch.setattr(report, "reproduce", lambda out, **kw: tmp_path / "index.html")
+
+    def run(out, progress, **kw):
+        progress("workers", "2", 0.0)
+        return tmp_path / "index.html"
+
+    monkeypatch.setattr(report, "reproduce", run)
     r = CliRunner().invoke(app, ["reproduce", "--quick", "--out", str(tmp_path)],
                            env={"COLUMNS": "200"})
     assert r.exit_code == 0, r.output
+    lines = r.output.splitlines()
+    assert lines[0] == f"reproducing the thesis at quick resolution into {tmp_path}"
+    n_figures = len(report.figure_inputs())
+    assert lines[1].endswith(f"] {len(catalogue.STUDIES)} studies, {n_figures} figures on "
+                             "2 workers")
     rows = [ln for ln in r.output.splitlines() if "claim number" in ln]
     assert len(rows) == len(claims)
     for c, row in zip(claims, rows, strict=True):
@@ -505,3 +515,91 @@ def test_figure_e3_fills_its_box() -> None:
     (ax,) = fig.axes
     drawn = ax.get_window_extent()  # the axes box after equal aspect shrank it
     assert drawn.height / fig.bbox.height > 0.5  # 0.22 in the old 6 x 5 inch box
+
+
+def _draw(plots, tasks) -> None:
+    for task in tasks:
+        plots.done(task, task.fn(*task.args, None))
+
+
+def test_a_kept_figure_is_not_drawn_again_and_is_the_drawn_image(data, tmp_path) -> None:
+    """A rerun takes each figure from ``figures/report-<key>.png`` when its key still holds:
+    no draw, and the same image (the page is made of these images)."""
+    subset = {"4.1": data["4.1"], "velocity": data["velocity"]}
+    first = report.ReportPlots(tmp_path)
+    tasks = first.ready(subset)
+    assert sorted(t.key[1] for t in tasks) == ["4.1", "4.8", "4.9"] and first.drawn == 3
+    _draw(first, tasks)
+    for t in tasks:
+        png = (tmp_path / "figures" / f"report-{t.key[1]}.png").read_bytes()
+        assert report.png_key(png) == t.args[2] == report.figure_key(t.key[1], t.args[1])
+    again = report.ReportPlots(tmp_path)
+    assert again.cost == report.PLOT_SECONDS * (len(again.inputs) - 3)
+    assert again.ready(subset) == [] and again.drawn == 0
+    assert again.images == first.images
+    plain = report.ReportPlots()  # no folder: every figure drawn, as before
+    _draw(plain, plain.ready(subset))
+    assert plain.drawn == 3 and set(plain.images) == set(first.images)
+
+
+def test_a_changed_input_or_plotting_code_draws_again(data, tmp_path, monkeypatch) -> None:
+    import shutil
+    from pathlib import Path
+
+    import tslip
+    from tslip import _codehash as ch
+
+    study = data["velocity"]
+    subset = {"4.1": data["4.1"], "velocity": study}
+    first = report.ReportPlots(tmp_path)
+    _draw(first, first.ready(subset))
+
+    def drawn(inputs) -> list[str]:
+        plots = report.ReportPlots(tmp_path)
+        return sorted(t.key[1] for t in plots.ready(inputs))
+
+    timed = StudyResult(study.spec, study.frame.assign(seconds=3.0), {"seconds": 9.0})
+    assert drawn({**subset, "velocity": timed}) == []  # timings are not drawn
+    frame = study.frame.copy()
+    frame.loc[1, "max_nontrivial"] += 1e-9
+    assert drawn({**subset, "velocity": StudyResult(study.spec, frame, study.meta)}) == [
+        "4.8", "4.9"]
+    (tmp_path / "figures" / "report-4.1.png").write_bytes(b"\x89PNG\r\n\x1a\n damaged")
+    assert drawn(subset) == ["4.1"]
+    _draw(first, first.ready({}))  # nothing new
+    root = tmp_path / "src" / "tslip"  # an edit of the plotting code
+    shutil.copytree(Path(tslip.__file__).parent, root,
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    f = root / "plotting" / "studies.py"
+    f.write_text(f.read_text() + "\n_EDIT = 1\n")
+    monkeypatch.setattr(ch, "_ROOT", root)
+    ch.cache_clear()
+    report._plotting_code.cache_clear()
+    try:
+        assert drawn(subset) == ["4.1", "4.8", "4.9"]
+    finally:
+        monkeypatch.undo()
+        ch.cache_clear()
+        report._plotting_code.cache_clear()
+
+
+def test_png_key_reads_the_text_chunk_only_of_a_png() -> None:
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(2, 1))
+    fig.subplots().plot([0, 1])
+    import base64
+
+    png = base64.b64decode(report.figure_png(fig, key="abc123").split(",", 1)[1])
+    assert report.png_key(png) == "abc123"
+    assert report.png_key(base64.b64decode(report.figure_png(fig).split(",", 1)[1])) is None
+    assert report.png_key(b"GIF89a") is None and report.png_key(png[:20]) is None
+
+
+def test_a_recorded_run_keeps_its_figure_key_between_computations() -> None:
+    """Figure 4.5's data computed twice (a rerun) give one key: a recorded run's step and
+    event lists are keyed by their items, not by their arrays' unused rows."""
+    first, second = catalogue.fig_step_down(n_steps=3), catalogue.fig_step_down(n_steps=3)
+    assert report.figure_key("4.5", {"4.5": first}) == report.figure_key("4.5", {"4.5": second})
+    changed = catalogue.fig_step_down(n_steps=4)
+    assert report.figure_key("4.5", {"4.5": changed}) != report.figure_key("4.5", {"4.5": first})

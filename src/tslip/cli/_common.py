@@ -15,7 +15,7 @@ import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
@@ -29,7 +29,9 @@ from rich.progress import (
 )
 
 from .._checks import check_output, parse_number
-from ..model.parameters import PARAMETER_TABLE, Params, preset, presets, read_params_file
+
+if TYPE_CHECKING:  # the model is imported when parameters are built: `tslip --help` stays fast
+    from ..model.parameters import Params
 
 __all__ = [
     "SchedulerOpt", "WorkersOpt",
@@ -55,7 +57,6 @@ if not getattr(typer.core.TyperOption.display_type_rich, "_tslip", False):
 #: Table files the commands read and write.
 DATA_SUFFIXES = (".csv", ".parquet")
 
-_TABLE = {row.name: row for row in PARAMETER_TABLE}
 _STRING_KEYS = ("controller", "leg_reset", "retraction")
 
 # -- options shared by several commands --------------------------------------------
@@ -197,6 +198,9 @@ def run(app: typer.Typer, prog_name: str) -> int:
 
 def _parse_sets(items: list[str] | None, base: Params) -> dict[str, Any]:
     """``["k=30", "controller.Kd=0.4"]`` -> overrides for :meth:`Params.from_dict`."""
+    from ..model.parameters import PARAMETER_TABLE
+
+    table = {row.name: row for row in PARAMETER_TABLE}
     out: dict[str, Any] = {}
     gains: dict[str, float] = {}
     seen: set[str] = set()
@@ -212,12 +216,12 @@ def _parse_sets(items: list[str] | None, base: Params) -> dict[str, Any]:
             gains[key.split(".", 1)[1]] = parse_number(value, f"--set {key}")
         elif key in _STRING_KEYS:
             out[key] = value
-        elif key in _TABLE or key == "omega_r_bar":
-            unit = _TABLE[key].unit if key in _TABLE else "-"
+        elif key in table or key == "omega_r_bar":
+            unit = table[key].unit if key in table else "-"
             out[key] = parse_number(value, f"--set {key} [{unit}]")
         else:
             raise ValueError(
-                f"unknown parameter {key!r} in --set; allowed: {sorted(_TABLE)} plus "
+                f"unknown parameter {key!r} in --set; allowed: {sorted(table)} plus "
                 "omega_r_bar, controller, controller.<gain>, leg_reset, retraction"
             )
     if gains:
@@ -245,6 +249,8 @@ def build_params_and_preset(
     The preset comes from ``--preset`` or the file's ``preset`` key (default
     table2.1); both given with different values is an error naming both.
     """
+    from ..model.parameters import Params, preset, presets, read_params_file
+
     data = {} if params_file is None else read_params_file(params_file)
     file_preset = data.pop("preset", None)
     if file_preset is not None:

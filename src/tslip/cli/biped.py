@@ -8,23 +8,18 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
-import numpy as np
 import typer
 
 from .._checks import check_number, check_output, parse_number
 from .._io import write_json
-from ..biped import BipedOptions, BipedParams, BipedState, simulate
-from ..biped.gait import (
-    find_periodic_gait,
-    floquet,
-    from_section,
-    to_section,
-    tracking_errors,
-)
-from ..biped.metacentre import metacentric_table, metacentric_test
 from ._common import errors, make_console
+
+if TYPE_CHECKING:  # each command imports the biped when it runs (a fast --help)
+    import numpy as np
+
+    from ..biped import BipedParams
 
 __all__ = ["biped_app"]
 
@@ -45,6 +40,8 @@ TolOpt = Annotated[float, typer.Option("--tol", help="Integrator rtol = atol.")]
 
 
 def _params(sets: list[str] | None, base: BipedParams | None = None) -> BipedParams:
+    from ..biped import BipedParams
+
     changes: dict[str, Any] = {}
     for item in sets or []:
         key, sep, value = item.partition("=")
@@ -69,6 +66,8 @@ def _check_strides(strides: int, tol: float | None = None) -> None:
 def _start(sets: list[str] | None, gait: str | Path | None,
            from_tslip: str | None = None) -> tuple[BipedParams, np.ndarray, float]:
     """Parameters, start state and start time: Table E.2, a TSLIP gait or a saved gait."""
+    from ..biped import BipedState
+
     if gait is not None and from_tslip is not None:
         raise ValueError("give at most one of --gait and --from-tslip")
     if gait is None:
@@ -100,6 +99,9 @@ def simulate_cmd(
     out: Annotated[Path | None, typer.Option("--out", help="CSV of the run.")] = None,
 ) -> None:
     """Run the biped from Table E.2 (or a gait) and report strides and tracking."""
+    from ..biped import BipedOptions, simulate
+    from ..biped.gait import tracking_errors
+
     with errors():
         _check_strides(strides, tol)
         if out is not None:
@@ -121,6 +123,11 @@ def simulate_cmd(
 def _gait_summary(p: BipedParams, z: np.ndarray, ev: np.ndarray | None,
                   strides: int) -> tuple[dict[str, Any], list[str]]:
     """Multipliers and strides until fall of a gait: JSON entries and printed lines."""
+    import numpy as np
+
+    from ..biped import simulate
+    from ..biped.gait import from_section
+
     data: dict[str, Any] = {}
     lines: list[str] = []
     if ev is not None and np.all(np.isfinite(ev)):
@@ -161,7 +168,7 @@ def search_cmd(
         "--strides", "-n", help="Strides run from the result (strides until fall).")] = 50,
 ) -> None:
     """Periodic gait: optional CMA-ES (eqs E.35-E.36), then shooting refinement."""
-    from ..biped.gait import refine_periodic_gait
+    from ..biped.gait import find_periodic_gait, refine_periodic_gait, to_section
 
     with errors():
         check_output(out, "--out", (".json",))
@@ -210,6 +217,7 @@ def animate_cmd(
     fps: Annotated[int, typer.Option("--fps", help="Frames per second of the animation.")] = 25,
 ) -> None:
     """Animate the runner with both legs."""
+    from ..biped import simulate
     from ..plotting.biped import animate_biped
 
     with errors():
@@ -237,6 +245,9 @@ def report_cmd(
     import pandas as pd
 
     from .._io import write_table
+    from ..biped import BipedState, simulate
+    from ..biped.gait import floquet, to_section
+    from ..biped.metacentre import metacentric_table, metacentric_test
     from ..plotting.biped import plot_foot_path, plot_metacentric, plot_tracking
 
     with errors():
@@ -298,8 +309,11 @@ def optimise_cmd(
     The best gait is written to --out at every improvement; Ctrl-C stops
     with the best so far, and --gait OUT continues from it.
     """
+    import numpy as np
+
+    from ..biped import BipedParams
     from ..biped.design import DESIGN_BOUNDS, check_search_settings, stable_gait_search
-    from ..biped.gait import section_multipliers
+    from ..biped.gait import section_multipliers, to_section
 
     with errors():
         check_output(out, "--out", (".json",))

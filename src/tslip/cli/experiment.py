@@ -11,16 +11,17 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
-import numpy as np
-import pandas as pd
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from .._checks import check_number, check_output
 from .._io import atomic_write, write_json, write_table
 from ._common import DATA_SUFFIXES, PresetOpt, SetOpt, build_params, errors, fail, make_console
+
+if TYPE_CHECKING:  # imported by the commands that read tables (a fast --help)
+    import pandas as pd
 
 __all__ = ["commands", "synth_video_cmd", "track_cmd", "process_cmd", "fit_cmd", "experiment_cmd"]
 
@@ -48,6 +49,8 @@ _STEP_COLUMNS = ("step", "tau", "stance_time", "flight_time", "y", "l", "beta", 
 
 def _read_table(path: Path, columns: tuple[str, ...], what: str) -> pd.DataFrame:
     """Read a .csv/.parquet table that must have numeric ``columns`` (one-line errors)."""
+    import pandas as pd
+
     if path.suffix.lower() not in DATA_SUFFIXES:
         raise ValueError(f"{what} must be a .csv or .parquet table, got {str(path)!r}")
     if not path.is_file():
@@ -218,6 +221,8 @@ def track_cmd(
 
 
 def _process(tracks_path: Path, out: Path) -> Any:
+    import numpy as np
+
     from ..experiment.signals import process_tracks
 
     check_output(out, "--out", DATA_SUFFIXES)

@@ -9,7 +9,6 @@ import time
 from pathlib import Path
 from typing import Annotated, Any
 
-import numpy as np
 import typer
 from rich import box
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
@@ -17,9 +16,6 @@ from rich.table import Table
 
 from .._checks import check_fits, check_number, check_output
 from .._io import atomic_write
-from ..gait import analyse, continue_gait, find_gait, get_param, impulse_linearisation
-from ..gait import pitch_disturbance_response as pitch_response
-from ..gait.stride import friction_ratio
 from ._common import (
     DATA_SUFFIXES,
     ParamsOpt,
@@ -148,6 +144,10 @@ def gait_cmd(
     ] = False,
 ) -> None:
     """Solve the periodic gait and report stability, strides, robustness, impulse."""
+    from ..gait import analyse, find_gait, impulse_linearisation
+    from ..gait import pitch_disturbance_response as pitch_response
+    from ..gait.stride import friction_ratio
+
     with errors():
         if method not in ("newton", "cma"):
             raise ValueError(f"--method must be 'newton' or 'cma', got {method!r}")
@@ -196,6 +196,10 @@ def continue_cmd(
     ] = None,
 ) -> None:
     """Follow the periodic gait along a parameter; print and save the branch."""
+    import numpy as np
+
+    from ..gait import continue_gait, get_param
+
     with errors():
         check_number(points, "--points", lower=2, integer=True)
         check_fits(points, _POINT_BYTES, "--points", "the branch")

@@ -7,13 +7,14 @@ and results go to explicit output files (with the version and the code hash
 in the ``.json`` beside them).
 """
 
+from __future__ import annotations
+
 import dataclasses
 import math
 import time
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
-import numpy as np
 import typer
 from rich import box
 from rich.console import Console
@@ -22,12 +23,6 @@ from rich.table import Table
 
 from .. import __version__
 from .._checks import check_number, check_output
-from .._codehash import code_hash
-from ..gait import Gait, find_gait
-from ..model.parameters import PARAMETER_TABLE, Params, preset, preset_description, presets
-from ..model.state import TouchdownState
-from ..simulation import IntegratorOptions, Status, Trajectory, simulate
-from ..simulation.integrate import check_simulation_size
 from ._common import (
     DATA_SUFFIXES,
     Failed,
@@ -42,6 +37,12 @@ from ._common import (
     file_size,
     make_console,
 )
+
+if TYPE_CHECKING:  # the commands import the model's code when they run (a fast --help)
+    from ..gait import Gait
+    from ..model.parameters import Params
+    from ..model.state import TouchdownState
+    from ..simulation import Trajectory
 
 __all__ = ["commands", "presets_cmd", "simulate_cmd", "animate_cmd", "demo_cmd"]
 
@@ -76,6 +77,9 @@ def _start(
     params: Params, no_gait: bool, console: Console
 ) -> tuple[Params, TouchdownState, Gait | None]:
     """Return the starting parameters and state: the periodic gait by default."""
+    from ..gait import find_gait
+    from ..model.state import TouchdownState
+
     if no_gait:
         state = TouchdownState.from_velocity(v=params.v0, delta=-0.1, beta=params.beta0)
         console.print(
@@ -102,6 +106,8 @@ def _check_run_options(steps: int, dt: float, rtol: float, atol: float,
     check_number(rtol, "--rtol", lower=0.0, upper=1.0, lower_open=True, upper_open=True)
     check_number(atol, "--atol", lower=0.0, upper=1.0, lower_open=True, upper_open=True)
     if params is not None:
+        from ..simulation.integrate import check_simulation_size
+
         check_simulation_size(params, steps, dt, "--steps")
 
 
@@ -114,6 +120,9 @@ def _run(
     atol: float,
     meta: dict[str, Any],
 ) -> Trajectory:
+    from .._codehash import code_hash
+    from ..simulation import IntegratorOptions, simulate
+
     options = IntegratorOptions(rtol=rtol, atol=atol)
     traj = simulate(params, state, steps, dt=dt, options=options)
     meta = {
@@ -165,6 +174,8 @@ def _steps_table(traj: Trajectory) -> Table:
 
 
 def _status_line(traj: Trajectory) -> str:
+    from ..simulation import Status
+
     st = traj.status
     t_end = float(traj["t"][-1]) if len(traj.data) else 0.0
     x_end = float(traj["x"][-1]) if len(traj.data) else 0.0
@@ -177,6 +188,8 @@ def _status_line(traj: Trajectory) -> str:
 
 
 def _energy_drift(traj: Trajectory) -> float:
+    import numpy as np
+
     e = traj["energy"]
     if len(e) == 0 or e[0] == 0:
         return math.nan
@@ -221,6 +234,8 @@ def presets_cmd(
     ] = None,
 ) -> None:
     """List the parameter presets from the thesis tables."""
+    from ..model.parameters import preset, preset_description, presets
+
     with errors():
         console = make_console()
         if name is not None:
@@ -243,6 +258,8 @@ def presets_cmd(
 
 
 def _preset_matrix(names: list[str]) -> Table:
+    from ..model.parameters import PARAMETER_TABLE, preset
+
     ps = [preset(n) for n in names]
     table = Table(title="parameters (dimensionless units of thesis Table 3.1)", box=box.SIMPLE_HEAD)
     table.add_column("symbol", no_wrap=True)
@@ -270,6 +287,8 @@ def _preset_matrix(names: list[str]) -> Table:
 
 
 def _preset_detail(name: str) -> Table:
+    from ..model.parameters import PARAMETER_TABLE, preset, preset_description
+
     p = preset(name)
     table = Table(title=f"{name}: {preset_description(name)}", box=box.SIMPLE_HEAD)
     table.add_column("name (--set)", no_wrap=True)
@@ -392,6 +411,8 @@ def demo_cmd(
     steps: StepsOpt = 20,
 ) -> None:
     """Solve the Table 2.1 passive gait, simulate it, write data, plot and animation."""
+    from ..model.parameters import preset, preset_description
+
     with errors():
         _check_run_options(steps, 0.01, 1e-8, 1e-8, preset("table2.1"))
         check_output(out_dir / "run.csv", "--out-dir")

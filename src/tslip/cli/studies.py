@@ -109,25 +109,31 @@ def reproduce_cmd(
 
     from rich.text import Text
 
-    from ..sweeps._warmup import announce
-
+    t0 = time.perf_counter()
     console = make_console()
     with errors():
         check_output(out / "index.html", "--out")  # before any work, naming the user's path
-    # before the slower imports: a first run says at once that it compiles
+    # at once, before the slower imports (tslip.sweeps imports the analyses and numba);
+    # a first run then says that it compiles
+    console.print(f"reproducing the thesis at {'quick' if quick else 'full'} resolution into "
+                  f"{out}")
+    from ..sweeps._warmup import announce
+
     compiling = ExitStack()
     compiling.enter_context(announce(console.print))
-    from ..plotting.report import read_claims, reproduce
+    from ..plotting.report import figure_inputs, read_claims, reproduce
     from ..sweeps import catalogue
     from ..sweeps.claims import Verdict, count_verdicts
 
     n_studies = len(catalogue.STUDIES)
-    t0 = time.perf_counter()
     state = {"studies": 0}
 
     def progress(stage: str, name: str, seconds: float) -> None:
         el = time.perf_counter() - t0
-        if stage == "study":
+        if stage == "workers":
+            console.print(f"[{el:6.1f} s] {n_studies} studies, {len(figure_inputs())} figures "
+                          f"on {name} worker{'s' if name != '1' else ''}")
+        elif stage == "study":
             state["studies"] += 1
             console.print(f"[{el:6.1f} s] study {state['studies']:2d}/{n_studies} {name} "
                           f"done ({seconds:.1f} s)")

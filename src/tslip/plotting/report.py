@@ -5,13 +5,22 @@ references (no scripts, fonts or style sheets), so it opens from disk with
 no server and no internet. One section per thesis figure: our plot, the
 thesis's claim, the numbers we measured and whether the claim holds; then
 the Table 6.2-style stride table and the Section 6.1 robustness numbers.
+
+Each figure's PNG is kept in ``out_dir/figures/report-<figure>.png`` with the
+key it was drawn under in a text chunk of the PNG (:func:`figure_key`: its
+input data and the plotting code's hash): a rerun whose figure has the same
+key takes the file instead of drawing it again.
 """
 
 from __future__ import annotations
 
 import base64
+import dataclasses
+import functools
+import hashlib
 import html
 import io
+import pickle
 from collections.abc import Callable, Mapping, Sequence
 from datetime import UTC, datetime
 from pathlib import Path
@@ -22,18 +31,26 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from .. import __version__
+from .._codehash import code_hash
 from .._io import atomic_write, write_json
 from ..model.units import UNIT
 from ..sweeps.claims import Verdict, count_verdicts
 from .notation import axis_label, key_html, tex_html, unit_html, value
 
 __all__ = ["CLAIMS_SCHEMA", "PLOT_SECONDS", "SECTIONS", "ReportPlots", "claims_json", "compute",
-           "figure_inputs", "figure_png", "plot_task", "read_claims", "render_ready", "reproduce",
-           "write_report"]
+           "figure_inputs", "figure_key", "figure_png", "plot_task", "png_key", "read_claims",
+           "render_ready", "reproduce", "write_report"]
 
 
-def figure_png(fig: Figure, dpi: int = 80) -> str:
-    """A figure as a ``data:image/png;base64,...`` URI.
+#: The resolution of the report's figures.
+DPI = 80
+#: The PNG text chunk's keyword that holds a cached figure's key (:func:`figure_key`).
+KEY_CHUNK = "tslip-figure-key"
+_URI = "data:image/png;base64,"
+
+
+def figure_png(fig: Figure, dpi: int = DPI, key: str | None = None) -> str:
+    """A figure as a ``data:image/png;base64,...`` URI; ``key`` in its text chunk ``KEY_CHUNK``.
 
     A figure with a layout engine is laid out here, at ``dpi``, and saved with
     the engine switched off (then restored): ``savefig`` would lay it out in a
@@ -42,18 +59,104 @@ def figure_png(fig: Figure, dpi: int = 80) -> str:
     """
     engine = fig.get_layout_engine()
     buf = io.BytesIO()
+    meta = {KEY_CHUNK: key} if key is not None else None
     if engine is None:
-        fig.savefig(buf, format="png", dpi=dpi)
+        fig.savefig(buf, format="png", dpi=dpi, metadata=meta)
     else:
         fig.dpi = dpi
         FigureCanvasAgg(fig)
         engine.execute(fig)
         fig.set_layout_engine(None)
         try:
-            fig.savefig(buf, format="png", dpi=dpi)
+            fig.savefig(buf, format="png", dpi=dpi, metadata=meta)
         finally:
             fig.set_layout_engine(engine)
-    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
+    return _URI + base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def png_key(png: bytes) -> str | None:
+    """The ``KEY_CHUNK`` text of a PNG file's bytes, or None (not a PNG, no such chunk).
+
+    Reads the chunk layout only (length, type, data, CRC; the PNG specification):
+    a damaged or foreign file has no key.
+    """
+    if not png.startswith(b"\x89PNG\r\n\x1a\n"):
+        return None
+    pos = 8
+    while pos + 8 <= len(png):
+        n = int.from_bytes(png[pos:pos + 4], "big")
+        kind, body = png[pos + 4:pos + 8], png[pos + 8:pos + 8 + n]
+        if kind == b"tEXt":
+            word, _, text = body.partition(b"\0")
+            if word == KEY_CHUNK.encode():
+                return text.decode("latin-1")
+        if kind in (b"IDAT", b"IEND"):  # text chunks come before the image data
+            return None
+        pos += 12 + n
+    return None
+
+
+@functools.cache
+def _plotting_code() -> str:
+    """The hash of the report's plotting code (:data:`ReportPlots.modules`, their imports
+    from tslip) and of the versions of the libraries that draw."""
+    from importlib import metadata
+
+    libs = ",".join(f"{lib}={metadata.version(lib)}" for lib in ("matplotlib", "pillow"))
+    return f"{code_hash(*ReportPlots.modules)}|{libs}"
+
+
+def _items(kind: str, items: tuple[Any, ...]) -> None:
+    """What :class:`_Canonical` pickles a sequence type as (never called: nothing unpickles)."""
+
+
+class _Canonical(pickle.Pickler):
+    """A pickler that writes a sequence class other than list and tuple (e.g. a recorded
+    run's :class:`~tslip.simulation.result.StepList`, built on first read from arrays
+    whose unused rows are not initialised) as its type's name and its items."""
+
+    def reducer_override(self, obj: Any) -> Any:
+        if (isinstance(obj, Sequence) and not isinstance(obj, (list, tuple, str, bytes, range))
+                and not dataclasses.is_dataclass(obj)):
+            return _items, (type(obj).__qualname__, tuple(obj))
+        return NotImplemented
+
+
+def _data_digest(v: Any) -> str:
+    """SHA-256 of one figure input as the plotting task receives it (pickled, :class:`_Canonical`).
+
+    A study result by its spec and columns only: its run record and its
+    ``seconds`` column are timings, which no figure draws. Pickling the same
+    data twice may give other bytes (e.g. a table read from disk and one
+    computed): that draws the figure again, never keeps a stale one.
+    """
+    if hasattr(v, "frame") and hasattr(v, "spec") and hasattr(v, "meta"):
+        f = v.frame.drop(columns=["seconds"], errors="ignore")
+        v = ("study", v.spec, list(f.columns), [str(t) for t in f.dtypes], list(f.index),
+             f.to_numpy(dtype=object))
+    buf = io.BytesIO()
+    _Canonical(buf, protocol=5).dump(v)
+    return hashlib.sha256(buf.getvalue()).hexdigest()
+
+
+def figure_key(fkey: str, inputs: Mapping[str, Any],
+               digests: dict[tuple[str, int], str] | None = None) -> str:
+    """The key a figure is drawn under: SHA-256 of its inputs and of the plotting code.
+
+    Each input by :func:`_data_digest` (``digests`` keeps them by key and object,
+    for inputs several figures share), the figure, :data:`DPI` and
+    :func:`_plotting_code`: a change to any of them draws the figure again.
+    Taken when the data arrive, before a figure is drawn from them (drawing may
+    fill an object's caches built on first read, which pickle).
+    """
+    digests = {} if digests is None else digests
+    h = hashlib.sha256(f"{fkey}|{DPI}|{_plotting_code()}".encode())
+    for k in sorted(inputs):
+        d = digests.get((k, id(inputs[k])))
+        if d is None:
+            d = digests[(k, id(inputs[k]))] = _data_digest(inputs[k])
+        h.update(f"|{k}={d}".encode())
+    return h.hexdigest()
 
 
 #: Controller studies of Figures 4.24-4.25: legend label -> study name.
@@ -344,14 +447,15 @@ def _global_pd_note(data: Mapping[str, Any]) -> str:
 PLOT_SECONDS = 0.5
 
 
-def plot_task(fkey: str, inputs: Mapping[str, Any], tick: Any = None) -> str | None:
-    """Figure ``fkey`` as a PNG data URI, from its inputs (a task, in a worker).
+def plot_task(fkey: str, inputs: Mapping[str, Any], key: str | None = None,
+              tick: Any = None) -> str | None:
+    """Figure ``fkey`` as a PNG data URI, from its inputs (a task, in a worker), ``key`` in it.
 
     None if the plot fails: :func:`write_report` draws it again here and
     reports the error in the page.
     """
     try:
-        return figure_png(_plots(inputs)[fkey]())
+        return figure_png(_plots(inputs)[fkey](), key=key)
     except Exception:  # noqa: BLE001 - reported by write_report
         return None
 
@@ -363,20 +467,42 @@ class ReportPlots:
     figure is a task (:func:`plot_task`) made ready as soon as the data it is
     drawn from (:func:`figure_inputs`) have arrived, so the figures are drawn
     on the worker pool while the rest is computed; ``images`` collects them.
+
+    With ``out_dir``, each drawn figure is kept in ``out_dir/figures/report-<figure>.png``
+    under its :func:`figure_key`, and a figure whose file holds the same key is
+    taken from it (no task): a rerun draws only what changed. Written atomically,
+    read as PNG bytes (the key from its text chunk, :func:`png_key`).
     """
 
     #: What :func:`plot_task` imports (for the workers to import once).
     modules = (__name__, "tslip.plotting.biped", "tslip.plotting.gait", "tslip.plotting.studies")
 
-    def __init__(self) -> None:
+    def __init__(self, out_dir: str | Path | None = None) -> None:
         self.inputs = figure_inputs()
         self.images: dict[str, str] = {}
         self.sent: set[str] = set()
+        self.folder = None if out_dir is None else Path(out_dir) / "figures"
+        self.drawn = 0  # figures sent to be drawn (the rest came from their files)
+        self.digests: dict[tuple[str, int], str] = {}  # (input, id) -> its data's digest
+
+    def path(self, fkey: str) -> Path | None:
+        """Where figure ``fkey`` is kept (None without ``out_dir``)."""
+        return None if self.folder is None else self.folder / f"report-{fkey}.png"
 
     @property
     def cost(self) -> float:
-        """Estimated seconds of the figures not yet sent."""
-        return PLOT_SECONDS * (len(self.inputs) - len(self.sent))
+        """Estimated seconds of the figures not yet sent (a figure with a file: none)."""
+        kept = {f for f in self.inputs if (p := self.path(f)) is not None and p.is_file()}
+        return PLOT_SECONDS * len(set(self.inputs) - self.sent - kept)
+
+    def _kept(self, fkey: str, key: str) -> str | None:
+        """Figure ``fkey``'s file as a data URI if it holds ``key``."""
+        path = self.path(fkey)
+        try:
+            png = path.read_bytes() if path is not None else b""
+        except OSError:
+            return None
+        return _URI + base64.b64encode(png).decode("ascii") if png_key(png) == key else None
 
     def ready(self, data: Mapping[str, Any]) -> list[Any]:
         """Tasks for the figures whose data ``data`` now holds (each figure once)."""
@@ -386,13 +512,25 @@ class ReportPlots:
         for fkey, keys in self.inputs.items():
             if fkey not in self.sent and all(k in data for k in keys):
                 self.sent.add(fkey)
-                out.append(Task(("plot", fkey), plot_task,
-                                (fkey, {k: data[k] for k in keys}), PLOT_SECONDS))
+                inputs = {k: data[k] for k in keys}
+                key = (figure_key(fkey, inputs, self.digests) if self.folder is not None
+                       else None)
+                if key is not None and (kept := self._kept(fkey, key)) is not None:
+                    self.images[fkey] = kept
+                    continue
+                self.drawn += 1
+                out.append(Task(("plot", fkey), plot_task, (fkey, inputs, key), PLOT_SECONDS))
         return out
 
     def done(self, task: Any, result: str | None) -> None:
-        if result is not None:
-            self.images[task.key[1]] = result
+        if result is None:
+            return
+        fkey = task.key[1]
+        self.images[fkey] = result
+        path = self.path(fkey)
+        if path is not None:
+            png = base64.b64decode(result.removeprefix(_URI))
+            atomic_write(path, lambda tmp: Path(tmp).write_bytes(png))
 
 
 def render_ready(data: Mapping[str, Any], images: dict[str, str]) -> None:
@@ -518,7 +656,7 @@ def compute(out_dir: str | Path, *, quick: bool = False, resolution: str | None 
     """
     from ..sweeps.reproduce import run_all
 
-    plots = ReportPlots()
+    plots = ReportPlots(out_dir)
     info: dict[str, Any] = {}
     data, claims, seconds = run_all(out_dir, quick=quick, resolution=resolution,
                                     workers=workers, scheduler=scheduler, progress=progress,

@@ -76,7 +76,8 @@ APPENDIX_E_SETTINGS: dict[str, dict[str, Any]] = {
 }
 
 #: ``progress(stage, name, seconds)`` after each study or figure, ``seconds`` its own time
-#: (the wall seconds of its tasks: :func:`tslip.sweeps._schedule.own_seconds`).
+#: (the wall seconds of its tasks: :func:`tslip.sweeps._schedule.own_seconds`); and once,
+#: before any work, ``("workers", "<count>", 0.0)`` with the worker processes chosen.
 Progress = Callable[[str, str, float], None]
 
 
@@ -442,7 +443,8 @@ def run_all(out_dir: str | Path, *, quick: bool = False, workers: int | None = N
     scheduler : str, optional
         Dask scheduler address to run the tasks on.
     progress : callable, optional
-        ``progress(stage, name, seconds)`` after each study and figure.
+        ``progress(stage, name, seconds)`` after each study and figure, and once
+        ``("workers", "<count>", 0.0)`` before the work (:data:`Progress`).
     resolution : {"tiny", "quick", "full"}, optional
         Overrides ``quick``; ``"tiny"`` (3 points a line, 3 x 3 grids, a
         short Appendix E) tests the pipeline, its numbers are not meant to be read.
@@ -528,6 +530,8 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
         n = 1 if scheduler is not None else choose_workers(cost, workers)
         if info is not None:
             info["workers"] = n
+        if progress:
+            progress("workers", str(n), 0.0)
 
         def study_done(name: str) -> None:
             results[name] = jobs.pop(name).result(n, scheduler, timing=timing)
