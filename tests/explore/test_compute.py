@@ -98,3 +98,20 @@ def test_the_stability_map_stops_when_progress_cancels():
     with pytest.raises(compute.MapCancelled):
         compute.stability_map(tslip.preset("table6.1"), ("k", 7.0, 9.0), ("Kd", 0.3, 0.5), 3,
                               cancel)
+
+
+def test_a_map_cell_the_continuation_missed_gets_the_gait_find_gait_finds():
+    """The SLIP's branch through k = 25 ends (a fold) before k = 17.75, so the study's
+    line at 17.75, continued from the line at 25, has no gait; find_gait finds another
+    gait there (delta near -0.8 instead of -0.09), and the map now shows it."""
+    p = tslip.preset("slip")
+    res = compute.stability_map(p, ("r", -0.1, 0.1), ("k", 17.75, 25.0), 2, lambda d, t: None)
+    f = res.frame
+    low = f[f["k"] == 17.75]
+    assert len(low) == 2 and (low["message"] == compute.FRESH).all()
+    for _, row in low.iterrows():
+        g = tslip.find_gait(dataclasses.replace(p, k=17.75, r=row["r"]))
+        assert g.converged
+        assert row["converged"]
+        assert row["delta"] == pytest.approx(g.state.delta, abs=1e-8)
+        assert row["max_nontrivial"] == pytest.approx(tslip.floquet(g).max_nontrivial, abs=1e-6)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import io
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -20,9 +20,10 @@ from ..gait import Floquet, Gait, find_gait, floquet, robustness
 from ..model.parameters import Params
 from ..simulation import Disturbance, Trajectory, simulate
 from ..sweeps import Axis, StudyResult, StudySpec, run_study
+from ..sweeps.point import Pending, analyse_point, gait_tol
 
 __all__ = ["Solved", "solve", "limit", "limits", "disturbed_run", "stability_map", "MapCancelled",
-           "params_toml", "trajectory_parquet", "FIELDS", "magnitude", "unit_circle"]
+           "params_toml", "trajectory_parquet", "FIELDS", "FRESH", "magnitude", "unit_circle"]
 
 #: The disturbance field of :class:`tslip.Disturbance` for each robustness kind.
 FIELDS = {"step_down": "dh", "push": "dxd", "pitch_rate": "dphid"}
@@ -99,11 +100,43 @@ def stability_map(params: Params, x: tuple[str, float, float], y: tuple[str, flo
     (:func:`tslip.sweeps.run_study` with one worker), and ``progress`` may
     raise :class:`MapCancelled` to stop it. The result's ``grid`` has the
     shape ``(points of y, points of x)``.
+
+    The study continues each line of y from its neighbour's gaits (Newton from
+    that gait only), so a cell beyond the end of the neighbour's branch (a fold)
+    has no gait there even where :func:`tslip.find_gait` finds one, and a line
+    with no gait leaves the next line without seeds. Those cells are searched
+    afresh, as a click on the cell would (:func:`_fresh`); ``progress`` counts
+    these searches as further points.
     """
     spec = StudySpec(name="explore-map", base=params,
                      axes=(Axis.linspace(_axis(y[0]), y[1], y[2], points),
                            Axis.linspace(_axis(x[0]), x[1], x[2], points)))
-    return run_study(spec, workers=1, progress=progress)
+    res = run_study(spec, workers=1, progress=progress)
+    return _fresh(res, progress)
+
+
+#: The study's message of a cell its neighbour line's gait did not continue to.
+NOT_CONTINUED = "no periodic gait continuing from the neighbouring line"
+#: The message of a cell found by a fresh search after that.
+FRESH = "found by a fresh search (the neighbouring line's gait did not continue here)"
+
+
+def _fresh(res: StudyResult, progress: Callable[[int, int], None]) -> StudyResult:
+    """``res`` with each cell the continuation missed searched afresh by :func:`find_gait`."""
+    frame, spec = res.frame.copy(), res.spec
+    missed = frame.index[~frame["converged"].astype(bool)
+                         & (frame["message"] == NOT_CONTINUED)]
+    done, total = len(frame), len(frame) + len(missed)
+    for n, i in enumerate(missed):
+        point = {a.param: float(frame.at[i, a.param]) for a in spec.axes}
+        gait = find_gait(spec.params_at(point), tol=gait_tol(spec))
+        if gait.converged:
+            rec = analyse_point(spec, Pending(int(i), point, gait, gait.residual, FRESH, 1, 0.0))
+            for key, value in rec.items():
+                if key in frame.columns:
+                    frame.at[i, key] = value
+        progress(done + n + 1, total)
+    return replace(res, frame=frame)
 
 
 def _axis(name: str) -> str:
