@@ -70,6 +70,8 @@ def test_a_newer_move_replaces_an_older_one(held):
         dataclasses.replace(tslip.preset("table6.1"), k=9.0))).max_nontrivial
     page.until(lambda: f"{want:.4f}" in page.ex.mult_text.text)
     page.until(lambda: page.ex.limit_text.text.startswith("robustness limits (25"))
+    page.until(lambda: len(page.ex.frames_src.data["t"]) > 10)  # the runner's animation
+    assert min(page.ex.ground_src.data["y"]) == max(page.ex.ground_src.data["y"]) == 0.0  # push
     old = tslip.floquet(tslip.find_gait(tslip.preset("table6.1"))).max_nontrivial
     assert not any(f"{old:.4f}" in text for text in page.shown)  # the older gait never drawn
     page.ex.close()

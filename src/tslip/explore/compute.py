@@ -2,7 +2,8 @@
 
 The gait and its multipliers (:func:`solve`), the three robustness limits
 (:func:`limits`, stoppable between limits), the runner after a disturbance at
-the second touch-down (:func:`disturbed_run`), the stability map over two
+the second touch-down (:func:`disturbed_run`) and its animation frames
+(:func:`runner_frames`), the stability map over two
 parameters through the study machinery (:func:`stability_map`), and the
 exports (:func:`params_toml`, :func:`trajectory_parquet`).
 """
@@ -13,6 +14,7 @@ import io
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -23,7 +25,8 @@ from ..sweeps import Axis, StudyResult, StudySpec, run_study
 from ..sweeps.point import Pending, analyse_point, gait_tol
 
 __all__ = ["Solved", "solve", "limit", "limits", "disturbed_run", "stability_map", "MapCancelled",
-           "params_toml", "trajectory_parquet", "FIELDS", "FRESH", "magnitude", "unit_circle"]
+           "params_toml", "trajectory_parquet", "FIELDS", "FRESH", "magnitude", "unit_circle",
+           "runner_frames", "ground", "FPS", "SPEED"]
 
 #: The disturbance field of :class:`tslip.Disturbance` for each robustness kind.
 FIELDS = {"step_down": "dh", "push": "dxd", "pitch_rate": "dphid"}
@@ -81,6 +84,49 @@ def disturbed_run(gait: Gait, kind: str, magnitude: float, n_steps: int = 6) -> 
     """``n_steps`` strides of ``gait`` with a ``kind`` disturbance at the second touch-down."""
     dist = Disturbance(at_step=1, **{FIELDS[kind]: float(magnitude)})
     return simulate(gait.params, gait.state, n_steps, disturbance=dist)
+
+
+#: The runner's animation: frames a second, and playback speed for a 1 m leg on Earth
+#: (a quarter of real time, as ``tslip animate``).
+FPS = 30.0
+SPEED = 0.25
+
+
+def runner_frames(traj: Trajectory, fps: float = FPS, speed: float = SPEED) -> dict[str, Any]:
+    """The animation of a run as columns, one row a frame (the page plays them).
+
+    Frame times are :func:`tslip.plotting.animation.frame_times` (``speed``
+    times real time for a 1 m leg), each frame the runner's
+    :func:`~tslip.plotting.animation.pose` there: the drawing of ``tslip
+    animate`` (trunk ellipse along the hip-CoM axis, spring leg, ground force
+    arrow at 0.15 l0 per Mg), in L.
+    """
+    from ..plotting.animation import TRUNK_WIDTH, frame_times, pose, sample, trunk_length
+
+    t = frame_times(traj, fps, speed)
+    p = traj.params
+    length = trunk_length(p)
+    poses = [pose(row, p.l0, length) for row in sample(traj, t)]
+    none = np.full(2, np.nan)
+    grf = [np.array([q.foot, q.grf]) if q.grf is not None else np.array([none, none])
+           for q in poses]
+    return {
+        "t": t, "stance": np.array([q.stance for q in poses], dtype=float),
+        **{f"{name}_{xy}": np.array([getattr(q, name)[j] for q in poses])
+           for name in ("com", "hip", "foot", "centre") for j, xy in enumerate("xy")},
+        "angle": np.array([q.angle for q in poses]),
+        "body_w": np.full(len(t), length), "body_h": np.full(len(t), TRUNK_WIDTH * p.l0),
+        "leg_x": [q.spring[:, 0] for q in poses], "leg_y": [q.spring[:, 1] for q in poses],
+        "axis_x": [q.axis[:, 0] for q in poses], "axis_y": [q.axis[:, 1] for q in poses],
+        "grf_x": [g[:, 0] for g in grf], "grf_y": [g[:, 1] for g in grf],
+    }
+
+
+def ground(traj: Trajectory) -> tuple[np.ndarray, np.ndarray]:
+    """The ground under a run as a polyline, its step-down drawn (``tslip animate``'s)."""
+    from ..plotting.trajectories import ground_profile
+
+    return ground_profile(traj, margin=0.5 * traj.params.l0)
 
 
 def magnitude(limit: float, fraction: float) -> float:
