@@ -134,21 +134,22 @@ class Explorer:
         self.fraction.on_change("value", self._guard(self._on_fraction))
         self._show_gains(p.controller.name)
 
-        self.gait_src = ColumnDataSource({"x": [], "y": []}, name="gait_source")
-        self.stance_src = ColumnDataSource({"x": [], "y": []})
+        # one source a plot (a change is a message): the stance samples are the rows
+        # whose "stance_y" is not NaN, the trivial multipliers those whose "triv_re" is not
+        self.gait_src = ColumnDataSource({"x": [], "y": [], "stance_y": []}, name="gait_source")
         self.pose_src = ColumnDataSource({"xs": [], "ys": []})
         self.gait_fig = figure(title="periodic gait (2 strides)", width=560, height=260,
                                x_axis_label="x [L]", y_axis_label="y [L]", match_aspect=True,
                                name="gait_plot")
         self.gait_fig.line("x", "y", source=self.gait_src, line_width=2, legend_label="CoM")
-        self.gait_fig.scatter("x", "y", source=self.stance_src, size=3, color="#d95f02",
+        self.gait_fig.scatter("x", "stance_y", source=self.gait_src, size=3, color="#d95f02",
                               legend_label="CoM in stance")
         self.gait_fig.multi_line("xs", "ys", source=self.pose_src, color="black", line_width=2)
         self.gait_fig.legend.location = "bottom_right"
 
         cx, cy = compute.unit_circle()
-        self.mult_src = ColumnDataSource({"re": [], "im": [], "abs": [], "kind": []})
-        self.triv_src = ColumnDataSource({"re": [], "im": [], "kind": []})
+        self.mult_src = ColumnDataSource({k: [] for k in ("re", "im", "triv_re", "triv_im",
+                                                          "abs", "kind")})
         self.mult_fig = figure(title="Floquet multipliers", width=300, height=300,
                                x_range=Range1d(start=-1.3, end=1.3),
                                y_range=Range1d(start=-1.3, end=1.3), match_aspect=True,
@@ -157,7 +158,7 @@ class Explorer:
         self.mult_fig.line(cx, cy, color="grey")
         self.mult_fig.scatter("re", "im", source=self.mult_src, size=9,
                               legend_label="non-trivial")
-        self.mult_fig.scatter("re", "im", source=self.triv_src, size=14, marker="x",
+        self.mult_fig.scatter("triv_re", "triv_im", source=self.mult_src, size=14, marker="x",
                               color="#d95f02", line_width=2, legend_label="trivial")
         self.mult_fig.legend.location = "bottom_left"
         self.mult_text = Div(text="", name="multipliers")
@@ -357,12 +358,10 @@ class Explorer:
         with self.lock:
             self.generation += 1
             gen = self.generation
-        self._update_link()
         if not _WARM.is_set():
             self.status.text = "computing the first gait"
-        else:
-            self.status.text = "computing"
-        self.limit_text.text = "robustness limits: updating"
+        # nothing else is sent now: each change is a message the page lays out before the
+        # next, so the gait's draw sends the permalink and "updating" along with the gait
         self._background(self.gait_pool, self._solve, gen, params)
 
     def _update_link(self) -> None:
@@ -413,35 +412,47 @@ class Explorer:
         if self.stale(gen):
             return
         self.solved, self.limits = solved, None
-        self.status.text = solved.message
         if not solved.ok:
-            for src in (self.gait_src, self.stance_src, self.mult_src, self.triv_src,
-                        self.pose_src, self.frames_src, self.path_src, self.ground_src):
+            for src in (self.gait_src, self.mult_src, self.pose_src, self.frames_src,
+                        self.path_src, self.ground_src):
                 src.data = {str(k): [] for k in src.data}
             self.mult_text.text = "no gait"
             self.limit_text.text = "robustness limits: no gait"
             self.strip_text.text = ""
+            self._draw_status(solved.message)
             return
         assert solved.trajectory is not None and solved.floquet is not None
+        assert solved.gait is not None
         tr, fl = solved.trajectory, solved.floquet
         stance = tr["stance"] > 0.5
-        self.gait_src.data = {"x": tr["x"], "y": tr["y"]}
-        self.stance_src.data = {"x": tr["x"][stance], "y": tr["y"][stance]}
+        self.gait_src.data = {"x": tr["x"], "y": tr["y"],
+                              "stance_y": np.where(stance, tr["y"], np.nan)}
         self.pose_src.data = _poses(tr, np.flatnonzero(np.diff(tr["stance"]) > 0.5) + 1)
         m = np.asarray(fl.multipliers)
         kinds = list(fl.trivial_kinds) or [""] * len(m)
         t = np.asarray(fl.trivial, dtype=bool)
-        self.mult_src.data = {"re": m.real[~t], "im": m.imag[~t], "abs": np.abs(m[~t]),
-                              "kind": [k for k, tt in zip(kinds, t, strict=True) if not tt]}
-        self.triv_src.data = {"re": m.real[t], "im": m.imag[t],
-                              "kind": [k for k, tt in zip(kinds, t, strict=True) if tt]}
+        nan = np.full(len(m), np.nan)
+        self.mult_src.data = {"re": np.where(t, nan, m.real), "im": np.where(t, nan, m.imag),
+                              "triv_re": np.where(t, m.real, nan),
+                              "triv_im": np.where(t, m.imag, nan), "abs": np.abs(m),
+                              "kind": [(k or "trivial") if tt else "non-trivial"
+                                       for k, tt in zip(kinds, t, strict=True)]}
         mags = ", ".join(f"{abs(x):.4f}" + (" (trivial)" if tt else "") for x, tt in zip(m, t,
                                                                                         strict=True))
         self.mult_text.text = (f"|multipliers|: {mags}<br>largest non-trivial "
-                               f"{fl.max_nontrivial:.4f}: {fl.stability}")
-        if not fl.stable:
+                               f"{fl.max_nontrivial:.4f}: {fl.stability} (gait residual "
+                               f"{solved.gait.residual:.1e})")
+        if fl.stable:
+            self.limit_text.text = "robustness limits: updating"
+        else:
             self.limit_text.text = "robustness limits: none (the gait is unstable)"
             self.strip_text.text = ""
+        self._draw_status(solved.message)
+
+    def _draw_status(self, message: str) -> None:
+        """The status line (unchanged while gaits are found: a change is a message) and link."""
+        self.status.text = message
+        self._update_link()
 
     def _draw_limits(self, gen: int, lim: dict[str, float]) -> None:
         if self.stale(gen):
@@ -574,9 +585,13 @@ function show(i) {
     label.setv({text: ''}, quiet);
     return;
   }
-  leg.setv({data: {x: d.leg_x[i], y: d.leg_y[i]}}, quiet);
-  axis.setv({data: {x: d.axis_x[i], y: d.axis_y[i]}}, quiet);
-  grf.setv({data: {x: d.grf_x[i], y: d.grf_y[i]}}, quiet);
+  const line = (col) => {  // row i of an (n, m) array
+    const a = d[col], m = a.length / n;
+    return Array.from(a.subarray(i * m, (i + 1) * m));
+  };
+  leg.setv({data: {x: line('leg_x'), y: line('leg_y')}}, quiet);
+  axis.setv({data: {x: line('axis_x'), y: line('axis_y')}}, quiet);
+  grf.setv({data: {x: line('grf_x'), y: line('grf_y')}}, quiet);
   body.setv({data: {x: [d.centre_x[i]], y: [d.centre_y[i]], w: [d.body_w[i]],
                     h: [d.body_h[i]], angle: [d.angle[i]]}}, quiet);
   joints.setv({data: {x: [d.hip_x[i], d.com_x[i], d.foot_x[i]],

@@ -56,7 +56,7 @@ def solve(params: Params, n_steps: int = 2) -> Solved:
     traj = simulate(gait.params, gait.state, n_steps)
     if traj.status.fell or traj.status.is_error:
         return Solved(gait, fl, None, f"no gait: the periodic run ended in {traj.status.name}")
-    return Solved(gait, fl, traj, f"gait found (residual {gait.residual:.1e})")
+    return Solved(gait, fl, traj, "gait found")
 
 
 def limit(gait: Gait, kind: str) -> float:
@@ -107,18 +107,21 @@ def runner_frames(traj: Trajectory, fps: float = FPS, speed: float = SPEED) -> d
     p = traj.params
     length = trunk_length(p)
     poses = [pose(row, p.l0, length) for row in sample(traj, t)]
-    none = np.full(2, np.nan)
-    grf = [np.array([q.foot, q.grf]) if q.grf is not None else np.array([none, none])
-           for q in poses]
+    none = np.full((2, 2), np.nan)
+    grf = [np.array([q.foot, q.grf]) if q.grf is not None else none for q in poses]
+    n = max(len(q.spring) for q in poses)  # a spring of zero length is two points: pad it
+    legs = np.array([np.vstack([q.spring, np.repeat(q.spring[-1:], n - len(q.spring), 0)])
+                     for q in poses])
+    axes, arrows = np.array([q.axis for q in poses]), np.array(grf)
     return {
         "t": t, "stance": np.array([q.stance for q in poses], dtype=float),
         **{f"{name}_{xy}": np.array([getattr(q, name)[j] for q in poses])
            for name in ("com", "hip", "foot", "centre") for j, xy in enumerate("xy")},
         "angle": np.array([q.angle for q in poses]),
         "body_w": np.full(len(t), length), "body_h": np.full(len(t), TRUNK_WIDTH * p.l0),
-        "leg_x": [q.spring[:, 0] for q in poses], "leg_y": [q.spring[:, 1] for q in poses],
-        "axis_x": [q.axis[:, 0] for q in poses], "axis_y": [q.axis[:, 1] for q in poses],
-        "grf_x": [g[:, 0] for g in grf], "grf_y": [g[:, 1] for g in grf],
+        # polylines, one row a frame (one array each: the page reads row i)
+        "leg_x": legs[:, :, 0], "leg_y": legs[:, :, 1], "axis_x": axes[:, :, 0],
+        "axis_y": axes[:, :, 1], "grf_x": arrows[:, :, 0], "grf_y": arrows[:, :, 1],
     }
 
 
