@@ -173,17 +173,18 @@ FRESH = "found by a fresh search (the neighbouring line's gait did not continue 
 def _fresh(res: StudyResult, progress: Callable[[int, int], None]) -> StudyResult:
     """``res`` with each cell the continuation missed searched afresh by :func:`find_gait`."""
     frame, spec = res.frame.copy(), res.spec
-    missed = frame.index[~frame["converged"].astype(bool)
-                         & (frame["message"] == NOT_CONTINUED)]
-    done, total = len(frame), len(frame) + len(missed)
-    for n, i in enumerate(missed):
-        point = {a.param: float(frame.at[i, a.param]) for a in spec.axes}
+    rows = np.flatnonzero((~frame["converged"].astype(bool)
+                           & (frame["message"] == NOT_CONTINUED)).to_numpy())
+    axes = {a.param: frame[a.param].to_numpy(float) for a in spec.axes}
+    done, total = len(frame), len(frame) + len(rows)
+    for n, j in enumerate(rows):
+        point = {name: float(values[j]) for name, values in axes.items()}
         gait = find_gait(spec.params_at(point), tol=gait_tol(spec))
         if gait.converged:
-            rec = analyse_point(spec, Pending(int(i), point, gait, gait.residual, FRESH, 1, 0.0))
+            rec = analyse_point(spec, Pending(int(j), point, gait, gait.residual, FRESH, 1, 0.0))
             for key, value in rec.items():
                 if key in frame.columns:
-                    frame.at[i, key] = value
+                    frame.at[frame.index[int(j)], key] = value
         progress(done + n + 1, total)
     return replace(res, frame=frame)
 
