@@ -389,9 +389,6 @@ class Explorer:
         if self.stale(gen):
             return
         self._post(self._draw_gait, gen, solved)
-        if solved.ok and solved.floquet is not None and solved.floquet.stable:
-            assert solved.gait is not None
-            self._background(self.limit_pool, self._limits, gen, solved.gait)
 
     def _limits(self, gen: int, gait: Any) -> None:
         lim = compute.limits(gait, stop=lambda: self.stale(gen), run=_limit_in_process)
@@ -444,6 +441,10 @@ class Explorer:
                                f"{solved.gait.residual:.1e})")
         if fl.stable:
             self.limit_text.text = "robustness limits: updating"
+            # asked for here, after the gait is drawn: callbacks posted before the page's
+            # session exists run in any order (Bokeh keeps them in a set), and the limits
+            # drawn before their gait would be hidden by its "updating"
+            self._background(self.limit_pool, self._limits, gen, solved.gait)
         else:
             self.limit_text.text = "robustness limits: none (the gait is unstable)"
             self.strip_text.text = ""
