@@ -78,8 +78,26 @@ def test_moving_a_slider_redraws_the_gait_and_the_multipliers(page, server):
     limit = tslip.robustness(tslip.find_gait(dataclasses.replace(p, k=9.0)), "step_down")
     wait_text(page, "limits", f"step_down {limit:.4g} [L]")
     wait_text(page, "runner", "at the 2nd touch-down")
+    check_the_runner_plays(page)
     SHOT.parent.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(SHOT), full_page=True)
+
+
+def check_the_runner_plays(page) -> None:
+    """The runner's animation plays in the page, pauses, and shows the frame asked for."""
+    pose = f"() => Array.from(({_MODEL})('runner_pose').data.x)"
+    page.wait_for_function(f"() => ({pose})().length === 3", timeout=TIMEOUT)
+    first = page.evaluate(pose)
+    page.wait_for_function(f"(a) => ({pose})()[1] !== a[1]", arg=first, timeout=TIMEOUT)
+    page.get_by_role("button", name="play / pause").click()
+    page.wait_for_function(f"() => !({_MODEL})('runner_play').active", timeout=TIMEOUT)
+    paused = page.evaluate(pose)
+    page.wait_for_timeout(300)  # 9 frames at 30 a second
+    assert page.evaluate(pose) == paused
+    set_value(page, "runner_frame", 5)
+    frame = page.evaluate(f"() => {{ const d = ({_MODEL})('runner_frames').data;"
+                          " return [d.hip_x[5], d.com_x[5], d.foot_x[5]]; }")
+    assert page.evaluate(pose) == pytest.approx(frame, abs=0)
 
 
 @pytest.mark.parametrize("bad", ["-1", "nan", "abc", "1e999"])

@@ -4,6 +4,9 @@ import base64
 import http.client
 import io
 import os
+import subprocess
+import sys
+import time
 import tomllib
 
 import pandas as pd
@@ -12,7 +15,7 @@ import pytest
 import tslip
 from tslip.simulation.result import TRAJECTORY_COLUMNS
 
-from .conftest import get
+from .conftest import START_TIMEOUT, free_port, get
 
 
 def test_the_page_is_served_on_the_loopback_address(server):
@@ -21,12 +24,12 @@ def test_the_page_is_served_on_the_loopback_address(server):
     assert b"<title>tslip explore</title>" in body
 
 
-def _open_ws(port: int, origin: str) -> int:
+def _open_ws(port: int, origin: str, host: str = "127.0.0.1") -> int:
     """The HTTP status of a websocket handshake (RFC 6455) from ``origin``: 101 opens it.
 
     Plain HTTP, as a browser sends it (no event loop: Playwright's runs in this thread).
     """
-    conn = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+    conn = http.client.HTTPConnection(host, port, timeout=30)
     try:
         conn.request("GET", "/ws", headers={
             "Upgrade": "websocket", "Connection": "Upgrade", "Origin": origin,
@@ -74,3 +77,41 @@ def test_a_bad_export_query_is_refused_with_the_reason_and_the_server_goes_on(se
     assert word in body.decode()
     assert get(server.url + "/favicon.ico")[0] == 200  # still serving
     assert server.alive()
+
+
+def test_another_host_warns_and_takes_websockets_only_from_that_host_and_port(tmp_path):
+    """``--host`` other than 127.0.0.1 warns on stderr, and the allow-list is that host:port
+    (127.0.0.2: another address of this machine's loopback, so nothing is exposed)."""
+    host, port = "127.0.0.2", free_port()
+    err = tmp_path / "stderr.txt"
+    with err.open("w") as out:
+        proc = subprocess.Popen([sys.executable, "-m", "tslip", "explore", "--host", host,
+                                 "--port", str(port), "--no-open"], stdout=subprocess.DEVNULL,
+                                stderr=out, env=os.environ.copy())
+    try:
+        deadline = time.monotonic() + START_TIMEOUT
+        while True:
+            try:
+                if get(f"http://{host}:{port}/favicon.ico", timeout=5)[0] == 200:
+                    break
+            except OSError:
+                pass
+            assert proc.poll() is None and time.monotonic() < deadline, err.read_text()
+            time.sleep(0.2)
+        text = err.read_text()
+        assert f"warning: serving on {host}" in text and "--host 127.0.0.1" in text
+        assert _open_ws(port, f"http://{host}:{port}", host) == 101
+        for origin in (f"http://127.0.0.1:{port}", f"http://localhost:{port}",
+                       f"http://{host}:{port + 1}", "http://evil.example"):
+            assert _open_ws(port, origin, host) == 403, origin
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+def test_the_default_host_does_not_warn(server):
+    assert "warning" not in server.text()

@@ -24,8 +24,8 @@ import numpy as np
 from bokeh.document import Document
 from bokeh.layouts import column, row
 from bokeh.models import ColumnDataSource, CustomJS, LinearColorMapper, Range1d, TapTool
-from bokeh.models.annotations import ColorBar
-from bokeh.models.widgets import Button, Div, Select, Slider, Spinner
+from bokeh.models.annotations import ColorBar, Label
+from bokeh.models.widgets import Button, Div, Select, Slider, Spinner, Toggle
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
@@ -134,21 +134,22 @@ class Explorer:
         self.fraction.on_change("value", self._guard(self._on_fraction))
         self._show_gains(p.controller.name)
 
-        self.gait_src = ColumnDataSource({"x": [], "y": []}, name="gait_source")
-        self.stance_src = ColumnDataSource({"x": [], "y": []})
+        # one source a plot (a change is a message): the stance samples are the rows
+        # whose "stance_y" is not NaN, the trivial multipliers those whose "triv_re" is not
+        self.gait_src = ColumnDataSource({"x": [], "y": [], "stance_y": []}, name="gait_source")
         self.pose_src = ColumnDataSource({"xs": [], "ys": []})
         self.gait_fig = figure(title="periodic gait (2 strides)", width=560, height=260,
                                x_axis_label="x [L]", y_axis_label="y [L]", match_aspect=True,
                                name="gait_plot")
         self.gait_fig.line("x", "y", source=self.gait_src, line_width=2, legend_label="CoM")
-        self.gait_fig.scatter("x", "y", source=self.stance_src, size=3, color="#d95f02",
+        self.gait_fig.scatter("x", "stance_y", source=self.gait_src, size=3, color="#d95f02",
                               legend_label="CoM in stance")
         self.gait_fig.multi_line("xs", "ys", source=self.pose_src, color="black", line_width=2)
         self.gait_fig.legend.location = "bottom_right"
 
         cx, cy = compute.unit_circle()
-        self.mult_src = ColumnDataSource({"re": [], "im": [], "abs": [], "kind": []})
-        self.triv_src = ColumnDataSource({"re": [], "im": [], "kind": []})
+        self.mult_src = ColumnDataSource({k: [] for k in ("re", "im", "triv_re", "triv_im",
+                                                          "abs", "kind")})
         self.mult_fig = figure(title="Floquet multipliers", width=300, height=300,
                                x_range=Range1d(start=-1.3, end=1.3),
                                y_range=Range1d(start=-1.3, end=1.3), match_aspect=True,
@@ -157,28 +158,18 @@ class Explorer:
         self.mult_fig.line(cx, cy, color="grey")
         self.mult_fig.scatter("re", "im", source=self.mult_src, size=9,
                               legend_label="non-trivial")
-        self.mult_fig.scatter("re", "im", source=self.triv_src, size=14, marker="x",
+        self.mult_fig.scatter("triv_re", "triv_im", source=self.mult_src, size=14, marker="x",
                               color="#d95f02", line_width=2, legend_label="trivial")
         self.mult_fig.legend.location = "bottom_left"
         self.mult_text = Div(text="", name="multipliers")
         self.limit_text = Div(text="", name="limits")
 
-        self.strip_src = ColumnDataSource({"x": [], "y": []})
-        self.strip_pose = ColumnDataSource({"xs": [], "ys": []})
-        self.ground_src = ColumnDataSource({"x": [], "y": []})
-        self.strip_fig = figure(title="runner after the disturbance", width=860, height=240,
-                                x_axis_label="x [L]", y_axis_label="y [L]", match_aspect=True,
-                                name="runner_plot")
-        self.strip_fig.line("x", "y", source=self.ground_src, color="saddlebrown", line_width=2)
-        self.strip_fig.line("x", "y", source=self.strip_src, line_width=2)
-        self.strip_fig.multi_line("xs", "ys", source=self.strip_pose, color="black", alpha=0.5)
-        self.strip_text = Div(text="", name="runner")
-
+        self._build_runner()
         self._build_map()
         controls = column(self.status, self.error, self.preset, self.controller, self.clock,
                           *self.sliders.values(), self.kind, self.fraction, self.link, width=330)
         plots = column(row(self.gait_fig, column(self.mult_fig, self.mult_text)),
-                       self.limit_text, self.strip_fig, self.strip_text, self.map_panel)
+                       self.limit_text, self.runner_panel, self.map_panel)
         self.doc.add_root(row(controls, plots))
         self.doc.title = "tslip explore"
 
@@ -186,6 +177,46 @@ class Explorer:
         c = control_for(name)
         lo, hi = c.span(value)
         return Slider(title=c.title, start=lo, end=hi, step=c.step, value=value, name=name)
+
+    def _build_runner(self) -> None:
+        """The runner's animation: frames sent once a run, played in the browser."""
+        self.frames_src = ColumnDataSource({k: [] for k in _FRAME_KEYS}, name="runner_frames")
+        self.path_src = ColumnDataSource({"x": [], "y": []})
+        self.ground_src = ColumnDataSource({"x": [], "y": []}, name="runner_ground")
+        self.leg_src = ColumnDataSource({"x": [], "y": []}, name="runner_leg")
+        self.axis_src = ColumnDataSource({"x": [], "y": []})
+        self.grf_src = ColumnDataSource({"x": [], "y": []})
+        self.body_src = ColumnDataSource({"x": [], "y": [], "w": [], "h": [], "angle": []})
+        self.joint_src = ColumnDataSource({"x": [], "y": [], "fill": []}, name="runner_pose")
+        fig = figure(title="runner after the disturbance", width=860, height=260,
+                     x_axis_label="x [L]", y_axis_label="y [L]", match_aspect=True,
+                     name="runner_plot")
+        fig.line("x", "y", source=self.ground_src, color="black", line_width=1.5)
+        fig.line("x", "y", source=self.path_src, color="#1f77b4", alpha=0.4)
+        fig.line("x", "y", source=self.leg_src, color="#262626", line_width=1.6)
+        fig.ellipse("x", "y", width="w", height="h", angle="angle", source=self.body_src,
+                    fill_color="#9ecae1", line_color="#08519c", line_width=1.5)
+        fig.line("x", "y", source=self.axis_src, color="#08519c", line_width=1.2)
+        fig.line("x", "y", source=self.grf_src, color="#e34a33", alpha=0.6, line_width=3)
+        fig.scatter("x", "y", source=self.joint_src, size=8, fill_color="fill",
+                    line_color="black")
+        self.clock_label = Label(x=8, y=8, x_units="screen", y_units="screen", text="",
+                                 text_font="monospace", text_font_size="11px")
+        fig.add_layout(self.clock_label)
+        self.play = Toggle(label="play / pause", active=True, name="runner_play", width=110)
+        self.frame = Slider(title="frame", start=0, end=1, step=1, value=0, name="runner_frame",
+                            width=600)
+        player = CustomJS(args={
+            "frames": self.frames_src, "leg": self.leg_src, "axis": self.axis_src,
+            "grf": self.grf_src, "body": self.body_src, "joints": self.joint_src,
+            "label": self.clock_label, "slider": self.frame, "toggle": self.play,
+            "fps": compute.FPS}, code=_PLAYER)
+        self.frames_src.js_on_change("data", player)
+        self.frame.js_on_change("value", player)
+        self.play.js_on_change("active", player)
+        self.strip_fig = fig
+        self.strip_text = Div(text="", name="runner")
+        self.runner_panel = column(fig, row(self.play, self.frame), self.strip_text)
 
     def _build_map(self) -> None:
         names = [c.name for c in CONTROLS] + _all_gains()
@@ -327,12 +358,10 @@ class Explorer:
         with self.lock:
             self.generation += 1
             gen = self.generation
-        self._update_link()
         if not _WARM.is_set():
             self.status.text = "computing the first gait"
-        else:
-            self.status.text = "computing"
-        self.limit_text.text = "robustness limits: updating"
+        # nothing else is sent now: each change is a message the page lays out before the
+        # next, so the gait's draw sends the permalink and "updating" along with the gait
         self._background(self.gait_pool, self._solve, gen, params)
 
     def _update_link(self) -> None:
@@ -360,9 +389,6 @@ class Explorer:
         if self.stale(gen):
             return
         self._post(self._draw_gait, gen, solved)
-        if solved.ok and solved.floquet is not None and solved.floquet.stable:
-            assert solved.gait is not None
-            self._background(self.limit_pool, self._limits, gen, solved.gait)
 
     def _limits(self, gen: int, gait: Any) -> None:
         lim = compute.limits(gait, stop=lambda: self.stale(gen), run=_limit_in_process)
@@ -375,42 +401,59 @@ class Explorer:
         kind, frac = self.kind.value, float(self.fraction.value)
         mag = compute.magnitude(lim[kind], frac)
         traj = compute.disturbed_run(gait, kind, mag)
+        frames, ground = compute.runner_frames(traj), compute.ground(traj)
         if not self.stale(gen):
-            self._post(self._draw_runner, gen, traj, kind, mag)
+            self._post(self._draw_runner, gen, traj, frames, ground, kind, mag)
 
     def _draw_gait(self, gen: int, solved: compute.Solved) -> None:
         if self.stale(gen):
             return
         self.solved, self.limits = solved, None
-        self.status.text = solved.message
         if not solved.ok:
-            for src in (self.gait_src, self.stance_src, self.mult_src, self.triv_src,
-                        self.pose_src, self.strip_src, self.strip_pose, self.ground_src):
+            for src in (self.gait_src, self.mult_src, self.pose_src, self.frames_src,
+                        self.path_src, self.ground_src):
                 src.data = {str(k): [] for k in src.data}
             self.mult_text.text = "no gait"
             self.limit_text.text = "robustness limits: no gait"
             self.strip_text.text = ""
+            self._draw_status(solved.message)
             return
         assert solved.trajectory is not None and solved.floquet is not None
+        assert solved.gait is not None
         tr, fl = solved.trajectory, solved.floquet
         stance = tr["stance"] > 0.5
-        self.gait_src.data = {"x": tr["x"], "y": tr["y"]}
-        self.stance_src.data = {"x": tr["x"][stance], "y": tr["y"][stance]}
+        self.gait_src.data = {"x": tr["x"], "y": tr["y"],
+                              "stance_y": np.where(stance, tr["y"], np.nan)}
         self.pose_src.data = _poses(tr, np.flatnonzero(np.diff(tr["stance"]) > 0.5) + 1)
         m = np.asarray(fl.multipliers)
         kinds = list(fl.trivial_kinds) or [""] * len(m)
         t = np.asarray(fl.trivial, dtype=bool)
-        self.mult_src.data = {"re": m.real[~t], "im": m.imag[~t], "abs": np.abs(m[~t]),
-                              "kind": [k for k, tt in zip(kinds, t, strict=True) if not tt]}
-        self.triv_src.data = {"re": m.real[t], "im": m.imag[t],
-                              "kind": [k for k, tt in zip(kinds, t, strict=True) if tt]}
+        nan = np.full(len(m), np.nan)
+        self.mult_src.data = {"re": np.where(t, nan, m.real), "im": np.where(t, nan, m.imag),
+                              "triv_re": np.where(t, m.real, nan),
+                              "triv_im": np.where(t, m.imag, nan), "abs": np.abs(m),
+                              "kind": [(k or "trivial") if tt else "non-trivial"
+                                       for k, tt in zip(kinds, t, strict=True)]}
         mags = ", ".join(f"{abs(x):.4f}" + (" (trivial)" if tt else "") for x, tt in zip(m, t,
                                                                                         strict=True))
         self.mult_text.text = (f"|multipliers|: {mags}<br>largest non-trivial "
-                               f"{fl.max_nontrivial:.4f}: {fl.stability}")
-        if not fl.stable:
+                               f"{fl.max_nontrivial:.4f}: {fl.stability} (gait residual "
+                               f"{solved.gait.residual:.1e})")
+        if fl.stable:
+            self.limit_text.text = "robustness limits: updating"
+            # asked for here, after the gait is drawn: callbacks posted before the page's
+            # session exists run in any order (Bokeh keeps them in a set), and the limits
+            # drawn before their gait would be hidden by its "updating"
+            self._background(self.limit_pool, self._limits, gen, solved.gait)
+        else:
             self.limit_text.text = "robustness limits: none (the gait is unstable)"
             self.strip_text.text = ""
+        self._draw_status(solved.message)
+
+    def _draw_status(self, message: str) -> None:
+        """The status line (unchanged while gaits are found: a change is a message) and link."""
+        self.status.text = message
+        self._update_link()
 
     def _draw_limits(self, gen: int, lim: dict[str, float]) -> None:
         if self.stale(gen):
@@ -420,16 +463,17 @@ class Explorer:
         self.limit_text.text = "robustness limits (25 strides): " + ", ".join(
             f"{k} {v:.4g} [{units[k]}]" for k, v in lim.items())
 
-    def _draw_runner(self, gen: int, tr: Any, kind: str, mag: float) -> None:
+    def _draw_runner(self, gen: int, tr: Any, frames: dict[str, Any],
+                     ground: tuple[np.ndarray, np.ndarray], kind: str, mag: float) -> None:
         if self.stale(gen):
             return
-        self.strip_src.data = {"x": tr["x"], "y": tr["y"]}
-        idx = np.arange(0, len(tr["t"]), max(1, len(tr["t"]) // 40))
-        self.strip_pose.data = _poses(tr, idx)
-        xs = np.linspace(float(tr["x"].min()) - 0.5, float(tr["x"].max()) + 0.5, 400)
-        self.ground_src.data = {"x": xs, "y": [tr.terrain.height(float(x)) for x in xs]}
+        self.ground_src.data = {"x": ground[0], "y": ground[1]}
+        self.path_src.data = {"x": tr["x"], "y": tr["y"]}
+        self.frames_src.data = frames  # the page plays them (_PLAYER)
         self.strip_text.text = (f"{kind} of {mag:.4g} at the 2nd touch-down: "
-                                f"{len(tr.steps)} strides, {tr.status.name}")
+                                f"{len(tr.steps)} strides, {tr.status.name}; "
+                                f"{len(frames['t'])} frames at {compute.FPS:g} per second, "
+                                f"{compute.SPEED:g} x real time for a 1 m leg")
 
     # -- the stability map ------------------------------------------------------
     def _on_map(self) -> None:
@@ -518,6 +562,62 @@ def _poses(tr: Any, idx: np.ndarray) -> dict[str, Any]:
         ys += [[tr["foot_y"][i], tr["hip_y"][i]], [tr["hip_y"][i], tr["y"][i]]]
     return {"xs": xs, "ys": ys}
 
+
+#: The columns of the runner's frames (:func:`compute.runner_frames`).
+_FRAME_KEYS = ("t", "stance", "com_x", "com_y", "hip_x", "hip_y", "foot_x", "foot_y", "centre_x",
+               "centre_y", "angle", "body_w", "body_h", "leg_x", "leg_y", "axis_x", "axis_y",
+               "grf_x", "grf_y")
+
+#: Plays the runner's frames in the browser: a new run restarts at frame 0, the toggle
+#: starts and stops a timer at ``fps`` that steps the frame slider, and the slider shows
+#: its frame. The pose sources change in the page only (``sync: false``): a frame costs
+#: the server nothing.
+_PLAYER = """
+const n = frames.get_length() || 0;
+const quiet = {sync: false};
+function show(i) {
+  const d = frames.data;
+  if (n === 0) {
+    for (const s of [leg, axis, grf, body, joints]) {
+      const empty = {};
+      for (const k of Object.keys(s.data)) empty[k] = [];
+      s.setv({data: empty}, quiet);
+    }
+    label.setv({text: ''}, quiet);
+    return;
+  }
+  const line = (col) => {  // row i of an (n, m) array
+    const a = d[col], m = a.length / n;
+    return Array.from(a.subarray(i * m, (i + 1) * m));
+  };
+  leg.setv({data: {x: line('leg_x'), y: line('leg_y')}}, quiet);
+  axis.setv({data: {x: line('axis_x'), y: line('axis_y')}}, quiet);
+  grf.setv({data: {x: line('grf_x'), y: line('grf_y')}}, quiet);
+  body.setv({data: {x: [d.centre_x[i]], y: [d.centre_y[i]], w: [d.body_w[i]],
+                    h: [d.body_h[i]], angle: [d.angle[i]]}}, quiet);
+  joints.setv({data: {x: [d.hip_x[i], d.com_x[i], d.foot_x[i]],
+                      y: [d.hip_y[i], d.com_y[i], d.foot_y[i]],
+                      fill: ['white', 'black', d.stance[i] > 0.5 ? '#d62728' : 'white']}},
+              quiet);
+  label.setv({text: `t = ${d.t[i].toFixed(3)} g^-1/2 L^1/2  frame ${i + 1}/${n}  `
+                    + (d.stance[i] > 0.5 ? 'stance' : 'flight')}, quiet);
+}
+if (cb_obj === frames) {
+  slider.setv({end: Math.max(n - 1, 1), value: 0}, quiet);
+  show(0);
+} else if (cb_obj === slider) {
+  show(Math.min(Math.max(Math.round(slider.value), 0), Math.max(n - 1, 0)));
+}
+if (cb_obj === toggle || cb_obj === frames) {
+  if (frames._tslip_timer) { clearInterval(frames._tslip_timer); frames._tslip_timer = null; }
+  if (toggle.active && n > 0) {
+    frames._tslip_timer = setInterval(() => {
+      const m = frames.get_length() || 1;
+      slider.setv({value: (Math.round(slider.value) + 1) % m}, quiet);
+    }, 1000 / fps);
+  }
+}
+"""
 
 #: Keep the address bar on the current state (the permalink's query).
 _REPLACE_URL = """

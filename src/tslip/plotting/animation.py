@@ -10,7 +10,7 @@ import math
 import os
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -23,16 +23,21 @@ from ..simulation.result import TRAJECTORY_COLUMNS
 from .trajectories import ground_profile
 
 if TYPE_CHECKING:
+    from ..model.parameters import Params
     from ..model.terrain import Terrain
     from ..simulation.result import Trajectory
 
-__all__ = ["animate", "frame_times", "render_frames", "TIME_UNIT_1M"]
+__all__ = ["animate", "frame_times", "render_frames", "TIME_UNIT_1M", "Pose", "pose",
+           "sample", "trunk_length", "TRUNK_WIDTH", "FORCE_SCALE"]
 
 #: Seconds per model time unit g^-1/2 L^1/2 for a 1 m leg on Earth.
 TIME_UNIT_1M = math.sqrt(1.0 / 9.81)
 
 _SUFFIXES = (".gif", ".mp4")
 _COL = {name: i for i, name in enumerate(TRAJECTORY_COLUMNS)}
+#: The trunk's drawn width [l0] and the ground force arrow's length [l0 per Mg].
+TRUNK_WIDTH = 0.26
+FORCE_SCALE = 0.15
 
 
 def frame_times(
@@ -73,6 +78,52 @@ def _sample(data: np.ndarray, t_frames: np.ndarray) -> np.ndarray:
     jump = stance[k] != stance[k + 1]
     w = np.where(jump, np.round(w), w)
     return data[k] * (1.0 - w)[:, None] + data[k + 1] * w[:, None]
+
+
+def sample(traj: Trajectory, t_frames: np.ndarray) -> np.ndarray:
+    """The trajectory's rows (``TRAJECTORY_COLUMNS``) at ``t_frames``, as the frames show them."""
+    return _sample(traj.data, np.asarray(t_frames, dtype=float))
+
+
+def trunk_length(params: Params) -> float:
+    """The drawn trunk's length [L]: ``|r| + l0 / 2``, hip and CoM inside it."""
+    return abs(params.r) + 0.5 * params.l0
+
+
+class Pose(NamedTuple):
+    """The runner's drawing at one sample: points [L], the leg, the trunk and the force."""
+
+    com: np.ndarray
+    hip: np.ndarray
+    foot: np.ndarray
+    stance: bool
+    spring: np.ndarray  #: (n, 2) zig-zag polyline from the hip to the foot
+    centre: np.ndarray  #: the trunk's centre, midway between hip and CoM
+    angle: float  #: the trunk's long axis from the x axis [rad]: phi + pi/2
+    axis: np.ndarray  #: (2, 2) ends of the trunk's axis
+    grf: np.ndarray | None  #: tip of the ground force arrow from the foot (stance, force > 0)
+
+
+def pose(row: np.ndarray, l0: float, trunk_len: float) -> Pose:
+    """The :class:`Pose` of one trajectory row (``TRAJECTORY_COLUMNS``).
+
+    The trunk lies along the hip-CoM axis, hip = CoM + r (-sin phi, cos phi)
+    (docs/conventions.md); the leg is a spring from the hip to the foot.
+    """
+    c = _COL
+    x, y, phi = row[c["x"]], row[c["y"]], row[c["phi"]]
+    com = np.array([x, y])
+    hip = np.array([row[c["hip_x"]], row[c["hip_y"]]])
+    foot = np.array([row[c["foot_x"]], row[c["foot_y"]]])
+    stance = bool(row[c["stance"]] > 0.5)
+    up = np.array([-math.sin(phi), math.cos(phi)])
+    centre = 0.5 * (hip + com)
+    axis = np.array([centre - 0.5 * trunk_len * up, centre + 0.5 * trunk_len * up])
+    fx, fy = row[c["Fx"]], row[c["Fy"]]
+    grf = (foot + FORCE_SCALE * l0 * np.array([fx, fy])
+           if stance and math.hypot(fx, fy) > 1e-3 else None)
+    return Pose(com, hip, foot, stance, _spring(hip, foot, l0), centre,
+                float(phi) + 0.5 * math.pi, axis, grf)
 
 
 def _spring(hip: np.ndarray, foot: np.ndarray, l0: float, n_coils: int = 7) -> np.ndarray:
@@ -135,9 +186,10 @@ class _Scene:
             ax.plot(fx, fy, ls="none", marker="|", ms=8, color="0.5", zorder=1)
         (self.trail,) = ax.plot([], [], color="C0", lw=1, alpha=0.6, zorder=2)
         (self.leg,) = ax.plot([], [], color="0.15", lw=1.6, solid_joinstyle="miter", zorder=5)
-        self.trunk_len = trunk_len = abs(p.r) + 0.5 * p.l0
+        self.trunk_len = trunk_len = trunk_length(p)
         self.body = Ellipse(
-            (0, 0), trunk_len, 0.26 * p.l0, angle=90.0, fc="#9ecae1", ec="#08519c", lw=1.5, zorder=3
+            (0, 0), trunk_len, TRUNK_WIDTH * p.l0, angle=90.0, fc="#9ecae1", ec="#08519c", lw=1.5,
+            zorder=3,
         )
         ax.add_patch(self.body)
         (self.axis,) = ax.plot([], [], color="#08519c", lw=1.2, zorder=4)
@@ -158,7 +210,6 @@ class _Scene:
             zorder=7,
         )
         ax.add_patch(self.grf)
-        self.force_scale = 0.15 * p.l0  # L per Mg
         self.text = ax.text(
             0.015,
             0.97,
@@ -172,37 +223,27 @@ class _Scene:
         )
 
     def update(self, row: np.ndarray, trail: np.ndarray, step_no: int) -> None:
-        c = _COL
-        x, y, phi = row[c["x"]], row[c["y"]], row[c["phi"]]
-        hip = np.array([row[c["hip_x"]], row[c["hip_y"]]])
-        foot = np.array([row[c["foot_x"]], row[c["foot_y"]]])
-        stance = row[c["stance"]] > 0.5
+        q = pose(row, self.l0, self.trunk_len)
+        x = q.com[0]
         self.ax.set_xlim(x - 0.4 * self.view_w, x + 0.6 * self.view_w)
         ground = float(np.interp(x, self.gx, self.gy))
         self.ax.set_ylim(ground - 0.12 * self.view_h, ground + 0.88 * self.view_h)
         self.trail.set_data(trail[:, 0], trail[:, 1])
-        spring = _spring(hip, foot, self.l0)
-        self.leg.set_data(spring[:, 0], spring[:, 1])
-        # trunk: an ellipse along the axis through hip and CoM,
-        # hip = CoM + r (-sin phi, cos phi) (docs/conventions.md)
-        up = np.array([-math.sin(phi), math.cos(phi)])
-        centre = 0.5 * (hip + np.array([x, y]))
-        self.body.set_center(tuple(centre))
-        self.body.set_angle(math.degrees(phi) + 90.0)
-        a, b = centre - 0.5 * self.trunk_len * up, centre + 0.5 * self.trunk_len * up
-        self.axis.set_data([a[0], b[0]], [a[1], b[1]])
-        self.hip.set_center(tuple(hip))
-        self.com.set_center((x, y))
-        self.foot.set_center(tuple(foot))
-        self.foot.set_facecolor("C3" if stance else "white")
-        fx, fy = row[c["Fx"]], row[c["Fy"]]
-        if stance and math.hypot(fx, fy) > 1e-3:
-            self.grf.set_positions(tuple(foot), tuple(foot + self.force_scale * np.array([fx, fy])))
+        self.leg.set_data(q.spring[:, 0], q.spring[:, 1])
+        self.body.set_center(tuple(q.centre))
+        self.body.set_angle(math.degrees(q.angle))
+        self.axis.set_data(q.axis[:, 0], q.axis[:, 1])
+        self.hip.set_center(tuple(q.hip))
+        self.com.set_center(tuple(q.com))
+        self.foot.set_center(tuple(q.foot))
+        self.foot.set_facecolor("C3" if q.stance else "white")
+        if q.grf is not None:
+            self.grf.set_positions(tuple(q.foot), tuple(q.grf))
             self.grf.set_visible(True)
         else:
             self.grf.set_visible(False)
         self.text.set_text(
-            f"t = {row[c['t']]:6.3f}  step {step_no:3d}  {'stance' if stance else 'flight'}"
+            f"t = {row[_COL['t']]:6.3f}  step {step_no:3d}  {'stance' if q.stance else 'flight'}"
         )
 
     def render(self) -> np.ndarray:
