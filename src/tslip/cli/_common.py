@@ -212,13 +212,13 @@ def _parse_sets(items: list[str] | None, base: Params) -> dict[str, Any]:
             gains[key.split(".", 1)[1]] = parse_number(value, f"--set {key}")
         elif key in _STRING_KEYS:
             out[key] = value
-        elif key in _TABLE or key == "omega_r_bar":
-            unit = _TABLE[key].unit if key in _TABLE else "-"
+        elif key in _TABLE or key in ("omega_r_bar", "alpha_stop"):
+            unit = _TABLE[key].unit if key in _TABLE else {"alpha_stop": "rad"}.get(key, "-")
             out[key] = parse_number(value, f"--set {key} [{unit}]")
         else:
             raise ValueError(
                 f"unknown parameter {key!r} in --set; allowed: {sorted(_TABLE)} plus "
-                "omega_r_bar, controller, controller.<gain>, leg_reset, retraction"
+                "omega_r_bar, alpha_stop, controller, controller.<gain>, leg_reset, retraction"
             )
     if gains:
         if "controller" in out:
