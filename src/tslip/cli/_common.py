@@ -75,8 +75,8 @@ SetOpt = Annotated[
         "-s",
         metavar="KEY=VALUE",
         help="Override a parameter, e.g. k=30, omega_r_bar=0.2, controller=local_velocity, "
-        "controller.Kd=0.4, leg_reset=global, retraction=apex. Repeatable; applied after "
-        "--params.",
+        "controller.Kd=0.4, leg_reset=global, retraction=apex, alpha_stop=1.3. Repeatable; "
+        "applied after --params.",
     ),
 ]
 ParamsOpt = Annotated[
