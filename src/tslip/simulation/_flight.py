@@ -52,11 +52,11 @@ def stop_time(P, ta):
     ``ta`` is the retraction clock's start (:func:`retraction_start`). The leg
     stops at ``max(alpha_r, alpha_stop)`` (``min`` for ``omega_r < 0``), so at
     ``ta`` itself when ``alpha_r`` is already beyond the stop; no stop
-    (``alpha_stop`` NaN, i.e. ``None``) or ``omega_r = 0``: ``inf``.
+    (``alpha_stop`` packed as 0.0, i.e. ``None``) or ``omega_r = 0``: ``inf``.
     """
     stop = P[P_STOP]
     w = P[P_OMEGA]
-    if stop != stop or w == 0.0:
+    if stop == 0.0 or w == 0.0:
         return math.inf
     return ta + max((stop - P[P_ALPHA]) / w, 0.0)
 
@@ -86,7 +86,7 @@ def flight_leg_angle(P, phi0, phid, t, ta):
         s = 0.0
         w = 0.0
     a = P[P_ALPHA] + P[P_OMEGA] * s
-    if P[P_STOP] == P[P_STOP] and t >= stop_time(P, ta):  # a stop (not NaN), reached
+    if P[P_STOP] != 0.0 and t >= stop_time(P, ta):  # a stop (0.0: none), reached
         a = stop_angle(P)
         w = 0.0
     if P[P_GLOBAL] != 0.0:
