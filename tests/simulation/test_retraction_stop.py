@@ -331,3 +331,15 @@ def test_alpha_stop_on_the_command_line():
         build_params(None, ["alpha_stop=x"], None)
     with pytest.raises(ValueError, match=r"^alpha_stop \[rad\] must be a number in \(0, "):
         build_params(None, ["alpha_stop=4"], None)
+
+
+@pytest.mark.parametrize("placement", ["apex", "liftoff"])
+def test_zero_flight_disturbance_keeps_the_stop(placement):
+    """A disturbance placed in flight restarts the flight from there: the leg must still be
+    held at the stop it reached before (here by the apex) and touch down as undisturbed."""
+    p, s = _with_stop("local, apex clock", 0.6)
+    p = dataclasses.replace(p, retraction="liftoff", alpha_stop=p.alpha_r + 0.05)
+    r = tslip.step(p, s)
+    assert _stop_time(p, r.liftoff.yd) < r.liftoff.yd / p.g < r.flight_time  # stopped by apex
+    run = run_disturbed(p, s, "push", [0.0], n_steps=1, placement=placement)
+    np.testing.assert_allclose(run.touchdowns[0, 0, :5], r.state.section(), atol=1e-12)
