@@ -117,7 +117,7 @@ def parameter_table() -> str:
              "| --- | --- | --- | --- | --- | --- | --- |"]
     for f in dataclasses.fields(Params):
         md = f.metadata
-        if "unit" not in md:
+        if "lower" not in md:  # not a number field (alpha_stop: below)
             continue
         lo = _bound(md["lower"], md["lower_open"], True)
         hi = _bound(md["upper"], md["upper_open"], False)
@@ -130,6 +130,9 @@ def parameter_table() -> str:
     lines.append(f'| `retraction` | | | `"{defaults["retraction"]}"` | {choices(RETRACTIONS)} '
                  "| start of the retraction clock: lift-off (eq. 2.17) or the flight apex "
                  "(held at `alpha_r` until then) | Section 2.5 |")
+    stop = {f.name: f for f in dataclasses.fields(Params)}["alpha_stop"].metadata
+    lines.append(f"| `alpha_stop` | {stop['symbol']} | {stop['unit']} | `None` | {stop['range']} "
+                 f"| {_cell(stop['description'])} | {stop['source']} |")
     return "\n".join(lines) + "\n"
 
 

@@ -20,7 +20,8 @@ The file format
 ---------------
 A saved object is a tree of JSON values; what JSON cannot say is tagged:
 ``{"__type__": "tslip.gait.stability:Floquet", "fields": {...}}`` for a
-dataclass, ``{"__enum__": ..., "value": ...}`` for an enum member,
+dataclass (a field left at its default ``None`` omitted),
+``{"__enum__": ..., "value": ...}`` for an enum member,
 ``{"__ndarray__": dtype, "shape": ..., "data": ...}`` for an array (a list
 for small arrays, base64 of the little-endian bytes for large ones, so the
 values come back bit for bit), ``{"__float__": "nan"}`` for a non-finite
@@ -303,9 +304,11 @@ def encode(obj: Any, where: str = "result") -> Any:
     if isinstance(obj, Result) and dataclasses.is_dataclass(obj):
         return {"__type__": _name(type(obj)), "fields": _encode_fields(obj._fields())}
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        # a field left at its default None is omitted (e.g. Params.alpha_stop: no stop)
         return {"__type__": _name(type(obj)),
                 "fields": _encode_fields({f.name: getattr(obj, f.name)
-                                          for f in dataclasses.fields(obj) if f.init})}
+                                          for f in dataclasses.fields(obj) if f.init and not (
+                                              f.default is None and getattr(obj, f.name) is None)})}
     if isinstance(obj, tuple):
         return {"__tuple__": [encode(v, where) for v in obj]}
     if isinstance(obj, list):

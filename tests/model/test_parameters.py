@@ -18,7 +18,8 @@ def test_table_matches_dataclass_fields_and_defaults():
         assert f.metadata["unit"] == row.unit
         assert f.metadata["symbol"] == row.symbol
     assert {r.name for r in PARAMETER_TABLE} == set(fields) - {"controller", "leg_reset",
-                                                                "retraction"}
+                                                                "retraction", "alpha_stop"}
+    assert fields["alpha_stop"].default is None  # optional: no stop (not a table row)
 
 
 def test_defaults_are_table_2_1():

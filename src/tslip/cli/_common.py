@@ -76,8 +76,8 @@ SetOpt = Annotated[
         "-s",
         metavar="KEY=VALUE",
         help="Override a parameter, e.g. k=30, omega_r_bar=0.2, controller=local_velocity, "
-        "controller.Kd=0.4, leg_reset=global, retraction=apex. Repeatable; applied after "
-        "--params.",
+        "controller.Kd=0.4, leg_reset=global, retraction=apex, alpha_stop=1.3. Repeatable; "
+        "applied after --params.",
     ),
 ]
 ParamsOpt = Annotated[
@@ -216,13 +216,13 @@ def _parse_sets(items: list[str] | None, base: Params) -> dict[str, Any]:
             gains[key.split(".", 1)[1]] = parse_number(value, f"--set {key}")
         elif key in _STRING_KEYS:
             out[key] = value
-        elif key in table or key == "omega_r_bar":
-            unit = table[key].unit if key in table else "-"
+        elif key in table or key in ("omega_r_bar", "alpha_stop"):
+            unit = table[key].unit if key in table else {"alpha_stop": "rad"}.get(key, "-")
             out[key] = parse_number(value, f"--set {key} [{unit}]")
         else:
             raise ValueError(
                 f"unknown parameter {key!r} in --set; allowed: {sorted(table)} plus "
-                "omega_r_bar, controller, controller.<gain>, leg_reset, retraction"
+                "omega_r_bar, alpha_stop, controller, controller.<gain>, leg_reset, retraction"
             )
     if gains:
         if "controller" in out:

@@ -119,8 +119,13 @@ def _run_flight_disturbed(params: Params, state: TouchdownState, kind: Kind, d: 
     fs = np.empty(10)
     if placement == "apex":
         t_a = min(max(lo[3], 0.0) / params.g, s0.flight_time)
-        # the leg's retraction clock keeps running (the apex clock starts at t_a)
-        P[pk.P_ALPHA] += P[pk.P_OMEGA] * max(t_a - kn.retraction_start(P, lo[3]), 0.0)
+        # the leg's retraction clock keeps running (the apex clock starts at t_a) and a
+        # retraction stop reached by t_a holds the leg there (stop_binds)
+        ta = kn.retraction_start(P, lo[3])
+        if _packed.stop_binds(P, lo[3], t_a):
+            P[pk.P_ALPHA] = kn.stop_angle(P)
+        else:
+            P[pk.P_ALPHA] += P[pk.P_OMEGA] * max(t_a - ta, 0.0)
         kn.flight_state(P, lo, t_a, fs)  # (the CoM part does not depend on alpha_r)
         lo = fs[:6].copy()
     tx, th = Terrain.flat(state.h).arrays()

@@ -68,6 +68,9 @@ Progress = Callable[[int, int, float, "Gait | None"], None]
 
 
 def _check_name(params: Params, name: str) -> None:
+    if name == "alpha_stop":
+        raise ValueError("alpha_stop cannot be swept (it may be None, no stop); set it in the "
+                         "parameters of each run")
     if name in _SOLVED:
         raise ValueError(f"{name!r} is solved for by the gait search (Section 2.8); it cannot "
                          "be a continuation parameter")

@@ -51,10 +51,13 @@ from numpy.linalg import _umath_linalg
 from scipy.optimize import least_squares
 
 from .._results import Result, frame
+from ..model._pack import packed_params
 from ..model.controllers import GlobalPD
 from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..model.units import COLUMN_UNITS
+from ..simulation import _packed
+from ..simulation.integrate import step
 from ..simulation.options import IntegratorOptions
 from ._cma import CMAReport, cma_minimize
 from .problem import (
@@ -605,5 +608,23 @@ def find_gait(
         if max_evals < 1:
             raise ValueError(f"max_evals must be >= 1, got {max_evals!r}")
         starts = prob.guesses() if z0 is None else [z0]
-        return _cma_gait(prob, starts, tol, seed, max_evals, polish, jacobian)
-    return _search(prob, z0, tol)
+        gait = _cma_gait(prob, starts, tol, seed, max_evals, polish, jacobian)
+    else:
+        gait = _search(prob, z0, tol)
+    return _refuse_binding_stop(gait, options)
+
+
+def _refuse_binding_stop(gait: Gait, options: IntegratorOptions | None) -> Gait:
+    """``gait``, unless it touches down held by the retraction stop (``alpha_stop``).
+
+    Held there, ``alpha_r`` drops out of the residual (Section 7.5's stop is a
+    disturbance-only mechanism; docs/conventions.md).
+    """
+    p = gait.params
+    if not gait.converged or p.alpha_stop is None:
+        return gait
+    s = step(p, gait.state, options=options)
+    if s.ok and _packed.stop_binds(packed_params(p), s.liftoff.yd, s.flight_time):
+        raise ValueError("alpha_stop binds at the periodic gait, so alpha_r has no effect; "
+                         "choose alpha_stop beyond alpha_TD")
+    return gait

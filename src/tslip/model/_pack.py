@@ -14,7 +14,8 @@ from .parameters import Params
 P_M, P_J, P_R, P_K, P_L0, P_G, P_CL, P_OMEGA, P_ALPHA, P_GLOBAL, P_CTRL = range(11)
 P_C0 = 11  # tau = P[P_C0] + P[P_C0+1] phi + P[P_C0+2] betad + P[P_C0+3] phid
 P_APEX = 15  # 1.0: the retraction clock starts at the flight apex (retraction="apex")
-NP = 16
+P_STOP = 18  # retraction stop angle alpha_stop in (0, pi); 0.0: none (16-17: the stance's)
+NP = 19
 
 # -- integrator options O ----------------------------------------------------
 O_RTOL, O_ATOL, O_H0, O_MAXSTEPS, O_TMAX_STANCE, O_TMAX_FLIGHT, O_HMIN, O_METHOD = range(8)
@@ -106,6 +107,7 @@ def pack_params(p: Params) -> np.ndarray:
     out[P_CL], out[P_OMEGA], out[P_ALPHA] = p.c_l, p.omega_r, p.alpha_r
     out[P_GLOBAL] = 1.0 if p.leg_reset == "global" else 0.0
     out[P_APEX] = 1.0 if p.retraction == "apex" else 0.0
+    out[P_STOP] = 0.0 if p.alpha_stop is None else p.alpha_stop
     out[P_CTRL] = p.controller.code
     out[P_C0 : P_C0 + 4] = p.controller.torque_coefficients()
     return out

@@ -26,6 +26,7 @@ __all__ = [
     "stance_rhs",
     "ground_reaction_force",
     "energy",
+    "swing_angle",
 ]
 
 
@@ -123,3 +124,20 @@ def energy(p: Params, y: np.ndarray, h: float = 0.0) -> float:
     v = jacobian(p, q) @ qd
     return float(0.5 * p.m * (v[0] ** 2 + v[1] ** 2) + 0.5 * p.J * v[4] ** 2 + p.m * p.g * x[1]
                  + 0.5 * p.k * (p.l0 - q[0]) ** 2)
+
+
+def swing_angle(p: Params, s: float) -> float:
+    """Flight leg angle in the frame of ``alpha_r``, ``s`` after the retraction clock's start.
+
+    ``alpha_r + omega_r s`` (eq. 2.17; the local hip angle for ``leg_reset="local"``,
+    the global leg angle for ``"global"``), held at the retraction stop
+    (Section 7.5, ``p.alpha_stop``): ``min(alpha_r + omega_r s, max(alpha_r,
+    alpha_stop))`` for ``omega_r > 0``, the mirror for ``omega_r < 0``
+    (docs/conventions.md). ``s < 0`` (before the clock starts) holds ``alpha_r``.
+    """
+    a = p.alpha_r + p.omega_r * max(s, 0.0)
+    if p.alpha_stop is None or p.omega_r == 0.0:
+        return a
+    if p.omega_r > 0.0:
+        return min(a, max(p.alpha_r, p.alpha_stop))
+    return max(a, min(p.alpha_r, p.alpha_stop))

@@ -104,6 +104,20 @@ PARAMETER_TABLE: tuple[ParameterInfo, ...] = tuple(
 )
 _TABLE = {row.name: row for row in PARAMETER_TABLE}
 
+#: The optional retraction stop angle (Section 7.5): not a row of :data:`PARAMETER_TABLE`,
+#: whose fields are all numbers, because its default is ``None`` (no stop).
+ALPHA_STOP_INFO: dict[str, Any] = {
+    "symbol": "alpha_stop", "unit": "rad", "dims": (0, 0, 0), "range": "(0, pi)",
+    "description": "retraction stop angle in flight, in the frame of alpha_r (None: no stop)",
+    "source": "Section 7.5 (suggested)",
+}
+
+
+def _check_alpha_stop(value: object) -> float:
+    """``alpha_stop`` checked: a number in (0, pi) [rad] (``None`` is handled by the caller)."""
+    return float(check_number(value, "alpha_stop", unit="rad", lower=0.0, upper=math.pi,
+                              lower_open=True, upper_open=True))
+
 
 def _f(name: str) -> Any:
     row = _TABLE[name]
@@ -166,6 +180,11 @@ class Params(_PackCache):
         retracts, ``alpha(t) = alpha_r + omega_r max(0, t - t_apex)``; a flight
         that leaves the ground moving down has no apex, and its clock starts
         at lift-off (``t_apex = t_LO``). docs/conventions.md, "Frames and angles".
+    alpha_stop : float or None
+        Retraction stop angle [rad] in (0, pi), in the frame of ``alpha_r``
+        (Section 7.5): the swing leg retracts no further than
+        ``max(alpha_r, alpha_stop)`` (``min`` for ``omega_r < 0``); ``None``
+        (default) retracts without a stop. docs/conventions.md, "Frames and angles".
 
     Examples
     --------
@@ -191,9 +210,12 @@ class Params(_PackCache):
     controller: Controller = field(default_factory=Passive)
     leg_reset: LegReset = "local"
     retraction: Retraction = "liftoff"
+    alpha_stop: float | None = field(default=None, metadata=ALPHA_STOP_INFO)
 
     def __post_init__(self) -> None:
         check_fields(self)  # every PARAMETER_TABLE row, by its field's metadata
+        if self.alpha_stop is not None:
+            object.__setattr__(self, "alpha_stop", _check_alpha_stop(self.alpha_stop))
         if not isinstance(self.controller, Controller):
             raise ValueError(
                 "controller must be one of Passive, GlobalPD, LocalVelocity, ConstantTorque, "
@@ -225,6 +247,8 @@ class Params(_PackCache):
         out: dict[str, Any] = {row.name: getattr(self, row.name) for row in PARAMETER_TABLE}
         out["leg_reset"] = self.leg_reset
         out["retraction"] = self.retraction
+        if self.alpha_stop is not None:  # None (no stop) is omitted
+            out["alpha_stop"] = self.alpha_stop
         out["controller"] = self.controller.to_dict()
         return out
 
@@ -233,8 +257,8 @@ class Params(_PackCache):
         """Build from a dict of overrides on ``base`` (default: Table 2.1).
 
         Accepts the field names, ``omega_r_bar`` (eq. 2.18), ``preset`` (a
-        base preset name), ``controller`` (a name or a table), ``leg_reset``
-        and ``retraction``. Values are
+        base preset name), ``controller`` (a name or a table), ``leg_reset``,
+        ``retraction`` and ``alpha_stop``. Values are
         typed strictly (see :func:`tslip._checks.check_number`); a ``preset``
         that differs from a given ``base``, or both ``omega_r`` and
         ``omega_r_bar``, is an error rather than a silent choice.
@@ -261,11 +285,13 @@ class Params(_PackCache):
             if name in data:
                 _check_choice(name, data[name])
                 changes[name] = data.pop(name)
+        if "alpha_stop" in data:
+            changes["alpha_stop"] = _check_alpha_stop(data.pop("alpha_stop"))
         for key, value in data.items():
             if key not in _TABLE:
                 raise ValueError(
                     f"unknown parameter {key!r}; allowed: {sorted(_TABLE)} "
-                    "plus omega_r_bar, controller, leg_reset, retraction, preset"
+                    "plus omega_r_bar, controller, leg_reset, retraction, alpha_stop, preset"
                 )
             row = _TABLE[key]
             changes[key] = check_number(

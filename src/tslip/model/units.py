@@ -93,6 +93,8 @@ def param_unit(name: str) -> str | None:
 
     if name == "omega_r_bar":
         return "-"
+    if name == "alpha_stop":
+        return "rad"
     for row in PARAMETER_TABLE:
         if row.name == name:
             return row.unit
@@ -166,6 +168,8 @@ def to_si(params: Params, scaling: Scaling) -> dict[str, Any]:
     }
     out["leg_reset"] = params.leg_reset
     out["retraction"] = params.retraction
+    if params.alpha_stop is not None:  # an angle: the same in SI
+        out["alpha_stop"] = params.alpha_stop
     return out
 
 
@@ -194,7 +198,7 @@ def from_si(values: dict[str, Any], scaling: Scaling | None = None,
                 k: (scaling.to_dimensionless(v, _CONTROLLER_DIMS[k]) if k in _CONTROLLER_DIMS
                     else v) for k, v in ctrl.items()
             }
-        elif key in ("leg_reset", "retraction"):
+        elif key in ("leg_reset", "retraction", "alpha_stop"):
             changes[key] = value
         elif key in dims:
             changes[key] = scaling.to_dimensionless(float(value), dims[key])

@@ -1,7 +1,8 @@
 """Compiled flight in closed form: the swing leg, the flight state, the next touch-down.
 
 Private (see :mod:`._kernels`). Flight is ballistic (eq. 2.7) with the leg reset
-of eq. 2.17 (signs in docs/conventions.md); only the touch-down time needs a
+of eq. 2.17 (signs in docs/conventions.md) and the optional retraction stop
+(Section 7.5, ``Params.alpha_stop``); only the touch-down time needs a
 search (:func:`find_touchdown`, which compiles on its own; the other functions
 are ``inline="always"``, copied into the kernels that call them).
 """
@@ -22,6 +23,7 @@ from ..model._pack import (
     P_L0,
     P_OMEGA,
     P_R,
+    P_STOP,
     ST_ERR_FLIGHT_TIMEOUT,
     ST_FALL_NO_TOUCHDOWN,
     ST_FALL_TRIP,
@@ -44,13 +46,38 @@ def retraction_start(P, yd0):
 
 
 @njit(**_INLINE)
+def stop_time(P, ta):
+    """Time after lift-off at which the leg reaches its stop, ``inf`` if it never does.
+
+    ``ta`` is the retraction clock's start (:func:`retraction_start`). The leg
+    stops at ``max(alpha_r, alpha_stop)`` (``min`` for ``omega_r < 0``), so at
+    ``ta`` itself when ``alpha_r`` is already beyond the stop; no stop
+    (``alpha_stop`` packed as 0.0, i.e. ``None``) or ``omega_r = 0``: ``inf``.
+    """
+    stop = P[P_STOP]
+    w = P[P_OMEGA]
+    if stop == 0.0 or w == 0.0:
+        return math.inf
+    return ta + max((stop - P[P_ALPHA]) / w, 0.0)
+
+
+@njit(**_INLINE)
+def stop_angle(P):
+    """Angle held once stopped: ``max(alpha_r, alpha_stop)`` (``min`` if ``omega_r < 0``)."""
+    return P[P_STOP] if (P[P_STOP] - P[P_ALPHA]) * P[P_OMEGA] > 0.0 else P[P_ALPHA]
+
+
+@njit(**_INLINE)
 def flight_leg_angle(P, phi0, phid, t, ta):
     """Leg angle ``beta(t)`` in flight, ``t`` since lift-off, and its rate.
 
     The hip angle is ``alpha_r + omega_r max(0, t - ta)`` with ``ta`` from
-    :func:`retraction_start` (held at ``alpha_r`` until then); ``beta = alpha -
-    phi(t)`` for the local reset, ``beta = alpha`` for the global one. The rate
-    is the one from ``t`` on (retracting at ``t = ta``).
+    :func:`retraction_start` (held at ``alpha_r`` until then), held at the stop
+    from :func:`stop_time` on (``min(alpha_r + omega_r max(0, t - ta),
+    max(alpha_r, alpha_stop))`` for ``omega_r > 0``, docs/conventions.md);
+    ``beta = alpha - phi(t)`` for the local reset, ``beta = alpha`` for the
+    global one. The rate is the one from ``t`` on (retracting at ``t = ta``,
+    stopped at the stop time).
     """
     if t >= ta:
         s = t - ta
@@ -58,9 +85,13 @@ def flight_leg_angle(P, phi0, phid, t, ta):
     else:
         s = 0.0
         w = 0.0
+    a = P[P_ALPHA] + P[P_OMEGA] * s
+    if P[P_STOP] != 0.0 and t >= stop_time(P, ta):  # a stop (0.0: none), reached
+        a = stop_angle(P)
+        w = 0.0
     if P[P_GLOBAL] != 0.0:
-        return P[P_ALPHA] + P[P_OMEGA] * s, w
-    return P[P_ALPHA] + P[P_OMEGA] * s - (phi0 + phid * t), w - phid
+        return a, w
+    return a - (phi0 + phid * t), w - phid
 
 
 @njit(**_INLINE)
@@ -134,7 +165,10 @@ def find_touchdown(P, O, lo, tx, th, res):
     it has to rise, docs/conventions.md). Terrain: heights ``th[k]`` between
     breakpoints ``tx`` (``len(th) == len(tx) + 1``). With the apex clock the
     leg rate jumps at the apex, so ``K`` bounds both rates and no step
-    crosses the apex.
+    crosses the apex. The retraction stop (``alpha_stop``) splits the search
+    at :func:`stop_time` too: no step crosses it, and ``K`` is the held leg's
+    from there on (a flight that touches down before it takes the steps it
+    takes without a stop).
 
     ``res`` receives ``(t_td, ground_h, clearance_at_reset)``.
     """
@@ -146,6 +180,7 @@ def find_touchdown(P, O, lo, tx, th, res):
     ta = retraction_start(P, lo[3])
     if ta > 0.0:  # before the apex the held leg turns with the trunk (local) or not at all
         bd = max(abs(bd), abs(0.0 if P[P_GLOBAL] != 0.0 else phid))
+    ts = stop_time(P, ta)
     Kf = g + r * phid * phid + l0 * bd * bd + 1e-300
     Kh = g + r * phid * phid + 1e-300
     vx = abs(lo[2]) + r * abs(phid) + l0 * abs(bd) + 1e-300
@@ -158,6 +193,11 @@ def find_touchdown(P, O, lo, tx, th, res):
     res[2] = foot_y - th[k]
     armed = foot_y - th[k] > 0.0
     for _ in range(100000):
+        if t >= ts:  # stopped from here on: the leg turns with the trunk (local) or not at all
+            ts = math.inf
+            bd = 0.0 if P[P_GLOBAL] != 0.0 else phid
+            Kf = g + r * phid * phid + l0 * bd * bd + 1e-300
+            vx = abs(lo[2]) + r * abs(phid) + l0 * abs(bd) + 1e-300
         if t > t_max:
             res[0] = t
             return ST_ERR_FLIGHT_TIMEOUT
@@ -193,6 +233,8 @@ def find_touchdown(P, O, lo, tx, th, res):
             dt = min(dt, max(dist / vx, 1e-12))
         if t < ta:  # stop at the apex: the foot's rate jumps there
             dt = min(dt, ta - t)
+        elif ts < math.inf:  # and at the retraction stop (Section 7.5)
+            dt = min(dt, ts - t)
         t += dt
         foot_y, foot_yd, hip_y, hip_yd, foot_x = _flight_heights(P, lo, t, ta)
         knew = _segment(tx, foot_x)

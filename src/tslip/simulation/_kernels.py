@@ -31,6 +31,8 @@ from ._flight import (
     flight_samples,
     flight_state,
     retraction_start,
+    stop_angle,
+    stop_time,
 )
 from ._record import RECORD_RUN
 from ._specialise import ByMethod
@@ -60,8 +62,9 @@ __all__ = [
     "STRIDE", "com_velocity",
     "event_values", "find_touchdown", "flight_leg_angle", "flight_samples", "flight_state",
     "grf", "hip_torque", "integrate_stance", "record_run", "retraction_start", "rhs",
-    "run_batch", "run_batch_serial", "stance_accel", "stance_initial", "stride", "stride_batch",
-    "stride_batch_serial",
+    "run_batch", "run_batch_serial", "stance_accel", "stance_initial", "stop_angle",
+    "stop_time", "stride",
+    "stride_batch", "stride_batch_serial",
 ]
 
 

@@ -97,6 +97,16 @@ def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # no
     return st
 
 
+def stop_binds(P: np.ndarray, yd0: float, tf: float) -> bool:
+    """Whether a flight of ``tf`` after a lift-off at ``ydot = yd0`` touches down stopped.
+
+    The retraction stop (Section 7.5; docs/conventions.md) holds the hip angle
+    at ``max(alpha_r, alpha_stop)`` (``min`` for ``omega_r < 0``) from
+    :func:`._kernels.stop_time` on; False without a stop or with ``omega_r = 0``.
+    """
+    return bool(tf >= kn.stop_time(P, kn.retraction_start(P, yd0)))
+
+
 def alpha_r_column(P: np.ndarray, out: np.ndarray) -> np.ndarray:
     """``dq'/d alpha_r`` of a completed stride (5,), from its ``out`` vector.
 
@@ -108,11 +118,15 @@ def alpha_r_column(P: np.ndarray, out: np.ndarray) -> np.ndarray:
     With ``df/d alpha_r = -l0 cos beta`` the implicit derivative is
     ``dt_TD/d alpha_r = l0 cos beta / f'(t_TD)``, and ``q' = (beta(t),
     phi(t), xd, yd - g t, phid)`` moves by its time derivative times that,
-    plus 1 in ``beta``.
+    plus 1 in ``beta``. A touch-down held at ``alpha_stop`` by the retraction
+    stop (:func:`stop_binds`) does not depend on ``alpha_r``: the column is 0
+    (a reset beyond the stop is held at ``alpha_r``, as without retraction).
     """
     g, r, l0 = P[pk.P_G], P[pk.P_R], P[pk.P_L0]
     tf = out[pk.OUT_TF]
     phi0, yd0, phid0 = out[pk.OUT_LO + 4], out[pk.OUT_LO + 3], out[pk.OUT_LO + 5]
+    if stop_binds(P, yd0, tf) and kn.stop_angle(P) != P[pk.P_ALPHA]:
+        return np.zeros(5)
     b = out[pk.OUT_TD]  # beta(t_TD)
     _, bdot = kn.flight_leg_angle(P, phi0, phid0, tf, kn.retraction_start(P, yd0))
     ph = phi0 + phid0 * tf

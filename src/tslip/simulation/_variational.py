@@ -16,7 +16,9 @@ chain; each link is differentiated exactly:
    retraction clock (``retraction="apex"``) the touch-down leg angle also
    depends on the lift-off ``ydot`` through the apex time ``t_apex = ydot / g``,
    ``d beta / d ydot = -omega_r / g`` when the leg retracts at touch-down (0 when
-   it touches down still held, and for a flight without apex).
+   it touches down still held, and for a flight without apex); a touch-down
+   after the retraction stop (``alpha_stop``) has a constant hip angle, whose
+   derivatives are 0.
 
 ``Df`` comes from differentiating ``M qdd = R`` (eq. 2.3, ``R = Q - C``):
 ``d qdd = M^-1 (dR - dM qdd)``, with the closed-form ``M^-1`` of
@@ -54,7 +56,7 @@ from ..model._pack import (
     ST_OK,
 )
 from . import _rk
-from ._flight import flight_leg_angle, retraction_start
+from ._flight import flight_leg_angle, retraction_start, stop_time
 from ._rk import _INLINE, _JIT
 from ._specialise import ByMethod, specialise
 from ._stance import NSTATE, hip_torque, rhs, stance_initial
@@ -276,8 +278,9 @@ def _make_stride_jacobian(method: int) -> Callable:
         local = P[P_GLOBAL] == 0.0
         dbdphi = -1.0 if local else 0.0
         dbdphid = -tf if local else 0.0
-        # apex clock: beta = alpha_r + omega_r (t - yd0 / g) [- phi(t)] once retracting
-        dbdyd = -P[P_OMEGA] / g if (ta > 0.0 and tf >= ta) else 0.0
+        # apex clock: beta = alpha_r + omega_r (t - yd0 / g) [- phi(t)] once retracting,
+        # until the retraction stop (then the hip angle is a constant)
+        dbdyd = -P[P_OMEGA] / g if (ta > 0.0 and tf >= ta and tf < stop_time(P, ta)) else 0.0
         spt, cbt = math.sin(pht), math.cos(bt)
         # partials of f with respect to lo = (y, xd, yd, phi, phid) and t
         df = np.array([1.0, 0.0, tf, -r * spt - l0 * cbt * dbdphi,
