@@ -53,9 +53,11 @@ from ..model._pack import (
     OUT_TF,
     OUT_TFALL,
     OUT_TS,
+    OUT_TSW,
     OUT_XF,
     P_L0,
     P_R,
+    P_THRUST,
     ST_ERR_MAX_STEPS,
     ST_ERR_NONFINITE,
     ST_ERR_STANCE_TIMEOUT,
@@ -209,6 +211,18 @@ def event_status(ev):
 
 
 @njit(**_INLINE)
+def thrust_switch(Pw, O, method, y, K, gv, ytmp):
+    """The leg thrust's switch at the stance state ``y`` (event 4): the working
+    parameters ``Pw`` take the rest length ``l0 (1 + d)`` (``P_THRUST`` holds ``-d``);
+    ``K[0] = f(y)`` and the event values ``gv`` anew; returns the next step size,
+    estimated afresh (the vector field jumps there)."""
+    Pw[P_THRUST] = -Pw[P_THRUST]
+    event_values(Pw, y, gv)
+    rhs(Pw, y, K[0])
+    return initial_step(Pw, method, y, K[0], O[O_RTOL], O[O_ATOL], ytmp, K[1])
+
+
+@njit(**_INLINE)
 def stance_out(y, stats, out):
     """``out`` of a stance alone: the final state, then ``stats``."""
     for i in range(NSTATE):
@@ -272,6 +286,11 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
     def stride(P, O, td, tx, th, rec, rec_dt, out):
         """One stride from the touch-down state ``td`` (7) to the next, with the pair ``method``.
 
+        With leg thrust (``P[P_THRUST] > 0``) the stance runs on a copy of ``P``
+        whose rest length switches at the first ``ldot`` crossing from < 0 to >= 0
+        (event 4, :func:`thrust_switch`; its time since touch-down in ``OUT_TSW``);
+        without, on ``P`` itself, and no switch is looked for.
+
         Fills ``out`` (layout ``OUT_*`` in ``_pack``) and returns the status.
         Without ``fly``, the stance alone from the stance state ``td`` (6): ``out``
         receives the final state and ``stats`` (below), and nothing else runs.
@@ -291,6 +310,8 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         read. ``stats`` = ``[t_end, n_accepted, n_rejected, n_recorded, overflow]``.
         """
         y = np.empty(NSTATE)
+        P0 = P
+        P = P0.copy() if P0[P_THRUST] > 0.0 else P0  # the stance's working parameters
         if fly:
             xf = stride_start(P, td, y, out)
         else:
@@ -323,7 +344,17 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
             if ev < 0 or h > 0.0:
                 # one Runge-Kutta step (the one loop holds the stage arithmetic once)
                 rk_step(P, method, y, h, K, ytmp, ynew)
-            if ev >= 0:
+            if ev == 4:
+                # that was the exact step to the thrust's switch: the stance goes on
+                t += h
+                if h > 0.0:
+                    copy_state(y, ynew)
+                h = thrust_switch(P, O, method, y, K, gv_old, ytmp)
+                if fly:
+                    out[OUT_TSW] = t
+                ev = -1
+                last_rejected = False
+            elif ev >= 0:
                 # that was the exact step to the event: the stance ends
                 t += h
                 if h > 0.0:
@@ -375,7 +406,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         stats[3] = nrec
         stats[4] = overflow
         if fly:
-            return stride_finish(P, O, status, td, xf, y, stats, tx, th, out)
+            return stride_finish(P0, O, status, td, xf, y, stats, tx, th, out)
         stance_out(y, stats, out)
         return status
 
