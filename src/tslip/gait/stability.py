@@ -170,12 +170,12 @@ def conserved_gradients(params: Params, q: np.ndarray) -> list[np.ndarray]:
     """Gradients on the section of the quantities the stride map conserves.
 
     Energy ``E = m (xd^2 + yd^2)/2 + J phid^2/2 + m g (l0 sin beta - r cos phi)``
-    when nothing dissipates or adds work (no torque, no leg damping); the pitch
-    rate too when in addition ``r = 0``.
+    when nothing dissipates or adds work (no torque, no leg damping, no leg
+    thrust); the pitch rate too when in addition ``r = 0``.
     """
     p = params
     no_torque = not any(p.controller.torque_coefficients())
-    if not (no_torque and p.c_l == 0.0):
+    if not (no_torque and p.c_l == 0.0 and p.leg_thrust == 0.0):
         return []
     b, ph, xd, yd, phd = q
     grads = [np.array([p.m * p.g * p.l0 * math.cos(b), p.m * p.g * p.r * math.sin(ph),

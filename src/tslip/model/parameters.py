@@ -235,7 +235,10 @@ class Params(_PackCache):
 
     @property
     def bounce_time(self) -> float:
-        """Spring-mass half period ``pi sqrt(m/k)`` (eq. 3.9)."""
+        """Spring-mass half period ``pi sqrt(m/k)`` (eq. 3.9) of the linear leg."""
+        if self.leg_exponent != 1.0:
+            raise ValueError("bounce_time of a leg_exponent != 1 spring depends on its "
+                             "amplitude; use tslip.gait.bounce_time(params, leg_speed)")
         return math.pi * math.sqrt(self.m / self.k)
 
     # -- serialisation -------------------------------------------------------
