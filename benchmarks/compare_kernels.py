@@ -21,7 +21,6 @@ import sys
 
 import numpy as np
 
-
 _OUT_ADDED = ("OUT_TSW",)  # output slots added since the first checkouts compared
 
 
