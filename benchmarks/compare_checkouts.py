@@ -69,6 +69,7 @@ def main() -> None:
             for k in ("AB" if i % 2 == 0 else "BA"):
                 loads.append(os.getloadavg()[0])
                 res[k].append(_run(srcs[k], caches[k], a.bench_args))
+                print(f"run {i + 1} {k} (load {loads[-1]:.1f}): {res[k][-1]}", flush=True)
     print(f"A = {srcs['A'].parent}, B = {srcs['B'].parent}; {a.repeats} alternated runs each "
           f"of bench_limit.py {' '.join(a.bench_args)}; 1-min load {min(loads):.1f}-"
           f"{max(loads):.1f}")

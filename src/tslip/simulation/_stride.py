@@ -211,15 +211,32 @@ def event_status(ev):
 
 
 @njit(**_INLINE)
-def thrust_switch(Pw, O, method, y, K, gv, ytmp):
-    """The leg thrust's switch at the stance state ``y`` (event 4): the working
-    parameters ``Pw`` take the rest length ``l0 (1 + d)`` (``P_THRUST`` holds ``-d``);
-    ``K[0] = f(y)`` and the event values ``gv`` anew; returns the next step size,
-    estimated afresh (the vector field jumps there)."""
+def working_params(P):
+    """The stance's parameters: a copy of ``P`` to switch the rest length in if it has
+    leg thrust (:func:`thrust_switch`), else ``P`` itself."""
+    return P.copy() if P[P_THRUST] > 0.0 else P
+
+
+@njit(**_INLINE)
+def thrust_switch(Pw, O, method, y, K, gv, ytmp, fly, t, out):
+    """The leg thrust's switch at the stance state ``y`` (event 4, at time ``t``, kept in
+    ``out[OUT_TSW]`` of a stride): the working parameters ``Pw`` take the rest length
+    ``l0 (1 + d)`` (``P_THRUST`` holds ``-d``); ``K[0] = f(y)`` and the event values
+    ``gv`` anew; returns the next step size, estimated afresh (the field jumps there)."""
+    if fly:
+        out[OUT_TSW] = t
     Pw[P_THRUST] = -Pw[P_THRUST]
     event_values(Pw, y, gv)
     rhs(Pw, y, K[0])
     return initial_step(Pw, method, y, K[0], O[O_RTOL], O[O_ATOL], ytmp, K[1])
+
+
+@njit(**_INLINE)
+def record_close(P, rec, nrec, t, y, on_grid, status):
+    """Close a grid record with the lift-off row: ``(rows used, overflow)``."""
+    if on_grid and status == ST_OK:
+        return append_row(P, rec, nrec, t, y)
+    return nrec, 0.0
 
 
 @njit(**_INLINE)
@@ -311,7 +328,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         """
         y = np.empty(NSTATE)
         P0 = P
-        P = P0.copy() if P0[P_THRUST] > 0.0 else P0  # the stance's working parameters
+        P = working_params(P0)
         if fly:
             xf = stride_start(P, td, y, out)
         else:
@@ -349,9 +366,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
                 t += h
                 if h > 0.0:
                     copy_state(y, ynew)
-                h = thrust_switch(P, O, method, y, K, gv_old, ytmp)
-                if fly:
-                    out[OUT_TSW] = t
+                h = thrust_switch(P, O, method, y, K, gv_old, ytmp, fly, t, out)
                 ev = -1
                 last_rejected = False
             elif ev >= 0:
@@ -395,10 +410,8 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
             if at_steps:
                 nrec, ovf = append_row(P, rec, nrec, t, y)
                 overflow = max(overflow, ovf)
-        if on_grid and status == ST_OK:
-            # always close the record with the lift-off row
-            nrec, ovf = append_row(P, rec, nrec, t, y)
-            overflow = max(overflow, ovf)
+        nrec, ovf = record_close(P, rec, nrec, t, y, on_grid, status)  # the lift-off row
+        overflow = max(overflow, ovf)
         stats = np.empty(5)
         stats[0] = t
         stats[1] = n_acc
