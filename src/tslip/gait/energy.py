@@ -194,12 +194,21 @@ def velocity_after_height_change(
     -------
     HeightChangeResult
 
+    Raises
+    ------
+    ValueError
+        For ``leg_thrust != 0``: the thrust adds energy every stride, so eq. 3.8's
+        balance does not hold.
+
     References
     ----------
     Thesis Sections 3.3 and 4.2, eq. 3.8, Figure 4.4.
     """
     if not (isinstance(n_average, int) and 2 <= n_average <= n_steps):
         raise ValueError(f"n_average must be an integer in [2, n_steps], got {n_average!r}")
+    if gait.params.leg_thrust != 0.0:
+        raise ValueError(f"leg_thrust must be 0 for the energy balance of eq. 3.8 (a "
+                         f"conservative model), got {gait.params.leg_thrust!r}")
     v0 = gait.state.v
     dv_expected = expected_velocity_change(v0, dh, gait.params.g)
     traj = simulate(gait.params, gait.state, n_steps, disturbance=Disturbance(dh=dh),

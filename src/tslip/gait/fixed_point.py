@@ -406,8 +406,10 @@ def _newton_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float,
                  max_starts: int | None) -> Gait:
     starts = iter(starts)
     first = next(starts)
-    # global PD has more equations than unknowns and no exact fixed point: least squares only
-    exact = not isinstance(prob.params.controller, GlobalPD)
+    # global PD has more equations than unknowns and no exact fixed point: least squares
+    # only; so too a leg spring exponent below 1, which has no exact Jacobian
+    exact = not isinstance(prob.params.controller, GlobalPD) and prob.params.leg_exponent >= 1
+
     z, err, n = newton_solve(prob.residual, itertools.chain([first], starts), tol=tol,
                              max_starts=max_starts,
                              jacobian=prob.residual_jacobian if exact else None)
@@ -468,7 +470,8 @@ def _cma_gait(prob: GaitProblem, starts: Iterable[np.ndarray], tol: float, seed:
     head += f", residual {r_cma:.2e}"
     if not polish:
         return _make_gait(prob, x, tol, head, "cma", report)
-    z, err, _ = newton_solve(prob.residual, [x], tol=tol, jacobian=prob.residual_jacobian)
+    z, err, _ = newton_solve(prob.residual, [x], tol=tol, jacobian=(
+        prob.residual_jacobian if prob.params.leg_exponent >= 1 else None))
     if z is None or err > r_cma:  # polishing did not help: keep the CMA-ES point
         return _make_gait(prob, x, tol, head + "; Newton polish failed", "cma", report)
     z = _wrap(prob, z)

@@ -535,6 +535,8 @@ class GaitProblem:
 
         p, s = self.decode(z)
         q = s.section()
+        if p.leg_exponent < 1.0:
+            jacobian = "fd"  # no exact Jacobian (tslip.simulation._packed.check_exact)
         try:
             A = map_jacobian(p, q, method=jacobian, options=self.options)
         except ValueError:

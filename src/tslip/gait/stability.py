@@ -170,12 +170,12 @@ def conserved_gradients(params: Params, q: np.ndarray) -> list[np.ndarray]:
     """Gradients on the section of the quantities the stride map conserves.
 
     Energy ``E = m (xd^2 + yd^2)/2 + J phid^2/2 + m g (l0 sin beta - r cos phi)``
-    when nothing dissipates or adds work (no torque, no leg damping); the pitch
-    rate too when in addition ``r = 0``.
+    when nothing dissipates or adds work (no torque, no leg damping, no leg
+    thrust); the pitch rate too when in addition ``r = 0``.
     """
     p = params
     no_torque = not any(p.controller.torque_coefficients())
-    if not (no_torque and p.c_l == 0.0):
+    if not (no_torque and p.c_l == 0.0 and p.leg_thrust == 0.0):
         return []
     b, ph, xd, yd, phd = q
     grads = [np.array([p.m * p.g * p.l0 * math.cos(b), p.m * p.g * p.r * math.sin(ph),
@@ -318,7 +318,9 @@ def floquet(
         From :func:`tslip.find_gait`.
     method : {"exact", "fd"}
         Variational equations with saltation, or central differences (eq. B.2;
-        on the apex section, of the apex map).
+        on the apex section, of the apex map). ``"exact"`` for a leg spring
+        exponent below 1 uses ``"fd"`` (its stiffness is infinite at touch-down;
+        the result's ``method`` says ``"fd"``).
     step : float
         Finite-difference step (``method="fd"``); results are insensitive to
         it between about 1e-6 and 1e-4 at the default tolerance 1e-12.
@@ -334,6 +336,8 @@ def floquet(
     Floquet
     """
     section = gait.section if section is None else section
+    if method == "exact" and gait.params.leg_exponent < 1.0:
+        method = "fd"  # no exact Jacobian (tslip.simulation._packed.check_exact)
     if section not in ("touchdown", "apex"):
         raise ValueError(f"section must be 'touchdown' or 'apex', got {section!r}")
     q = gait.state.section()

@@ -18,9 +18,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._results import Result, frame
+from ..model._pack import packed_params
 from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..model.units import COLUMN_UNITS, UNIT
+from ..simulation._kernels import stance_initial
 from ..simulation.options import IntegratorOptions
 from .fixed_point import Gait
 from .impulse import _impulse_from_run, _stance_run
@@ -42,8 +44,22 @@ __all__ = [
 ]
 
 
-def bounce_time(params: Params) -> float:
+def bounce_time(params: Params, leg_speed: float | None = None) -> float:
     """Half period of the spring-mass bounce, ``pi sqrt(m/k)`` (eq. 3.9).
+
+    For a power-law leg (``leg_exponent = n != 1``, docs/model.md) the period
+    depends on the amplitude: the bounce ``m l'' = F_s(l)`` from ``l = l0`` at
+    the leg speed ``|ldot| = leg_speed`` compresses to ``x_max = ((n+1) m ldot^2 /
+    (2 k l0^2))^(1/(n+1))`` (``V(x_max)`` equal to the kinetic energy) and lasts
+    ``t_b = 2 sqrt((n+1) m / (2 k)) x_max^((1-n)/2) I_n``, ``I_n = int_0^1 (1 -
+    u^(n+1))^(-1/2) du = sqrt(pi) G(1/(n+1)) / ((n+1) G(1/(n+1) + 1/2))``
+    (``G`` the gamma function); ``n = 1`` gives eq. 3.9 for any amplitude.
+
+    Parameters
+    ----------
+    params : Params
+    leg_speed : float, optional
+        ``|ldot|`` at touch-down [g^1/2 L^1/2]; required when ``n != 1``.
 
     Returns
     -------
@@ -56,7 +72,18 @@ def bounce_time(params: Params) -> float:
     >>> round(bounce_time(tslip.preset("table2.1")), 4)
     0.6283
     """
-    return math.pi * math.sqrt(params.m / params.k)
+    n = params.leg_exponent
+    if n == 1.0:
+        return math.pi * math.sqrt(params.m / params.k)
+    if leg_speed is None or not (math.isfinite(leg_speed) and leg_speed > 0):
+        raise ValueError(f"leg_speed must be in (0, inf) for leg_exponent {n:g} != 1 (the "
+                         f"bounce time of a non-linear spring depends on its amplitude), "
+                         f"got {leg_speed!r}")
+    p = params
+    x_max = ((n + 1) * p.m * leg_speed**2 / (2 * p.k * p.l0**2)) ** (1 / (n + 1))
+    a = 1 / (n + 1)
+    integral = math.sqrt(math.pi) * math.gamma(a) / ((n + 1) * math.gamma(a + 0.5))
+    return 2 * math.sqrt((n + 1) * p.m / (2 * p.k)) * x_max ** ((1 - n) / 2) * integral
 
 
 def predicted_stance_time(params: Params, v0: float | None = None) -> float:
@@ -104,7 +131,8 @@ def predicted_flight_time(
     return 2.0 * abs(yd) / g, approx
 
 
-def fast_running_index(params: Params, v0: float | None = None) -> float:
+def fast_running_index(params: Params, v0: float | None = None,
+                       leg_speed: float | None = None) -> float:
     """Fast-running index ``I_fr = pi v0 sqrt(m/k) / (l0 (pi - 2 beta0))`` (eq. 3.12).
 
     The ratio of the bounce time (eq. 3.9) to the geometric stance time
@@ -115,6 +143,8 @@ def fast_running_index(params: Params, v0: float | None = None) -> float:
     params : Params
     v0 : float, optional
         Speed [g^1/2 L^1/2]; default ``params.v0``.
+    leg_speed : float, optional
+        Touch-down ``|ldot|`` for a power-law leg (:func:`bounce_time`).
 
     Returns
     -------
@@ -129,7 +159,7 @@ def fast_running_index(params: Params, v0: float | None = None) -> float:
     >>> round(fast_running_index(tslip.preset("table6.1"), v0=4.4 / math.sqrt(9.81 * 0.5)), 2)
     1.72
     """
-    return bounce_time(params) / predicted_stance_time(params, v0)
+    return bounce_time(params, leg_speed) / predicted_stance_time(params, v0)
 
 
 _STRIDE_UNITS = {**COLUMN_UNITS, **dict.fromkeys(
@@ -153,7 +183,8 @@ class StrideProperties(Result):
     step_frequency : float
         ``1 / (t_s + t_f)`` (Table 6.2).
     bounce_time : float
-        ``t_b = pi sqrt(m/k)`` (eq. 3.9).
+        ``t_b = pi sqrt(m/k)`` (eq. 3.9); for a power-law leg at the touch-down
+        leg speed (:func:`bounce_time`).
     stance_time_predicted : float
         ``2 l0 (pi/2 - beta0) / v0`` (eq. 3.10).
     flight_time_predicted : float
@@ -218,17 +249,20 @@ def stride_properties(gait: Gait) -> StrideProperties:
     """
     p, s = gait.params, gait.state
     ts, tf = float(gait.stance_time), float(gait.flight_time)
+    y0 = np.empty(6)
+    stance_initial(packed_params(p), s.as_array(), y0)  # eq. A.5 inverted
+    ld = abs(float(y0[3]))
     tf_exact, tf_approx = predicted_flight_time(s.yd, p.g, v0=s.v, delta=s.delta)
     return StrideProperties(
         stance_time=ts,
         flight_time=tf,
         duty_factor=ts / (ts + tf),
         step_frequency=1.0 / (ts + tf),
-        bounce_time=bounce_time(p),
+        bounce_time=bounce_time(p, ld),
         stance_time_predicted=predicted_stance_time(p, s.v),
         flight_time_predicted=tf_exact,
         flight_time_small_angle=tf_approx,
-        fast_running_index=fast_running_index(p, s.v),
+        fast_running_index=fast_running_index(p, s.v, ld),
         params=p,
         state=s,
     )

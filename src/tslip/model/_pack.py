@@ -14,7 +14,9 @@ from .parameters import Params
 P_M, P_J, P_R, P_K, P_L0, P_G, P_CL, P_OMEGA, P_ALPHA, P_GLOBAL, P_CTRL = range(11)
 P_C0 = 11  # tau = P[P_C0] + P[P_C0+1] phi + P[P_C0+2] betad + P[P_C0+3] phid
 P_APEX = 15  # 1.0: the retraction clock starts at the flight apex (retraction="apex")
-P_STOP = 18  # retraction stop angle alpha_stop in (0, pi); 0.0: none (16-17: the stance's)
+P_NEXP = 16  # leg spring exponent n (1: the linear spring of eq. 2.1)
+P_THRUST = 17  # leg thrust d >= 0; a stance's working copy holds -d once its rest length switched
+P_STOP = 18  # retraction stop angle alpha_stop in (0, pi); 0.0: none
 NP = 19
 
 # -- integrator options O ----------------------------------------------------
@@ -45,7 +47,8 @@ OUT_FYNEG = 23  # 1.0 if F_y < 0 right at touch-down
 OUT_TFALL = 24  # time of the fall since touch-down (NaN if none)
 OUT_NREC = 25  # number of recorded stance rows
 OUT_RECOVF = 26  # 1.0 if the record buffer overflowed
-NOUT = 27
+OUT_TSW = 27  # time of the leg thrust's switch since touch-down (NaN if none)
+NOUT = 28
 
 # -- record row -----------------------------------------------------------
 REC_T, REC_L, REC_BETA, REC_PHI, REC_LD, REC_BETAD, REC_PHID, REC_FX, REC_FY, REC_TAU = range(10)
@@ -107,6 +110,7 @@ def pack_params(p: Params) -> np.ndarray:
     out[P_CL], out[P_OMEGA], out[P_ALPHA] = p.c_l, p.omega_r, p.alpha_r
     out[P_GLOBAL] = 1.0 if p.leg_reset == "global" else 0.0
     out[P_APEX] = 1.0 if p.retraction == "apex" else 0.0
+    out[P_NEXP], out[P_THRUST] = p.leg_exponent, p.leg_thrust
     out[P_STOP] = 0.0 if p.alpha_stop is None else p.alpha_stop
     out[P_CTRL] = p.controller.code
     out[P_C0 : P_C0 + 4] = p.controller.torque_coefficients()

@@ -12,6 +12,8 @@ IHMC 2019, Section 2.2 and Appendix A.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .parameters import Params
@@ -23,6 +25,9 @@ __all__ = [
     "forces",
     "convective",
     "hip_torque",
+    "spring_force",
+    "spring_energy",
+    "leg_force",
     "stance_rhs",
     "ground_reaction_force",
     "energy",
@@ -76,15 +81,40 @@ def hip_torque(p: Params, q: np.ndarray, qd: np.ndarray) -> float:
     return c.tau_c - c.c_h * alphad  # type: ignore[attr-defined]
 
 
-def leg_force(p: Params, q: np.ndarray, qd: np.ndarray) -> float:
-    """Compressive leg force ``F_l = k (l0 - l) - c_l ldot`` (eq. 2.1)."""
-    return p.k * (p.l0 - q[0]) - p.c_l * qd[0]
+def spring_force(p: Params, l: Any, l_rest: float | None = None) -> Any:
+    """Compressive spring force ``F_s = k l0 sgn(x) |x|^n``, ``x = (l_rest - l) / l0``.
+
+    ``n = p.leg_exponent``; ``n = 1`` is eq. 2.1's ``k (l_rest - l)``. ``l_rest``
+    defaults to ``l0`` (before a leg thrust's switch; docs/model.md, "Leg spring
+    and thrust"). ``l`` may be an array.
+    """
+    lr = p.l0 if l_rest is None else l_rest
+    if p.leg_exponent == 1.0:
+        return p.k * (lr - l)
+    x = (lr - np.asarray(l, dtype=float)) / p.l0
+    return p.k * p.l0 * np.sign(x) * np.abs(x) ** p.leg_exponent
 
 
-def forces(p: Params, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+def spring_energy(p: Params, l: Any, l_rest: float | None = None) -> Any:
+    """Spring potential ``V = k l0^2 |x|^(n+1) / (n+1)`` (``k (l_rest - l)^2 / 2`` at n = 1)."""
+    lr = p.l0 if l_rest is None else l_rest
+    n = p.leg_exponent
+    if n == 1.0:
+        return 0.5 * p.k * (lr - l) ** 2
+    x = np.abs((lr - np.asarray(l, dtype=float)) / p.l0)
+    return p.k * p.l0**2 * x ** (n + 1) / (n + 1)
+
+
+def leg_force(p: Params, q: np.ndarray, qd: np.ndarray, l_rest: float | None = None) -> Any:
+    """Compressive leg force ``F_l = F_s - c_l ldot`` (eq. 2.1 at ``n = 1``)."""
+    return spring_force(p, q[0], l_rest) - p.c_l * qd[0]
+
+
+def forces(p: Params, q: np.ndarray, qd: np.ndarray,
+           l_rest: float | None = None) -> np.ndarray:
     """Generalised forces ``Q = J_T^T (f_g + f_t + f_l)`` (eq. A.11)."""
     tau = hip_torque(p, q, qd)
-    f = np.array([0.0, -p.m * p.g, leg_force(p, q, qd), tau, tau])  # eqs A.8-A.10
+    f = np.array([0.0, -p.m * p.g, leg_force(p, q, qd, l_rest), tau, tau])  # eqs A.8-A.10
     return jacobian(p, q).T @ f
 
 
@@ -101,29 +131,31 @@ def convective(p: Params, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
     return jacobian(p, q).T @ _full_mass(p) @ c
 
 
-def stance_rhs(p: Params, y: np.ndarray) -> np.ndarray:
+def stance_rhs(p: Params, y: np.ndarray, l_rest: float | None = None) -> np.ndarray:
     """Time derivative of ``y = (l, beta, phi, ld, betad, phid)`` (eq. A.14)."""
     q, qd = y[:3], y[3:]
-    qdd = np.linalg.solve(mass_matrix(p, q), forces(p, q, qd) - convective(p, q, qd))
+    qdd = np.linalg.solve(mass_matrix(p, q),
+                          forces(p, q, qd, l_rest) - convective(p, q, qd))
     return np.concatenate([qd, qdd])
 
 
-def ground_reaction_force(p: Params, y: np.ndarray) -> np.ndarray:
+def ground_reaction_force(p: Params, y: np.ndarray,
+                          l_rest: float | None = None) -> np.ndarray:
     """``(F_x, F_y)`` at the foot (eqs 2.5-2.6)."""
     q, qd = y[:3], y[3:]
     l, b = q[0], q[1]
-    fl = leg_force(p, q, qd)
+    fl = leg_force(p, q, qd, l_rest)
     tau = hip_torque(p, q, qd)
     return np.array([-fl * np.cos(b) + tau / l * np.sin(b), fl * np.sin(b) + tau / l * np.cos(b)])
 
 
-def energy(p: Params, y: np.ndarray, h: float = 0.0) -> float:
-    """Total mechanical energy in stance: kinetic + gravity + leg spring [MgL]."""
+def energy(p: Params, y: np.ndarray, h: float = 0.0, l_rest: float | None = None) -> float:
+    """Total mechanical energy in stance: kinetic + gravity + leg spring ``V`` [MgL]."""
     q, qd = y[:3], y[3:]
     x = kinematics(p, q, 0.0, h)
     v = jacobian(p, q) @ qd
     return float(0.5 * p.m * (v[0] ** 2 + v[1] ** 2) + 0.5 * p.J * v[4] ** 2 + p.m * p.g * x[1]
-                 + 0.5 * p.k * (p.l0 - q[0]) ** 2)
+                 + spring_energy(p, q[0], l_rest))
 
 
 def swing_angle(p: Params, s: float) -> float:

@@ -100,8 +100,17 @@ PARAMETER_TABLE: tuple[ParameterInfo, ...] = tuple(
         ("alpha_r", "alpha_r", "rad", (0, 0, 0), 1.0, -_INF, _INF, True, True,
          "leg reset angle at lift-off (local hip angle unless leg_reset='global')",
          "Section 2.3.2; solved in Section 2.8"),
+        ("leg_exponent", "n", "-", (0, 0, 0), 1.0, 0.5, 3.0, False, False,
+         "leg spring exponent: F_s = k l0 sgn(x) |x|^n, x = (l_rest - l) / l0",
+         "beyond the thesis (Section 7.8); eq. 2.1 at n = 1"),
+        ("leg_thrust", "d", "-", (0, 0, 0), 0.0, 0.0, 0.5, False, False,
+         "leg thrust: rest length l0 (1 + d) from maximum compression to lift-off",
+         "beyond the thesis (Section 7.8)"),
     )
 )
+#: Fields beyond the thesis, saved only when they differ from their default (so the
+#: files and cache keys of the thesis's models stay as they were).
+_OPTIONAL = ("leg_exponent", "leg_thrust")
 _TABLE = {row.name: row for row in PARAMETER_TABLE}
 
 #: The optional retraction stop angle (Section 7.5): not a row of :data:`PARAMETER_TABLE`,
@@ -166,6 +175,14 @@ class Params(_PackCache):
         docs/conventions.md: ``alpha(t) = alpha_r + omega_r (t - t_LO)``).
     alpha_r : float
         Leg angle set at lift-off [rad].
+    leg_exponent : float
+        Leg spring exponent ``n`` [-], 0.5 to 3 (1: eq. 2.1). With ``x = (l_rest -
+        l) / l0``, ``F_s = k l0 sgn(x) |x|^n`` and ``V = k l0^2 |x|^(n+1) / (n+1)``
+        (docs/model.md, "Leg spring and thrust").
+    leg_thrust : float
+        Leg thrust ``d`` [-], 0 to 0.5: in each stance the rest length steps from
+        ``l0`` to ``l0 (1 + d)`` at maximum compression (the first ``ldot`` crossing
+        from < 0 to >= 0), for the rest of that stance.
     controller : Controller
         Hip controller in stance, default :class:`Passive`.
     leg_reset : {"local", "global"}
@@ -207,6 +224,8 @@ class Params(_PackCache):
     c_l: float = _f("c_l")
     omega_r: float = _f("omega_r")
     alpha_r: float = _f("alpha_r")
+    leg_exponent: float = _f("leg_exponent")
+    leg_thrust: float = _f("leg_thrust")
     controller: Controller = field(default_factory=Passive)
     leg_reset: LegReset = "local"
     retraction: Retraction = "liftoff"
@@ -238,13 +257,18 @@ class Params(_PackCache):
 
     @property
     def bounce_time(self) -> float:
-        """Spring-mass half period ``pi sqrt(m/k)`` (eq. 3.9)."""
+        """Spring-mass half period ``pi sqrt(m/k)`` (eq. 3.9) of the linear leg."""
+        if self.leg_exponent != 1.0:
+            raise ValueError("bounce_time of a leg_exponent != 1 spring depends on its "
+                             "amplitude; use tslip.gait.bounce_time(params, leg_speed)")
         return math.pi * math.sqrt(self.m / self.k)
 
     # -- serialisation -------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         """Plain ``dict`` (TOML / JSON friendly), controller as a sub-table."""
-        out: dict[str, Any] = {row.name: getattr(self, row.name) for row in PARAMETER_TABLE}
+        out: dict[str, Any] = {row.name: getattr(self, row.name) for row in PARAMETER_TABLE
+                               if row.name not in _OPTIONAL or getattr(self, row.name)
+                               != row.default}
         out["leg_reset"] = self.leg_reset
         out["retraction"] = self.retraction
         if self.alpha_stop is not None:  # None (no stop) is omitted

@@ -29,7 +29,7 @@ from ..model import _pack as pk
 from . import _kernels as kn
 from ._stride import RUN_ROW
 
-__all__ = ["touchdown", "stride_map", "stride_jacobian", "alpha_r_column", "run"]
+__all__ = ["touchdown", "stride_map", "stride_jacobian", "check_exact", "alpha_r_column", "run"]
 
 _TX = np.empty(0)  # flat ground: no terrain breakpoints
 _NO_REC = np.empty((0, pk.NREC))  # the stride kernels record nothing into it
@@ -72,6 +72,19 @@ def _variational() -> Any:
     return _VA
 
 
+def check_exact(P: np.ndarray) -> None:
+    """Refuse an exact Jacobian for a leg spring exponent below 1 (one-line ``ValueError``).
+
+    ``dF_s/dl = -k n |x|^(n-1)`` is infinite at touch-down (``x = 0``) when ``n < 1``,
+    so the variational equations have no finite start; finite differences work.
+    """
+    n = P[pk.P_NEXP]
+    if n < 1.0:
+        raise ValueError(f"leg_exponent {n:g} < 1 has no exact Jacobian: the leg stiffness "
+                         "k n |x|^(n-1) is infinite at touch-down; use finite differences "
+                         "(method='fd')")
+
+
 def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E741
                     J: np.ndarray, out: np.ndarray) -> int:
     """As :func:`stride_map`, and the exact Jacobian ``dq'/dq`` (5 x 5) into ``J``.
@@ -81,6 +94,7 @@ def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # no
     deterministic, so a call with the same inputs as one of the last
     ``_JACOBIANS_KEPT`` returns its stored result (identical bits).
     """
+    check_exact(P)
     td = touchdown(q, h)
     key = P.tobytes() + O.tobytes() + td.tobytes()
     with _JACOBIANS_LOCK:

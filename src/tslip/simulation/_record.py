@@ -25,13 +25,14 @@ from ..model._pack import (
     OUT_TD,
     OUT_TF,
     OUT_TS,
+    OUT_TSW,
     OUT_XF,
     P_G,
     P_J,
-    P_K,
     P_L0,
     P_M,
     P_R,
+    P_THRUST,
     REC_T,
     RI_LOFY,
     RI_NSTANCE,
@@ -68,15 +69,15 @@ from ..model._pack import (
 from ._flight import flight_leg_angle, flight_state, retraction_start
 from ._rk import _INLINE, _JIT
 from ._specialise import specialise
-from ._stance import _com_velocity
+from ._stance import _com_velocity, spring_energy
 from ._stride import stride_of
 
 
 @njit(**_INLINE)
 def _energy(P, y, xd, yd, phid, l):
-    """Total mechanical energy: kinetic + gravity + leg spring [MgL]."""
+    """Total mechanical energy: kinetic + gravity + leg spring ``V`` [MgL]."""
     return (0.5 * P[P_M] * (xd * xd + yd * yd) + 0.5 * P[P_J] * phid * phid
-            + P[P_M] * P[P_G] * y + 0.5 * P[P_K] * (P[P_L0] - l) * (P[P_L0] - l))
+            + P[P_M] * P[P_G] * y + spring_energy(P, l))
 
 
 @njit(**_INLINE)
@@ -233,10 +234,13 @@ def fill_table(P, rows, starts, outs, info, n, table):
     :func:`_make_record_run`'s ``record_run`` wrote them; ``table`` is
     ``NTRAJ x rows`` (column-major: a column of the trajectory is a row here).
     Stance rows come from the record rows by eqs A.3-A.5, flight rows from the
-    lift-off state in closed form (eq. 2.7).
+    lift-off state in closed form (eq. 2.7). A stance row after the leg thrust's
+    switch (``OUT_TSW``) takes the switched rest length.
     """
     lo = np.empty(6)
     fs = np.empty(10)
+    Pw = P.copy()  # the switched parameters of a thrust's stance rows
+    Pw[P_THRUST] = -P[P_THRUST]
     for s in range(n):
         inf = info[s]
         out = outs[s]
@@ -245,8 +249,10 @@ def fill_table(P, rows, starts, outs, info, n, table):
         nrec = int(inf[RI_NSTANCE])
         xf = out[OUT_XF]
         h = starts[s, 6]
+        tsw = out[OUT_TSW]  # NaN without a switch: no row is after it
         for k in range(nrec):
-            _stance_row(P, t0, s, xf, h, rows[row + k], table[:, row + k])
+            Pk = Pw if rows[row + k, REC_T] > tsw else P
+            _stance_row(Pk, t0, s, xf, h, rows[row + k], table[:, row + k])
         t_lo = t0 + out[OUT_TS]
         for j in range(6):
             lo[j] = out[OUT_LO + j]

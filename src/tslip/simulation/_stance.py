@@ -16,7 +16,7 @@ import math
 from numba import njit
 
 from .._kernel_cache import check as _check_cache
-from ..model._pack import P_C0, P_CL, P_G, P_J, P_K, P_L0, P_M, P_R
+from ..model._pack import P_C0, P_CL, P_G, P_J, P_K, P_L0, P_M, P_NEXP, P_R, P_THRUST
 from ._rk import _INLINE, _JIT
 
 #: Stance state ``y = (l, beta, phi, ld, betad, phid)``.
@@ -31,6 +31,67 @@ def hip_torque(P, phi, betad, phid):
     ``Controller.torque_coefficients``.
     """
     return P[P_C0] + P[P_C0 + 1] * phi + P[P_C0 + 2] * betad + P[P_C0 + 3] * phid
+
+
+@njit(**_INLINE)
+def rest_length(P):
+    """The leg's current rest length ``l_rest``: ``l0``, or ``l0 (1 + d)`` once a
+    stance's thrust has switched (its working copy then holds ``-d`` in ``P_THRUST``)."""
+    d = P[P_THRUST]
+    return P[P_L0] if d >= 0.0 else P[P_L0] * (1.0 - d)
+
+
+@njit(**_INLINE)
+def spring_force(P, l):
+    """Compressive spring force ``F_s = k l0 sgn(x) |x|^n``, ``x = (l_rest - l) / l0``.
+
+    ``n = 1`` is eq. 2.1's ``k (l_rest - l)``, computed as such (docs/model.md,
+    "Leg spring and thrust").
+    """
+    n = P[P_NEXP]
+    lr = rest_length(P)
+    if n == 1.0:
+        return P[P_K] * (lr - l)  # eq. 2.1
+    x = (lr - l) / P[P_L0]
+    f = P[P_K] * P[P_L0] * abs(x) ** n
+    return f if x >= 0.0 else -f
+
+
+@njit(**_INLINE)
+def leg_force(P, l, ld):
+    """Compressive leg force ``F_l = F_s - c_l ldot`` (eq. 2.1 at ``n = 1``)."""
+    return spring_force(P, l) - P[P_CL] * ld
+
+
+@njit(**_INLINE)
+def spring_slope(P, l):
+    """``dF_s/dl = -k n |x|^(n-1)`` (``-k`` at ``n = 1``); infinite at ``x = 0`` for ``n < 1``."""
+    n = P[P_NEXP]
+    if n == 1.0:
+        return -P[P_K]
+    x = (rest_length(P) - l) / P[P_L0]
+    return -P[P_K] * n * abs(x) ** (n - 1.0)
+
+
+@njit(**_INLINE)
+def spring_energy(P, l):
+    """Spring potential ``V = k l0^2 |x|^(n+1) / (n+1)`` (``k (l_rest - l)^2 / 2`` at ``n = 1``)."""
+    n = P[P_NEXP]
+    lr = rest_length(P)
+    if n == 1.0:
+        return 0.5 * P[P_K] * (lr - l) * (lr - l)
+    l0 = P[P_L0]
+    return P[P_K] * l0 * l0 * abs((lr - l) / l0) ** (n + 1.0) / (n + 1.0)
+
+
+@njit(**_INLINE)
+def liftoff_on_spring(P):
+    """Whether lift-off is located as ``l_rest - l = 0`` rather than ``F_y = 0``: a
+    non-linear spring (``n != 1``) with no leg damping and no hip torque, where
+    ``F_y = F_s sin(beta)`` vanishes with the spring (with zero slope for ``n > 1``,
+    infinite for ``n < 1``); the same instant, found more accurately."""
+    return (P[P_NEXP] != 1.0 and P[P_CL] == 0.0 and P[P_C0] == 0.0 and P[P_C0 + 1] == 0.0
+            and P[P_C0 + 2] == 0.0 and P[P_C0 + 3] == 0.0)
 
 
 @njit(**_INLINE)
@@ -54,7 +115,7 @@ def stance_accel(P, y):
     sa = sb * cp + cb * sp  # sin(beta + phi)
     ca = cb * cp - sb * sp  # cos(beta + phi)
     tau = hip_torque(P, ph, bd, phd)
-    fl = P[P_K] * (P[P_L0] - l) - P[P_CL] * ld  # eq. 2.1
+    fl = leg_force(P, l, ld)  # eq. 2.1
     # R = Q - C (eq. A.11, A.13)
     r1 = -m * g * sb + fl - (m * r * phd * phd * sa - m * l * bd * bd)
     r2 = tau - m * g * l * cb - (m * r * l * phd * phd * ca + 2.0 * m * l * bd * ld)
@@ -82,7 +143,7 @@ def grf(P, y):
     """Ground reaction force ``(F_x, F_y, tau)`` (eqs 2.5-2.6)."""
     l, b = y[0], y[1]
     tau = hip_torque(P, y[2], y[4], y[5])
-    fl = P[P_K] * (P[P_L0] - l) - P[P_CL] * y[3]
+    fl = leg_force(P, l, y[3])
     sb = math.sin(b)
     cb = math.cos(b)
     return -fl * cb + tau / l * sb, fl * sb + tau / l * cb, tau
@@ -104,7 +165,7 @@ def com_velocity(P, y):
                          y[3], y[4], y[5])
 
 
-NEVENTS = 4  # event_values
+NEVENTS = 5  # event_values
 #: Leg length, as a fraction of ``l0``, at which a stance ends as the hip reaching the
 #: ground (eq. 2.11, ``Status.FALL_HIP_GROUND``): a leg compressed that far has put the
 #: hip on its foot. Without it such a stance ground on at ever smaller steps until
@@ -120,17 +181,24 @@ def event_values(P, y, gv):
     ``l sin(beta)`` (eq. 2.11); 2: ``xdot_m`` (eq. 2.10); 3: the leg
     collapsing, ``l - L_COLLAPSE l0``: the hip reaching the foot, on the
     ground, which event 1 cannot see (it only approaches zero as ``l -> 0``,
-    where the polar equations are singular, ``betad ~ 1/l^2``).
+    where the polar equations are singular, ``betad ~ 1/l^2``); 4: the leg
+    thrust's switch, ``-ldot`` while it is pending (``P_THRUST > 0``), else 1.
+
+    Lift-off is located as ``l_rest - l`` when :func:`liftoff_on_spring`.
     """
     l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
     sb = math.sin(b)
     cb = math.cos(b)
-    tau = hip_torque(P, ph, bd, phd)
-    fl = P[P_K] * (P[P_L0] - l) - P[P_CL] * ld
-    gv[0] = fl * sb + tau / l * cb  # F_y, eq. 2.6
+    if liftoff_on_spring(P):
+        gv[0] = rest_length(P) - l
+    else:
+        tau = hip_torque(P, ph, bd, phd)
+        fl = leg_force(P, l, ld)
+        gv[0] = fl * sb + tau / l * cb  # F_y, eq. 2.6
     gv[1] = l * sb
     gv[2] = -ld * cb + l * sb * bd + P[P_R] * math.cos(ph) * phd  # xdot_m, eq. A.5
     gv[3] = l - L_COLLAPSE * P[P_L0]
+    gv[4] = -ld if P[P_THRUST] > 0.0 else 1.0
 
 
 @njit(**_INLINE)

@@ -115,12 +115,12 @@ def first_event(P, method, R, gv_old, gv_new, ytmp, gv_tmp, st):
     ``theta`` is the fraction of the step at which event ``ev`` fires, ``(2.0, -1)``
     if none does. Falls are searched first and lift-off wins only if strictly
     earlier (``F_y = F_l sin(beta)`` and the hip height ``l sin(beta)`` vanish
-    together when ``beta`` reaches 0).
+    together when ``beta`` reaches 0); the thrust's switch (event 4) comes last.
     """
     theta_ev = 2.0
     first = -1
     for j in range(NEVENTS):
-        ev = (1, 3, 2, 0)[j]
+        ev = (1, 3, 2, 0, 4)[j]
         if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
             theta = event_root(P, method, R, ev, gv_old[ev], gv_new[ev], ytmp, gv_tmp, st)
             if theta < theta_ev - 1e-9:

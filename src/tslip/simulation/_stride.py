@@ -53,9 +53,11 @@ from ..model._pack import (
     OUT_TF,
     OUT_TFALL,
     OUT_TS,
+    OUT_TSW,
     OUT_XF,
     P_L0,
     P_R,
+    P_THRUST,
     ST_ERR_MAX_STEPS,
     ST_ERR_NONFINITE,
     ST_ERR_STANCE_TIMEOUT,
@@ -209,6 +211,35 @@ def event_status(ev):
 
 
 @njit(**_INLINE)
+def working_params(P):
+    """The stance's parameters: a copy of ``P`` to switch the rest length in if it has
+    leg thrust (:func:`thrust_switch`), else ``P`` itself."""
+    return P.copy() if P[P_THRUST] > 0.0 else P
+
+
+@njit(**_INLINE)
+def thrust_switch(Pw, O, method, y, K, gv, ytmp, fly, t, out):
+    """The leg thrust's switch at the stance state ``y`` (event 4, at time ``t``, kept in
+    ``out[OUT_TSW]`` of a stride): the working parameters ``Pw`` take the rest length
+    ``l0 (1 + d)`` (``P_THRUST`` holds ``-d``); ``K[0] = f(y)`` and the event values
+    ``gv`` anew; returns the next step size, estimated afresh (the field jumps there)."""
+    if fly:
+        out[OUT_TSW] = t
+    Pw[P_THRUST] = -Pw[P_THRUST]
+    event_values(Pw, y, gv)
+    rhs(Pw, y, K[0])
+    return initial_step(Pw, method, y, K[0], O[O_RTOL], O[O_ATOL], ytmp, K[1])
+
+
+@njit(**_INLINE)
+def record_close(P, rec, nrec, t, y, on_grid, status):
+    """Close a grid record with the lift-off row: ``(rows used, overflow)``."""
+    if on_grid and status == ST_OK:
+        return append_row(P, rec, nrec, t, y)
+    return nrec, 0.0
+
+
+@njit(**_INLINE)
 def stance_out(y, stats, out):
     """``out`` of a stance alone: the final state, then ``stats``."""
     for i in range(NSTATE):
@@ -272,6 +303,11 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
     def stride(P, O, td, tx, th, rec, rec_dt, out):
         """One stride from the touch-down state ``td`` (7) to the next, with the pair ``method``.
 
+        With leg thrust (``P[P_THRUST] > 0``) the stance runs on a copy of ``P``
+        whose rest length switches at the first ``ldot`` crossing from < 0 to >= 0
+        (event 4, :func:`thrust_switch`; its time since touch-down in ``OUT_TSW``);
+        without, on ``P`` itself, and no switch is looked for.
+
         Fills ``out`` (layout ``OUT_*`` in ``_pack``) and returns the status.
         Without ``fly``, the stance alone from the stance state ``td`` (6): ``out``
         receives the final state and ``stats`` (below), and nothing else runs.
@@ -291,6 +327,8 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         read. ``stats`` = ``[t_end, n_accepted, n_rejected, n_recorded, overflow]``.
         """
         y = np.empty(NSTATE)
+        P0 = P
+        P = working_params(P0)
         if fly:
             xf = stride_start(P, td, y, out)
         else:
@@ -323,7 +361,15 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
             if ev < 0 or h > 0.0:
                 # one Runge-Kutta step (the one loop holds the stage arithmetic once)
                 rk_step(P, method, y, h, K, ytmp, ynew)
-            if ev >= 0:
+            if ev == 4:
+                # that was the exact step to the thrust's switch: the stance goes on
+                t += h
+                if h > 0.0:
+                    copy_state(y, ynew)
+                h = thrust_switch(P, O, method, y, K, gv_old, ytmp, fly, t, out)
+                ev = -1
+                last_rejected = False
+            elif ev >= 0:
                 # that was the exact step to the event: the stance ends
                 t += h
                 if h > 0.0:
@@ -364,10 +410,8 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
             if at_steps:
                 nrec, ovf = append_row(P, rec, nrec, t, y)
                 overflow = max(overflow, ovf)
-        if on_grid and status == ST_OK:
-            # always close the record with the lift-off row
-            nrec, ovf = append_row(P, rec, nrec, t, y)
-            overflow = max(overflow, ovf)
+        nrec, ovf = record_close(P, rec, nrec, t, y, on_grid, status)  # the lift-off row
+        overflow = max(overflow, ovf)
         stats = np.empty(5)
         stats[0] = t
         stats[1] = n_acc
@@ -375,7 +419,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         stats[3] = nrec
         stats[4] = overflow
         if fly:
-            return stride_finish(P, O, status, td, xf, y, stats, tx, th, out)
+            return stride_finish(P0, O, status, td, xf, y, stats, tx, th, out)
         stance_out(y, stats, out)
         return status
 

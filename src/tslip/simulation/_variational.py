@@ -48,18 +48,26 @@ from ..model._pack import (
     P_G,
     P_GLOBAL,
     P_J,
-    P_K,
     P_L0,
     P_M,
     P_OMEGA,
     P_R,
+    P_THRUST,
     ST_OK,
 )
 from . import _rk
 from ._flight import flight_leg_angle, retraction_start, stop_time
 from ._rk import _INLINE, _JIT
 from ._specialise import ByMethod, specialise
-from ._stance import NSTATE, hip_torque, rhs, stance_initial
+from ._stance import (
+    NSTATE,
+    hip_torque,
+    leg_force,
+    liftoff_on_spring,
+    rhs,
+    spring_slope,
+    stance_initial,
+)
 from ._stride import stride_of
 
 
@@ -81,7 +89,6 @@ def rhs_jacobian(P, y, Jf, ldd, bdd, phdd):
     m = P[P_M]
     r = P[P_R]
     g = P[P_G]
-    k = P[P_K]
     cl = P[P_CL]
     a1, a2, a3 = P[P_C0 + 1], P[P_C0 + 2], P[P_C0 + 3]
     l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
@@ -97,7 +104,7 @@ def rhs_jacobian(P, y, Jf, ldd, bdd, phdd):
     Jf[2, 5] = 1.0
     # dR/dy_j - dM/dy_j qdd, column by column (R = Q - C of eqs A.11, A.13)
     # d/dl: dM22 = 2 m l, dM23 = m r sa
-    c1 = -k + m * bd * bd
+    c1 = spring_slope(P, l) + m * bd * bd
     c2 = -m * g * cb - m * r * phd * phd * ca - 2.0 * m * bd * ld - (2.0 * m * l * bdd
                                                                        + m * r * sa * phdd)
     c3 = -m * r * bd * bd * ca - m * r * sa * bdd
@@ -126,12 +133,18 @@ def rhs_jacobian(P, y, Jf, ldd, bdd, phdd):
 
 @njit(**_INLINE)
 def fy_gradient(P, y, gr):
-    """Gradient of ``F_y`` (eq. 2.6) with respect to the stance state."""
+    """Gradient of the lift-off event with respect to the stance state: of ``F_y``
+    (eq. 2.6), or of ``l_rest - l`` when :func:`._stance.liftoff_on_spring`."""
     l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
+    if liftoff_on_spring(P):
+        for i in range(NSTATE):
+            gr[i] = 0.0
+        gr[0] = -1.0
+        return
     sb, cb = math.sin(b), math.cos(b)
     tau = hip_torque(P, ph, bd, phd)
-    fl = P[P_K] * (P[P_L0] - l) - P[P_CL] * ld
-    gr[0] = -P[P_K] * sb - tau * cb / (l * l)
+    fl = leg_force(P, l, ld)
+    gr[0] = spring_slope(P, l) * sb - tau * cb / (l * l)
     gr[1] = fl * cb - tau / l * sb
     gr[2] = P[P_C0 + 1] * cb / l
     gr[3] = -P[P_CL] * sb
@@ -185,6 +198,22 @@ def _sens_step(P, method, z, h, K, ztmp, Jf):
         z[i] = ztmp[i]
 
 
+@njit(**_INLINE)
+def _switch_saltation(Pw, z):
+    """The thrust's switch at ``(y, Phi) = z`` (event ``-ldot = 0``): ``Pw`` switches its
+    rest length and ``Phi += (f- - f+) dt_sw`` with ``dt_sw = -Phi[3] / f-[3]``, the
+    saltation of a vector field that jumps on an event surface."""
+    fm = np.empty(NSTATE)
+    fp = np.empty(NSTATE)
+    rhs(Pw, z[:NSTATE], fm)
+    Pw[P_THRUST] = -Pw[P_THRUST]
+    rhs(Pw, z[:NSTATE], fp)
+    for c in range(NSTATE):
+        dt = -z[NSTATE + 3 * NSTATE + c] / fm[3]
+        for i in range(NSTATE):
+            z[NSTATE + i * NSTATE + c] += (fm[i] - fp[i]) * dt
+
+
 def _make_stride_jacobian(method: int) -> Callable:
     def stride_jacobian(P, O, td, tx, th, Jq, out):
         """Next touch-down state and its exact Jacobian ``Jq = dq'/dq`` (5 x 5).
@@ -229,18 +258,22 @@ def _make_stride_jacobian(method: int) -> Callable:
         K = np.empty((_rk.NK, NAUG))
         ztmp = np.empty(NAUG)
         Jf = np.empty((NSTATE, NSTATE))
+        tsw = out[27]  # OUT_TSW: the thrust's switch, NaN if none
+        Pw = P.copy() if P[P_THRUST] > 0.0 else P  # the stance's working parameters
         for k in range(1, nrec):
             h = rec[k, 0] - rec[k - 1, 0]
             if h > 0.0:
-                _sens_step(P, method, z, h, K, ztmp, Jf)
+                _sens_step(Pw, method, z, h, K, ztmp, Jf)
+            if rec[k, 0] == tsw and Pw[P_THRUST] > 0.0:
+                _switch_saltation(Pw, z)
         for i in range(NSTATE):
             y[i] = z[i]
         Phi = z[NSTATE:].copy().reshape((NSTATE, NSTATE))
         # 3. saltation at lift-off: dt_LO = -(grad Fy . Phi) / (grad Fy . f)
         f = np.empty(NSTATE)
-        rhs(P, y, f)
+        rhs(Pw, y, f)
         gr = np.empty(NSTATE)
-        fy_gradient(P, y, gr)
+        fy_gradient(Pw, y, gr)
         gf = 0.0
         for i in range(NSTATE):
             gf += gr[i] * f[i]

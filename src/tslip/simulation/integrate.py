@@ -271,10 +271,17 @@ def step_jacobian(
     the saltation (event-time) term; the closed-form flight is differentiated
     analytically, including the touch-down time. See
     :mod:`tslip.simulation._variational`. The Jacobian is NaN after a fall.
+
+    Raises
+    ------
+    ValueError
+        For ``leg_exponent < 1``: the leg stiffness is infinite at touch-down.
     """
     from . import _variational as va
+    from ._packed import check_exact
 
     P = pk.pack_params(params)
+    check_exact(P)
     td = _section(q, h)
     out = np.empty(pk.NOUT)
     J = np.empty((5, 5))

@@ -52,7 +52,7 @@ OBJECTIVES: dict[str, tuple[int, str, str]] = {
     "pitch_rate": (+1, "rad g^1/2 L^-1/2", "pitch-rate limit |dphid| (robustness, 25 strides)"),
     "max_multiplier": (-1, "-", "largest non-trivial Floquet multiplier |lambda|"),
     "stance_time": (-1, "g^-1/2 L^1/2", "stance time t_s"),
-    "peak_leg_force": (-1, "m g", "peak axial leg force k (l0 - l) - c_l ld over stance"),
+    "peak_leg_force": (-1, "m g", "peak axial leg force F_l = F_s - c_l ld over stance"),
     "energy_per_stride": (-1, "M g L", "hip's net work per stride (tslip.gait.stride_work)"),
 }
 #: Limits of the search's settings (a search of more evaluations is a study of its own).

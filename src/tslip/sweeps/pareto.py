@@ -88,7 +88,10 @@ def code_version() -> str:
 
 
 def _peak_leg_force(gait: Gait) -> float:
-    """Largest axial leg force ``k (l0 - l) - c_l ld`` over the gait's stance [m g].
+    """Largest axial leg force ``F_l = F_s - c_l ld`` over the gait's stance [m g].
+
+    ``F_l = F_y sin(beta) - F_x cos(beta)`` (eqs 2.5-2.6 solved for it), from the
+    ground forces the kernels record: the one leg force of every spring and thrust.
 
     Sampled 2000 times a stance: the peak is flat (``dF/dt = 0``), so the sampled
     maximum is within about 1e-9 relative of the true one (the default sampling of
@@ -99,7 +102,8 @@ def _peak_leg_force(gait: Gait) -> float:
     p = gait.params
     df = simulate(p, gait.state, 1, dt=gait.stance_time / _FORCE_SAMPLES).to_dataframe()
     st = df[df["stance"] > 0]
-    force = p.k * (p.l0 - st["l"].to_numpy()) - p.c_l * st["ld"].to_numpy()
+    b = st["beta"].to_numpy()
+    force = st["Fy"].to_numpy() * np.sin(b) - st["Fx"].to_numpy() * np.cos(b)
     return float(force.max())
 
 

@@ -1,0 +1,99 @@
+"""Leg thrust (issue 26, section 1): the rest length steps to l0 (1 + d) at maximum compression.
+
+Checked against the independent Cartesian model of ``test_leg_exponent`` (scipy, the
+switch as an event), the closed-form spring work, and finite differences.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import tslip
+from tslip.gait.section import total_energy
+
+from .test_leg_exponent import STATE, TIGHT, _fd_jacobian, reference_stance, spring
+
+
+def _params(preset, **kw):
+    return dataclasses.replace(tslip.preset(preset), **kw)
+
+
+@pytest.mark.parametrize("n, d, c_l", [(1.0, 0.2, 0.0), (1.5, 0.1, 0.0), (1.0, 0.3, 0.5),
+                                       (2.0, 0.05, 0.3)])
+def test_thrust_stance_matches_an_independent_integration(n, d, c_l):
+    p = _params("table2.1", leg_exponent=n, leg_thrust=d, c_l=c_l,
+                k=25.0 * 0.2 ** (1 - n))
+    res = tslip.step(p, STATE, options=TIGHT)
+    t_lo, u, _ = reference_stance(p, STATE)
+    lo = res.liftoff
+    assert abs(res.stance_time - t_lo) < 1e-8
+    np.testing.assert_allclose([lo.x, lo.y, lo.phi, lo.xd, lo.yd, lo.phid], u,
+                               rtol=0, atol=1e-8)
+    # the thrust changes the stance: without it the lift-off differs by far more
+    t0, u0, _ = reference_stance(dataclasses.replace(p, leg_thrust=0.0), STATE)
+    assert np.max(np.abs(u - u0)) > 1e-3
+
+
+@pytest.mark.parametrize("n, d", [(1.0, 0.2), (1.5, 0.1), (0.8, 0.3)])
+def test_energy_added_is_the_closed_form_spring_work(n, d):
+    """Passive, no damping: ``E_after - E_before = V(l0 (1+d) - l_min) - V(l0 - l_min)``."""
+    p = _params("table2.1", leg_exponent=n, leg_thrust=d, k=25.0 * 0.2 ** (1 - n))
+    res = tslip.step(p, STATE, options=TIGHT)
+    lo = res.liftoff
+    l_min = float(res.stance[:, 1].min())  # a row at each step, one at the switch
+    _, _, l_min_ref = reference_stance(p, STATE)
+    assert abs(l_min - l_min_ref) < 1e-9
+    work = spring(p, l_min, p.l0 * (1 + d))[1] - spring(p, l_min, p.l0)[1]
+    assert work > 0.05
+    e0 = total_energy(p, tslip.TouchdownState.from_section(STATE))
+    # at lift-off the spring is relaxed (c_l = 0, no torque): the energy is the body's
+    e1 = (p.m * (lo.xd**2 + lo.yd**2) / 2 + p.J * lo.phid**2 / 2 + p.m * p.g * lo.y
+          + spring(p, lo.l, p.l0 * (1 + d))[1])
+    assert abs((e1 - e0) - work) < 1e-9
+    # the trajectory's energy column jumps by the same amount at the switch
+    tr = tslip.simulate(p, tslip.TouchdownState.from_section(STATE), 1, dt=0.002, options=TIGHT)
+    e = tr.to_dataframe()["energy"].to_numpy()
+    assert abs(e[-1] - e[0] - work) < 1e-8
+
+
+@pytest.mark.parametrize("preset, kw", [
+    ("table6.1", dict(leg_thrust=0.1)),
+    ("table6.1", dict(leg_thrust=0.1, leg_exponent=1.5, k=8.0 * 0.2 ** -0.5)),
+    ("table2.1", dict(leg_thrust=0.05, c_l=0.5)),
+])
+def test_exact_jacobian_carries_the_switch(preset, kw):
+    p = _params(preset, **kw)
+    q = STATE if preset == "table2.1" else np.array([0.93, 0.0, 1.9, -0.35, 0.0])
+    p = dataclasses.replace(p, alpha_r=_touching_alpha_r(p, q))
+    res, J = tslip.step_jacobian(p, q, options=TIGHT)
+    assert res.status == tslip.Status.OK
+    assert np.isfinite(tslip.step(p, q, options=TIGHT).stance[:, 1]).all()
+    np.testing.assert_allclose(J, _fd_jacobian(p, q), rtol=0, atol=1e-7)
+
+
+def _touching_alpha_r(p, q):
+    """A reset angle whose flight ends in a touch-down: that of the stride's lift-off
+    pitch that lands the leg at the start's angle (eq. 2.17 with the flight time)."""
+    for a in np.linspace(0.3, 1.6, 27):
+        if tslip.step_map(dataclasses.replace(p, alpha_r=float(a)), q).status == tslip.Status.OK:
+            return float(a)
+    raise AssertionError("no touch-down")
+
+
+def test_switch_time_is_reported_only_with_thrust():
+    """``OUT_TSW``: NaN without thrust (no switch looked for); with it, the instant of
+    maximum compression (``ldot = 0``) of the recorded stance."""
+    from tslip.model import _pack as pk
+
+    q = np.array([0.93, 0.0, 1.9, -0.35, 0.0])
+    p = tslip.preset("table6.1")
+    assert np.isnan(tslip.step_batch(p, q[None, :]).raw[0, pk.OUT_TSW])
+    pt = dataclasses.replace(p, leg_thrust=0.2)
+    t_sw = tslip.step_batch(pt, q[None, :], options=TIGHT).raw[0, pk.OUT_TSW]
+    st = tslip.step(pt, q, options=TIGHT).stance
+    row = st[st[:, 0] == t_sw]
+    assert len(row) == 1 and abs(row[0, 4]) < 1e-10  # ldot = 0 there
+    assert st[0, 4] < 0 and t_sw == st[np.argmin(st[:, 1]), 0]
