@@ -109,8 +109,9 @@ def test_generated_pages_follow_the_code(site: Path) -> None:
     model = unescape(re.sub(r"<[^>]+>", "", (site / "model.html").read_text()))
     for f in dataclasses.fields(Params):
         if "unit" in f.metadata:
+            default = "None" if f.default is None else f"{f.default:g}"
             row = re.search(rf"\n{re.escape(f.name)}\n{re.escape(f.metadata['symbol'])}\n"
-                            rf"{re.escape(f.metadata['unit'])}\n{f.default:g}\n", model)
+                            rf"{re.escape(f.metadata['unit'])}\n{default}\n", model)
             assert row, f"parameter {f.name} missing or wrong in the table"
 
 

@@ -90,7 +90,7 @@ def test_every_params_field_rekeys():
     base = tslip.preset("table2.1")
     key = _one_key(_rob(base))
     other = {"controller": LocalVelocity(Kd=0.5, alphad_ref=2.0), "leg_reset": "global",
-             "retraction": "apex"}
+             "retraction": "apex", "alpha_stop": 1.5}
     fields = dataclasses.fields(Params)
     # a field added to Params must be added here (else its effect on the key goes untested)
     assert {f.name for f in fields if not isinstance(getattr(base, f.name), float)} == set(other)

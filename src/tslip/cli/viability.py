@@ -26,8 +26,8 @@ def viability_cmd(
     workers: Annotated[int | None, typer.Option("--workers", min=1, help="Worker processes "
                                                 "(default: by the work, up to all cores).")]
     = None,
-    rule: Annotated[str | None, typer.Option("--rule", help="Cell rule: bracket (tslip's "
-                                             "default), nearest or vibly (vibly's); "
+    rule: Annotated[str | None, typer.Option("--rule", help='Cell rule: "bracket" (tslip\'s '
+                                             'default), "nearest" or "vibly" (vibly\'s); '
                                              "default: the spec's rule.")] = None,
     plot: Annotated[bool, typer.Option("--plot", help="Also draw viability.png.")] = False,
     wait: Annotated[bool, typer.Option("--wait", help="If another run is writing the "
