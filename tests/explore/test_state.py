@@ -48,6 +48,16 @@ def test_a_query_sets_the_parameters_as_params_would():
     assert state.params == want
 
 
+def test_the_future_research_leg_is_a_control_with_its_parameter_range():
+    state, errors = parse_query({"preset": "table6.1", "leg_exponent": "1.5",
+                                 "leg_thrust": "0.05"})
+    assert errors == []
+    assert (state.params.leg_exponent, state.params.leg_thrust) == (1.5, 0.05)
+    state, errors = parse_query({"preset": "table6.1", "leg_exponent": "0.4"})
+    assert len(errors) == 1 and "leg_exponent" in errors[0] and "0.5" in errors[0]
+    assert state.params.leg_exponent == 1.0
+
+
 def test_a_query_can_switch_the_controller_and_set_its_gains():
     state, errors = parse_query({"controller": "global_pd", "Kp": "7", "phi_ref": "0.1"})
     assert errors == []

@@ -64,6 +64,7 @@ _SPANS: dict[str, tuple[float, float, float]] = {
     "v0": (0.5, 10.0, 0.05), "c_l": (0.0, 2.0, 0.01), "omega_r": (-5.0, 10.0, 0.05),
     "Kp": (0.0, 20.0, 0.1), "Kd": (0.0, 5.0, 0.01), "phi_ref": (-0.5, 0.5, 0.01),
     "phid_ref": (-2.0, 2.0, 0.05), "c_h": (0.0, 2.0, 0.01),
+    "leg_exponent": (0.5, 3.0, 0.05), "leg_thrust": (0.0, 0.5, 0.01),
 }
 
 
@@ -87,7 +88,8 @@ def _gain_control(name: str) -> Control:
 
 #: The model's controls (Params fields), in the page's order.
 CONTROLS: tuple[Control, ...] = tuple(
-    _param_control(n) for n in ("k", "beta0", "r", "v0", "c_l", "omega_r"))
+    _param_control(n) for n in ("k", "beta0", "r", "v0", "c_l", "omega_r", "leg_exponent",
+                                "leg_thrust"))
 #: Each controller's gains the user sets (``alphad_ref`` and ``tau_c`` are solved with the
 #: gait, Section 2.8, as is ``alpha_r``).
 GAINS: dict[str, tuple[Control, ...]] = {
