@@ -108,3 +108,39 @@ def test_dask_cluster_gives_the_same_results(tmp_path):
         dask = run_study(spec, tmp_path / "d", scheduler=cluster.scheduler_address)
     assert dask.meta["scheduler"] == cluster.scheduler_address
     _cmp(serial.frame, dask.frame)
+
+
+def _double(x, tick=None):
+    return 2 * x
+
+
+def test_a_dask_cluster_gets_a_bounded_number_of_tasks_at_a_time(monkeypatch):
+    """Submitting every task at once held each one's arguments and result in this process
+    (4 GB for a 4500-chunk viability map): at most DASK_IN_FLIGHT per worker thread are
+    out, and every task still runs once."""
+    from dask.distributed import Client, LocalCluster
+
+    from tslip.sweeps import _schedule
+
+    out = {"now": 0, "max": 0}
+    submit = Client.submit
+
+    def counting(self, *args, **kwargs):
+        out["now"] += 1
+        out["max"] = max(out["max"], out["now"])
+        return submit(self, *args, **kwargs)
+
+    done = []
+
+    def on_done(task, result):
+        out["now"] -= 1
+        done.append(result)
+        return []
+
+    monkeypatch.setattr(Client, "submit", counting)
+    tasks = [_schedule.Task(("t", i), _double, (i,)) for i in range(30)]
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster:
+        _schedule.run_tasks(tasks, on_done, scheduler=cluster.scheduler_address)
+    assert sorted(done) == [2 * i for i in range(30)]
+    assert out["max"] == _schedule.DASK_IN_FLIGHT

@@ -197,18 +197,27 @@ def run_tasks(tasks: Iterable[Task], on_done: OnDone, workers: int = 1,
         queue.close()
 
 
+#: Tasks submitted to a Dask cluster at a time, per worker thread (a newly joined worker
+#: gets work when the next one is submitted).
+DASK_IN_FLIGHT = 4
+
+
 def _run_dask(address: str, ready: list[tuple[float, int, Task]],
               finish: Callable[[Task, tuple[Any, float, float]], None]) -> None:
-    """:func:`run_tasks` on a Dask cluster: every ready task submitted, largest first."""
+    """:func:`run_tasks` on a Dask cluster: ready tasks submitted largest first, at most
+    :data:`DASK_IN_FLIGHT` per worker thread at a time (the scheduler and the client hold
+    every submitted task's arguments and result until it is collected: submitting a
+    4500-chunk viability map at once took 4 GB here)."""
     try:
         from dask.distributed import Client, wait
     except ImportError:
         raise ValueError("--scheduler needs Dask: pip install 'tslip[dask]'") from None
     with Client(address) as client:
         running: dict[Any, Task] = {}
+        limit = DASK_IN_FLIGHT * max(1, sum(client.nthreads().values()))
         try:
             while ready or running:
-                while ready:
+                while ready and len(running) < limit:
                     task = heapq.heappop(ready)[2]
                     running[client.submit(_timed, task.fn, task.args, None, pure=False)] = task
                 for fut in wait(list(running), return_when="FIRST_COMPLETED").done:
