@@ -129,6 +129,18 @@ def stance_accel(P, y):
 @njit(**_JIT)
 def rhs(P, y, out):
     """Stance state derivative for ``y = (l, beta, phi, ld, betad, phid)``."""
+    rhs_inline(P, y, out)
+
+
+@njit(**_INLINE)
+def rhs_inline(P, y, out):
+    """:func:`rhs` inlined where it is called: the integrator's stage loop only.
+
+    LLVM inlined the plain ``rhs`` there by itself until the power-law spring's branch (a
+    ``pow`` call) made it larger; each stage then paid a numba call, 9 ns of a 40 ns right-
+    hand side, and the Table 6.1 stride took 16 % longer. Inlined at numba's level in
+    ``rk_step`` alone the stride is within 3-4 % of the linear-only kernel again, for about
+    2 s more compile CPU (everywhere: 11 s; ``benchmarks/bench_limit.py``)."""
     ldd, bdd, phdd, _, _ = stance_accel(P, y)
     out[0] = y[3]
     out[1] = y[4]

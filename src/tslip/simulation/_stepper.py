@@ -30,7 +30,7 @@ from numba import njit
 from .._kernel_cache import check as _check_cache
 from . import _rk
 from ._rk import _INLINE, _JIT
-from ._stance import NEVENTS, NSTATE, event_values, grf, rhs
+from ._stance import NEVENTS, NSTATE, event_values, grf, rhs, rhs_inline
 
 
 @njit(**_INLINE)
@@ -45,9 +45,9 @@ def rk_step(P, method, y, h, K, ytmp, ynew):
     ns = _rk.n_stages(method)
     for s in range(1, ns):
         _rk.stage_state(method, NSTATE, y, h, K, s, ytmp)
-        rhs(P, ytmp, K[s])
+        rhs_inline(P, ytmp, K[s])
     _rk.stage_state(method, NSTATE, y, h, K, ns, ynew)
-    rhs(P, ynew, K[ns])
+    rhs_inline(P, ynew, K[ns])
 
 
 @njit(**_INLINE)
