@@ -15,7 +15,7 @@ import pytest
 import tslip
 from tslip.simulation.result import TRAJECTORY_COLUMNS
 
-from .conftest import START_TIMEOUT, free_port, get
+from .conftest import START_TIMEOUT, free_port, get, stop
 
 
 def test_the_page_is_served_on_the_loopback_address(server):
@@ -105,12 +105,7 @@ def test_another_host_warns_and_takes_websockets_only_from_that_host_and_port(tm
                        f"http://{host}:{port + 1}", "http://evil.example"):
             assert _open_ws(port, origin, host) == 403, origin
     finally:
-        proc.terminate()
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        stop(proc)
 
 
 def test_the_default_host_does_not_warn(server):
