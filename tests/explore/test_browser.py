@@ -83,6 +83,25 @@ def test_moving_a_slider_redraws_the_gait_and_the_multipliers(page, server):
     page.screenshot(path=str(SHOT), full_page=True)
 
 
+def test_the_retraction_stop_reaches_the_limits_and_the_permalink(page, server):
+    """Section 7.5's stop, switched on in the page at alpha_TD + 0.12 rad: the step-down
+    limit shown is the one computed here with that stop (not the free gait's), and the
+    address bar holds the angle; switched off, the angle leaves the address."""
+    g = tslip.find_gait(tslip.preset("table6.1"))
+    stop = round(g.state.beta + g.state.phi + 0.12, 2)
+    stopped = tslip.robustness(dataclasses.replace(g, params=dataclasses.replace(
+        g.params, alpha_stop=stop)), "step_down")
+    assert abs(stopped - tslip.robustness(g, "step_down")) > 0.01  # the stop matters here
+    open_page(page, server, "?preset=table6.1")
+    set_value(page, "alpha_stop", stop)
+    set_value(page, "stop", "on")
+    wait_text(page, "limits", f"step_down {stopped:.4g} [L]")
+    page.wait_for_function("() => location.search.includes('alpha_stop=')", timeout=TIMEOUT)
+    assert parse_qs(urlparse(page.url).query)["alpha_stop"] == [repr(stop)]
+    set_value(page, "stop", "off")
+    page.wait_for_function("() => !location.search.includes('alpha_stop=')", timeout=TIMEOUT)
+
+
 def check_the_runner_plays(page) -> None:
     """The runner's animation plays in the page, pauses, and shows the frame asked for."""
     pose = f"() => Array.from(({_MODEL})('runner_pose').data.x)"

@@ -58,6 +58,20 @@ def test_the_future_research_leg_is_a_control_with_its_parameter_range():
     assert state.params.leg_exponent == 1.0
 
 
+def test_the_retraction_stop_is_in_the_query_only_when_set():
+    state, errors = parse_query({"preset": "table6.1", "alpha_stop": "1.34"})
+    assert errors == [] and state.params.alpha_stop == 1.34
+    assert "alpha_stop=1.34" in state.query()
+    assert parse_query(dict(parse_qsl(state.query())))[0] == state
+    free, errors = parse_query({"preset": "table6.1", "alpha_stop": "none"})
+    assert errors == [] and free.params.alpha_stop is None
+    assert "alpha_stop" not in free.query()
+    for bad in ("4", "0", "nan", "x"):
+        state, errors = parse_query({"preset": "table6.1", "alpha_stop": bad})
+        assert state.params.alpha_stop is None
+        assert len(errors) == 1 and errors[0].startswith("alpha_stop"), errors
+
+
 def test_a_query_can_switch_the_controller_and_set_its_gains():
     state, errors = parse_query({"controller": "global_pd", "Kp": "7", "phi_ref": "0.1"})
     assert errors == []

@@ -13,6 +13,7 @@ from __future__ import annotations
 import functools
 import html
 import logging
+import math
 import threading
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
@@ -31,7 +32,16 @@ from bokeh.plotting import figure
 
 from ..model.parameters import Params, preset
 from . import compute
-from .state import CLOCKS, CONTROLS, DISTURBANCES, GAINS, PRESETS, ExploreState, control_for
+from .state import (
+    CLOCKS,
+    CONTROLS,
+    DISTURBANCES,
+    GAINS,
+    PRESETS,
+    STOP,
+    ExploreState,
+    control_for,
+)
 
 __all__ = ["make_document", "COMPILING", "kernels_cold"]
 
@@ -79,6 +89,16 @@ def _limit_in_process(gait: Any, kind: str) -> float:
         raise
 
 
+#: The retraction stop's choices: none (``alpha_stop = None``), or at the slider's angle.
+STOP_CHOICES = {"off": "no stop", "on": "stop at alpha_stop"}
+
+
+def _stop_value(p: Params) -> float:
+    """The stop slider's value: the stop, or (none) 0.3 rad beyond ``alpha_r``, in range."""
+    value = p.alpha_stop if p.alpha_stop is not None else p.alpha_r + 0.3
+    return min(max(value, 0.01), math.pi - 0.01)
+
+
 def _all_gains() -> list[str]:
     return list(dict.fromkeys(c.name for g in GAINS.values() for c in g))
 
@@ -112,6 +132,11 @@ class Explorer:
                                  options=_options(GAINS), name="controller")
         self.clock = Select(title="retraction clock", value=p.retraction, options=_options(CLOCKS),
                             name="retraction")
+        self.stop = Select(title="retraction stop (Section 7.5)",
+                           value="off" if p.alpha_stop is None else "on",
+                           options=_options(STOP_CHOICES.items()), name="stop")
+        self.stop_angle = self._slider(STOP.name, _stop_value(p))
+        self.stop_angle.visible = p.alpha_stop is not None
         self.sliders: dict[str, Slider] = {}
         for c in CONTROLS:
             self.sliders[c.name] = self._slider(c.name, float(getattr(p, c.name)))
@@ -127,7 +152,8 @@ class Explorer:
         self.link.js_on_change("text", replace_url)
         self.doc.js_on_event("document_ready", replace_url)
         self.preset.on_change("value", self._guard(self._on_preset))
-        for w in (self.controller, self.clock, self.kind):
+        self.stop_angle.on_change("value", self._guard(self._on_control))
+        for w in (self.controller, self.clock, self.stop, self.kind):
             w.on_change("value", self._guard(self._on_select))
         for s in self.sliders.values():
             s.on_change("value", self._guard(self._on_control))
@@ -167,7 +193,8 @@ class Explorer:
         self._build_runner()
         self._build_map()
         controls = column(self.status, self.error, self.preset, self.controller, self.clock,
-                          *self.sliders.values(), self.kind, self.fraction, self.link, width=330)
+                          *self.sliders.values(), self.stop, self.stop_angle, self.kind,
+                          self.fraction, self.link, width=330)
         plots = column(row(self.gait_fig, column(self.mult_fig, self.mult_text)),
                        self.limit_text, self.runner_panel, self.map_panel)
         self.doc.add_root(row(controls, plots))
@@ -287,6 +314,8 @@ class Explorer:
         base = preset(self.preset.value)
         data: dict[str, Any] = {c.name: float(self.sliders[c.name].value) for c in CONTROLS}
         data["retraction"] = self.clock.value
+        if self.stop.value == "on":
+            data["alpha_stop"] = float(self.stop_angle.value)
         ctrl: dict[str, Any] = {"type": self.controller.value}
         if self.controller.value == base.controller.name:
             ctrl = base.controller.to_dict()  # keeps its solved reference as the guess
@@ -312,6 +341,9 @@ class Explorer:
             self.preset.value = state.preset
             self.controller.value = p.controller.name
             self.clock.value = p.retraction
+            self.stop.value = "off" if p.alpha_stop is None else "on"
+            self._set_slider(STOP.name, _stop_value(p))
+            self.stop_angle.visible = p.alpha_stop is not None
             for c in CONTROLS:
                 self._set_slider(c.name, float(getattr(p, c.name)))
             for c in GAINS[p.controller.name]:
@@ -322,7 +354,7 @@ class Explorer:
         self.request()
 
     def _set_slider(self, name: str, value: float) -> None:
-        s = self.sliders[name]
+        s = self.stop_angle if name == STOP.name else self.sliders[name]
         s.start, s.end = control_for(name).span(value)
         s.value = value
 
@@ -335,6 +367,7 @@ class Explorer:
         if self.loading:
             return
         self._show_gains(self.controller.value)
+        self.stop_angle.visible = self.stop.value == "on"
         self.request()
 
     def _on_control(self, attr: str, old: Any, new: Any) -> None:

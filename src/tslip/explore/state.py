@@ -17,10 +17,17 @@ from typing import Any
 from urllib.parse import urlencode
 
 from ..model.controllers import CONTROLLERS
-from ..model.parameters import PARAMETER_TABLE, RETRACTIONS, Params, preset, presets
+from ..model.parameters import (
+    ALPHA_STOP_INFO,
+    PARAMETER_TABLE,
+    RETRACTIONS,
+    Params,
+    preset,
+    presets,
+)
 
-__all__ = ["Control", "CONTROLS", "GAINS", "DISTURBANCES", "ExploreState", "parse_query",
-           "control_for"]
+__all__ = ["Control", "CONTROLS", "GAINS", "STOP", "DISTURBANCES", "ExploreState",
+           "parse_query", "control_for"]
 
 #: The disturbance kinds of the runner strip (thesis Section 3.1.3).
 DISTURBANCES: tuple[str, ...] = ("step_down", "push", "pitch_rate")
@@ -100,9 +107,15 @@ GAINS: dict[str, tuple[Control, ...]] = {
 }
 
 
+#: The retraction stop angle ``alpha_stop`` (Section 7.5): a slider shown while the page's
+#: "retraction stop" is on; off is ``None``, no stop, which no slider value can hold.
+STOP = Control("alpha_stop", ALPHA_STOP_INFO["unit"], 0.0, math.pi, True, True, 0.8, 2.2,
+               0.01, ALPHA_STOP_INFO["description"])
+
+
 def control_for(name: str) -> Control:
     """The :class:`Control` of a parameter or gain name."""
-    for c in (*CONTROLS, *(g for gains in GAINS.values() for g in gains)):
+    for c in (*CONTROLS, STOP, *(g for gains in GAINS.values() for g in gains)):
         if c.name == name:
             return c
     raise KeyError(name)
@@ -123,6 +136,8 @@ class ExploreState:
         out: dict[str, Any] = {"preset": self.preset}
         out.update({c.name: repr(float(getattr(p, c.name))) for c in CONTROLS})
         out["retraction"] = p.retraction
+        if p.alpha_stop is not None:  # absent: no stop
+            out["alpha_stop"] = repr(float(p.alpha_stop))
         out["controller"] = p.controller.name
         for c in GAINS[p.controller.name]:
             out[c.name] = repr(float(getattr(p.controller, c.name)))
@@ -169,6 +184,14 @@ def parse_query(args: Mapping[str, str]) -> tuple[ExploreState, list[str]]:
             params = Params.from_dict({"retraction": args["retraction"]}, base=params)
         except ValueError as exc:
             errors.append(str(exc))
+    if "alpha_stop" in args:  # a number, or "none" (no stop)
+        try:
+            text = args["alpha_stop"]
+            params = (dataclasses.replace(params, alpha_stop=None) if text == "none" else
+                      Params.from_dict({"alpha_stop": _number(text, "alpha_stop")},
+                                       base=params))
+        except ValueError as exc:
+            errors.append(str(exc))
     for c in GAINS[params.controller.name]:
         if c.name in args:
             try:
@@ -189,7 +212,7 @@ def parse_query(args: Mapping[str, str]) -> tuple[ExploreState, list[str]]:
             fraction = value
         except ValueError as exc:
             errors.append(str(exc))
-    known = {"preset", "controller", "retraction", "disturbance", "fraction",
+    known = {"preset", "controller", "retraction", "alpha_stop", "disturbance", "fraction",
              *(c.name for c in CONTROLS), *(c.name for g in GAINS.values() for c in g)}
     errors.extend(f"unknown URL entry {k!r}; allowed: {sorted(known)}"
                   for k in sorted(set(args) - known))
