@@ -97,3 +97,41 @@ def test_switch_time_is_reported_only_with_thrust():
     row = st[st[:, 0] == t_sw]
     assert len(row) == 1 and abs(row[0, 4]) < 1e-10  # ldot = 0 there
     assert st[0, 4] < 0 and t_sw == st[np.argmin(st[:, 1]), 0]
+
+
+@pytest.mark.parametrize("c_l", [0.05, 0.2])
+def test_find_gait_solves_the_thrust_that_replaces_the_dampers_loss(c_l):
+    """Passive hip with leg damping: ``find_gait`` solves ``leg_thrust`` (issue 26). On the
+    gait found, an independent integration of the stance (scipy, the thrust's switch as an
+    event) ends with the body's energy at touch-down: the thrust gives back exactly what
+    the damper took (the flight conserves it), and a thrust 1 % off does not."""
+    p = _params("table2.1", c_l=c_l)
+    g = tslip.find_gait(p)
+    assert g.converged, g.message
+    d = g.params.leg_thrust
+    assert 0.0 < d < 0.5
+
+    def body_energy_change(thrust):
+        q = dataclasses.replace(g.params, leg_thrust=thrust)
+        _, u, _ = reference_stance(q, g.state.section())
+        e_lo = q.m * (u[3] ** 2 + u[4] ** 2) / 2 + q.J * u[5] ** 2 / 2 + q.m * q.g * u[1]
+        return e_lo - total_energy(q, g.state)
+
+    assert abs(body_energy_change(d)) < 1e-8
+    assert abs(body_energy_change(1.01 * d)) > 1e-5
+    # without the damper there is nothing to give back: no thrust is solved for
+    assert "leg_thrust" not in tslip.gait.GaitProblem.from_params(
+        tslip.preset("table2.1")).names
+
+
+def test_a_solved_thrust_is_no_sweep_parameter_and_a_fixed_one_is():
+    from tslip.sweeps import StudySpec
+
+    def spec(c_l):
+        return StudySpec.from_dict({"name": "d", "preset": "table2.1", "params": {"c_l": c_l},
+                                    "analyses": ["floquet"],
+                                    "axis": [{"param": "leg_thrust", "values": [0.1, 0.2]}]})
+
+    with pytest.raises(ValueError, match=r"^'leg_thrust' is solved for by the gait search"):
+        spec(0.1)
+    assert spec(0.0).axes[0].param == "leg_thrust"

@@ -25,7 +25,7 @@ import numpy as np
 
 from .._checks import check_number
 from ..model import _pack as pk
-from ..model.controllers import ConstantTorque, Controller, LocalVelocity
+from ..model.controllers import ConstantTorque, Controller, LocalVelocity, Passive
 from ..model.parameters import Params
 from ..model.state import TouchdownState
 from ..simulation import _packed
@@ -117,6 +117,10 @@ def checked_replace(obj: _T, **changes: Any) -> _T:
 def _unknown_names(params: Params) -> tuple[str, ...]:
     """Free variables: ``(delta, phi, phid, alpha_r)`` and the controller reference.
 
+    The reference is ``alphad_ref`` (local velocity control), ``tau_c`` (a constant torque
+    with damping) or, for the passive hip with leg damping, the leg thrust ``leg_thrust``
+    (issue 26: the energy the damper takes each stride comes back through the thrust).
+
     At ``r = 0`` with a torque that does not depend on the pitch, ``phi`` is
     undetermined (it does not enter the stride, or with the local reset only
     as ``alpha_r - phi``): it is held at 0. Without any hip torque ``phid`` is
@@ -129,6 +133,8 @@ def _unknown_names(params: Params) -> tuple[str, ...]:
         names.append("alphad_ref")
     elif isinstance(ctrl, ConstantTorque) and (params.c_l > 0 or ctrl.c_h > 0):
         names.append("tau_c")
+    elif isinstance(ctrl, Passive) and params.c_l > 0:
+        names.append("leg_thrust")  # powered running: the thrust replaces what the damper takes
     a = ctrl.torque_coefficients()
     if params.r == 0.0 and a[1] == 0.0:
         names.remove("phi")
@@ -139,10 +145,12 @@ def _unknown_names(params: Params) -> tuple[str, ...]:
     return tuple(names)
 
 
+#: The controller references (and the leg thrust) a gait search may solve for.
+_REFERENCES = ("alphad_ref", "tau_c", "leg_thrust")
 #: The forms ``GaitProblem.names`` may take.
 _ALLOWED_NAMES = frozenset(("delta", *mid, "alpha_r", *ext)
                            for mid in ((), ("phi",), ("phid",), ("phi", "phid"))
-                           for ext in ((), ("alphad_ref",), ("tau_c",)))
+                           for ext in ((), ("alphad_ref",), ("tau_c",), ("leg_thrust",)))
 #: What a stride's output vector and Jacobian hold before the kernel fills them.
 _NAN_OUT = np.full(pk.NOUT, math.nan)
 _NAN_J = np.full((5, 5), math.nan)
@@ -264,6 +272,7 @@ class GaitProblem:
     _P: np.ndarray = field(init=False, repr=False, compare=False)
     _O: np.ndarray = field(init=False, repr=False, compare=False)
     _ref_gain: float = field(init=False, repr=False, compare=False)
+    _ref_slot: int = field(init=False, repr=False, compare=False)
     _idx: dict[str, int] = field(init=False, repr=False, compare=False)
     _at: tuple[int, int, int, int, int] = field(init=False, repr=False, compare=False)
 
@@ -272,7 +281,7 @@ class GaitProblem:
             object.__setattr__(self, "names", _unknown_names(self.params))
         if tuple(self.names) not in _ALLOWED_NAMES:
             raise ValueError("names must be ('delta', ['phi'], ['phid'], 'alpha_r') and at most "
-                             f"one of 'alphad_ref', 'tau_c', got {self.names}")
+                             f"one of 'alphad_ref', 'tau_c', 'leg_thrust', got {self.names}")
         if self.fix not in ("speed", "energy"):
             raise ValueError(f"fix must be 'speed' or 'energy', got {self.fix!r}")
         if self.section not in ("touchdown", "apex"):
@@ -287,7 +296,7 @@ class GaitProblem:
                                  f"touch-down potential at beta0), got {self.energy!r}")
         idx = {n: i for i, n in enumerate(self.names)}
         object.__setattr__(self, "_idx", idx)
-        ref = self.names[-1] if self.names[-1] in ("alphad_ref", "tau_c") else ""
+        ref = self.names[-1] if self.names[-1] in _REFERENCES else ""
         object.__setattr__(self, "_at", tuple(idx.get(n, -1) for n in (
             "delta", "phi", "phid", "alpha_r", ref)))
         # as pack_params(decode(z)[0]) but for alpha_r and the reference, which
@@ -301,6 +310,7 @@ class GaitProblem:
         object.__setattr__(self, "_O", self.options.packed())
         gain = getattr(ctrl, "Kd", 1.0) if "alphad_ref" in self.names else 1.0
         object.__setattr__(self, "_ref_gain", float(gain))
+        object.__setattr__(self, "_ref_slot", pk.P_THRUST if ref == "leg_thrust" else pk.P_C0)
 
     @classmethod
     def from_params(cls, params: Params, options: IntegratorOptions | None = None, *,
@@ -397,16 +407,26 @@ class GaitProblem:
             ctrl = checked_replace(ctrl, tau_c=ref)
         elif isinstance(ctrl, ConstantTorque) and ctrl.tau_c != 0.0:
             ctrl = checked_replace(ctrl, tau_c=0.0)  # no damping: no torque
-        p = checked_replace(self.params, alpha_r=alpha_r, controller=ctrl, v0=v)
+        thrust = ref if ref_name == "leg_thrust" else self.params.leg_thrust
+        p = checked_replace(self.params, alpha_r=alpha_r, controller=ctrl, v0=v,
+                            leg_thrust=thrust)
         s = TouchdownState.from_velocity(v=v, delta=delta, beta=p.beta0, phi=phi, phid=phid)
         return p, s
 
     def encode(self, gait: Gait) -> np.ndarray:
-        """Free variables of a gait (a warm start for nearby parameters)."""
+        """Free variables of a gait (a warm start for nearby parameters).
+
+        A gait whose search did not solve the leg thrust (no leg damping: a study's
+        neighbour at ``c_l = 0``) gives the energy-balance guess of :meth:`guesses` for it.
+        """
         s, p = gait.state, gait.params
         out = {"delta": s.delta, "phi": s.phi, "phid": s.phid, "alpha_r": p.alpha_r,
                "alphad_ref": getattr(p.controller, "alphad_ref", math.nan),
-               "tau_c": getattr(p.controller, "tau_c", math.nan)}
+               "tau_c": getattr(p.controller, "tau_c", math.nan),
+               "leg_thrust": getattr(p, "leg_thrust", math.nan)}
+        if "leg_thrust" in self.names and not (math.isfinite(out["leg_thrust"])
+                                               and out["leg_thrust"] > 0.0):
+            out["leg_thrust"] = float(self._guess(float(s.delta))[-1])
         z = np.array([out[n] for n in self.names], dtype=float)
         if not np.all(np.isfinite(z)):
             raise ValueError(f"the gait's controller has no {list(self.names)[-1]!r}")
@@ -425,7 +445,7 @@ class GaitProblem:
         P = self._P.copy()
         P[pk.P_ALPHA] = alpha_r
         if self._at[4] >= 0:
-            P[pk.P_C0] = self._ref_gain * ref
+            P[self._ref_slot] = self._ref_gain * ref
         v = self.speed(delta, phi, phid)
         q = np.array([self.params.beta0, phi, v * math.cos(delta), v * math.sin(delta), phid])
         out = _NAN_OUT.copy()
@@ -501,13 +521,13 @@ class GaitProblem:
         """``dq'/d ref`` by a central difference of step ``h``; None if a stride fails.
 
         The strides start from the section ``q`` of the stride at ``ref`` with
-        ``P`` as :meth:`_stride` wrote it, only ``P_C0`` changed (as ``_stride``
+        ``P`` as :meth:`_stride` wrote it, only the reference's slot changed (as ``_stride``
         writes it for ``ref +- h``).
         """
         Pd = P.copy()
         ends = []
         for value in (ref + h, ref - h):
-            Pd[pk.P_C0] = self._ref_gain * value
+            Pd[self._ref_slot] = self._ref_gain * value
             out = _NAN_OUT.copy()
             if _packed.stride_map(Pd, self._O, q, 0.0, out) != Status.OK:
                 return None
@@ -576,9 +596,9 @@ class GaitProblem:
         p = self.params
         tau_max = 10.0 + 2.0 * (p.c_l + getattr(p.controller, "c_h", 0.0)) * p.v0 / p.l0
         lo = {"delta": -math.pi / 2, "phi": -math.pi / 2, "phid": -10.0, "alpha_r": -_TWO_PI,
-              "alphad_ref": 0.0, "tau_c": -tau_max}
+              "alphad_ref": 0.0, "tau_c": -tau_max, "leg_thrust": 0.0}
         hi = {"delta": 0.0, "phi": math.pi / 2, "phid": 10.0, "alpha_r": _TWO_PI,
-              "alphad_ref": 5.0 * p.v0 / p.l0 + 10.0, "tau_c": tau_max}
+              "alphad_ref": 5.0 * p.v0 / p.l0 + 10.0, "tau_c": tau_max, "leg_thrust": 0.5}
         return (np.array([lo[n] for n in self.names]), np.array([hi[n] for n in self.names]))
 
     def scales(self) -> np.ndarray:
@@ -592,7 +612,8 @@ class GaitProblem:
         p = self.params
         damping = (p.c_l + getattr(p.controller, "c_h", 0.0)) * p.v0 / p.l0
         s = {"delta": 0.2, "phi": 0.2, "phid": 0.5, "alpha_r": 0.5,
-             "alphad_ref": 0.5 * max(1.0, p.v0 / p.l0), "tau_c": 0.2 * (1.0 + damping)}
+             "alphad_ref": 0.5 * max(1.0, p.v0 / p.l0), "tau_c": 0.2 * (1.0 + damping),
+             "leg_thrust": 0.05}
         return np.array([s[n] for n in self.names])
 
     def guesses(self) -> Iterator[np.ndarray]:
@@ -613,7 +634,7 @@ class GaitProblem:
         for d in (-0.005, -0.01, -0.02, -0.035, -0.05, -0.075, -0.1, -0.15, -0.2, -0.3, -0.4,
                   -0.5, -0.65, -0.8, -1.0, -1.2):
             for da in (0.0, -0.15, 0.15):
-                has_ref = self.names[-1] in ("alphad_ref", "tau_c")
+                has_ref = self.names[-1] in _REFERENCES
                 for f in ((1.0, 0.5, 2.0) if has_ref else (1.0,)):
                     if d in first and da == 0.0 and f == 1.0:
                         continue  # already tried
@@ -647,4 +668,13 @@ class GaitProblem:
             c_h = p.controller.c_h if isinstance(p.controller, ConstantTorque) else 0.0
             loss = p.c_l * ldot0**2 * ts / 2 + c_h * dalpha**2 / ts
             z.append(0.1 if loss == 0 else factor * loss / dalpha)
+        if "leg_thrust" in self.names:
+            # energy balance: the damper's loss c_l ldot0^2 ts / 2 (ldot as above) equals
+            # the thrust's work k l0^2 (d^2 + 2 d x) / 2 at the compression x = ldot0 ts /
+            # (pi l0) of that sine (n = 1)
+            ldot0 = v * math.cos(p.beta0 + delta)
+            loss = p.c_l * ldot0**2 * ts / 2
+            x = abs(ldot0) * ts / (math.pi * p.l0)
+            d = -x + math.sqrt(x * x + 2.0 * loss / (p.k * p.l0**2))
+            z.append(min(max(factor * d, 1e-4), 0.5))
         return np.array(z)

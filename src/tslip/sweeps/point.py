@@ -50,6 +50,7 @@ from ..gait.fixed_point import Gait, GaitProblem, _search, find_gait
 from ..gait.robustness import KINDS, robustness_report
 from ..gait.stability import floquet
 from ..gait.stride import stride_properties
+from ..model.controllers import Passive
 from ..model.parameters import Params
 from .spec import StudySpec
 
@@ -70,7 +71,7 @@ CODE: dict[str | None, tuple[str, ...]] = {
 MAX_FAILURES = 3
 
 #: Unknowns of the gait search (Section 2.8) a record keeps to seed its neighbours.
-UNKNOWNS = ("delta", "phi", "phid", "alpha_r", "alphad_ref", "tau_c")
+UNKNOWNS = ("delta", "phi", "phid", "alpha_r", "alphad_ref", "tau_c", "leg_thrust")
 
 #: ``emit(index, record)``: a point of the line is final.
 Emit = Callable[[int, dict[str, Any]], None]
@@ -109,15 +110,15 @@ class _Seed:
     Duck-types the two things a warm start (:meth:`GaitProblem.encode`) reads
     from a :class:`Gait`: ``state.delta/phi/phid`` and, of ``params``, the
     solved ``alpha_r`` and controller reference (``controller.alphad_ref`` or
-    ``controller.tau_c``): the record's numbers, which the gait's parameters
-    hold.
+    ``controller.tau_c``) or ``leg_thrust``: the record's numbers, which the gait's
+    parameters hold.
     """
 
     def __init__(self, z: dict[str, float]) -> None:
         self.z = z
         self.state = SimpleNamespace(**z)
         self.params = SimpleNamespace(
-            alpha_r=z["alpha_r"],
+            alpha_r=z["alpha_r"], leg_thrust=z["leg_thrust"],
             controller=SimpleNamespace(alphad_ref=z["alphad_ref"], tau_c=z["tau_c"]))
 
 
@@ -333,7 +334,16 @@ def _unknowns(g: Gait) -> dict[str, float]:
     return {"delta": _num(s.delta), "phi": _num(s.phi), "phid": _num(s.phid),
             "alpha_r": _num(g.params.alpha_r),
             "alphad_ref": _num(getattr(ctrl, "alphad_ref", math.nan)),
-            "tau_c": _num(getattr(ctrl, "tau_c", math.nan))}
+            "tau_c": _num(getattr(ctrl, "tau_c", math.nan)),
+            **_thrust(g)}
+
+
+def _thrust(g: Gait) -> dict[str, float]:
+    """``leg_thrust`` where the gait search solved it (passive hip, leg damping), else
+    nothing: the other studies' records keep their columns."""
+    p = g.params
+    return ({"leg_thrust": _num(p.leg_thrust)}
+            if isinstance(p.controller, Passive) and p.c_l > 0 else {})
 
 
 def analyse_point(spec: StudySpec, item: Pending, neutral_tol: float | None = None
@@ -379,6 +389,7 @@ def _analyse(spec: StudySpec, point: dict[str, float], g: Gait | None, residual:
         ctrl = g.params.controller
         rec["alphad_ref"] = _num(getattr(ctrl, "alphad_ref", math.nan))
         rec["tau_c"] = _num(getattr(ctrl, "tau_c", math.nan))
+        rec.update(_thrust(g))
     if "stride" in spec.analyses and g is not None:
         sp = stride_properties(g)
         rec.update(duty_factor=_num(sp.duty_factor), step_frequency=_num(sp.step_frequency),
