@@ -135,3 +135,19 @@ def test_a_solved_thrust_is_no_sweep_parameter_and_a_fixed_one_is():
     with pytest.raises(ValueError, match=r"^'leg_thrust' is solved for by the gait search"):
         spec(0.1)
     assert spec(0.0).axes[0].param == "leg_thrust"
+
+
+def test_stride_work_closes_with_the_thrust():
+    """``stride_work`` counts the thrust's spring work: on the passive Table 2.1 gait with
+    leg damping (thrust solved) the thrust is all the energy put in, so it equals the
+    damper's loss plus the lift-off loss, and equals the closed form at the independent
+    integration's ``l_min``."""
+    g = tslip.find_gait(_params("table2.1", c_l=0.1))
+    w = tslip.gait.stride_work(g)
+    assert w.hip == 0.0 and w.thrust > 0.04
+    assert abs(w.residual) < 1e-6
+    assert abs(w.thrust - (w.damper + w.liftoff)) < 1e-6
+    p = g.params
+    _, _, l_min = reference_stance(p, g.state.section())
+    closed = spring(p, l_min, p.l0 * (1 + p.leg_thrust))[1] - spring(p, l_min, p.l0)[1]
+    assert abs(w.thrust - closed) < 1e-9

@@ -24,9 +24,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._results import Result, frame
+from ..model.dynamics import spring_energy
 from ..model.state import TouchdownState
 from ..model.units import COLUMN_UNITS
-from ..simulation.integrate import Disturbance, simulate
+from ..simulation.integrate import Disturbance, simulate, step
 from ..simulation.options import IntegratorOptions
 from ..simulation.result import Status, Trajectory
 from .fixed_point import Gait
@@ -470,20 +471,24 @@ class StrideWork:
     still holds: lift-off is ``F_y = 0`` (eq. 2.8), which with leg damping or
     a hip torque comes before the leg is back at its rest length, and the
     massless leg then returns to ``l0`` without doing work on the body. In
-    flight ``E`` is constant. So ``change = hip - damper - liftoff`` up to the
-    quadrature error (:attr:`residual`), and a periodic gait has
-    ``hip = damper + liftoff``: what the hip actuator puts in per stride.
+    flight ``E`` is constant. The leg thrust (``Params.leg_thrust = d``) adds
+    ``V(l0 (1 + d) - l_min) - V(l0 - l_min)`` at its switch. So
+    ``change = hip - damper - liftoff + thrust`` up to the quadrature error
+    (:attr:`residual`), and a periodic gait has ``hip + thrust = damper + liftoff``:
+    what the hip actuator and the thrust put in per stride.
     """
 
     hip: float  #: hip actuator's net work, the integral of ``tau (phid + betad)`` over stance
     damper: float  #: leg damper's loss, the integral of ``c_l ld^2`` over stance
     liftoff: float  #: spring energy left in the leg at lift-off, lost with it
     change: float  #: ``E`` at the next touch-down minus ``E`` at this one
+    thrust: float = 0.0  #: the leg thrust's work at its switch (0 without thrust)
 
     @property
     def residual(self) -> float:
-        """``change - (hip - damper - liftoff)``: the quadrature error (0 in exact arithmetic)."""
-        return self.change - (self.hip - self.damper - self.liftoff)
+        """``change - (hip - damper - liftoff + thrust)``: the quadrature error (0 in exact
+        arithmetic)."""
+        return self.change - (self.hip - self.damper - self.liftoff + self.thrust)
 
 
 def stride_work(gait: Gait, *, samples: int = STRIDE_WORK_SAMPLES) -> StrideWork:
@@ -514,7 +519,12 @@ def stride_work(gait: Gait, *, samples: int = STRIDE_WORK_SAMPLES) -> StrideWork
     damper_power = gait.params.c_l * run["ld"][st] ** 2
     last = int(np.flatnonzero(st)[-1])  # the lift-off row; the next is the same state in flight
     energy = run["energy"]
+    p, thrust = gait.params, 0.0
+    if p.leg_thrust > 0.0:  # the switch at l_min: step records a row there, exactly
+        l_min = float(step(p, gait.state).stance[:, 1].min())
+        thrust = float(spring_energy(p, l_min, p.l0 * (1.0 + p.leg_thrust))
+                       - spring_energy(p, l_min, p.l0))
     return StrideWork(hip=float(np.trapezoid(hip_power, t)),
                       damper=float(np.trapezoid(damper_power, t)),
                       liftoff=float(energy[last] - energy[last + 1]),
-                      change=float(energy[-1] - energy[0]))
+                      change=float(energy[-1] - energy[0]), thrust=thrust)
