@@ -40,12 +40,11 @@ import pandas as pd
 from scipy.optimize import brentq
 
 from .._results import Result, with_units
-from ..model.controllers import Passive
 from ..model.parameters import PARAMETER_TABLE, Params
 from ..model.units import COLUMN_UNITS, param_unit
 from ..simulation.options import IntegratorOptions
 from .fixed_point import Gait, GaitProblem, _search, find_gait
-from .problem import Fix, Section, checked_replace, nominal_energy
+from .problem import Fix, Section, checked_replace, nominal_energy, thrust_solved
 from .section import apex_section_ok
 from .stability import floquet
 
@@ -63,10 +62,6 @@ _SOLVED = {"alpha_r", "controller.alphad_ref", "controller.tau_c"}
 Progress = Callable[[int, int, float, "Gait | None"], None]
 
 
-def _thrust_solved(params: Params) -> bool:
-    """Whether the gait search solves ``leg_thrust`` (a passive hip with leg damping)."""
-    return isinstance(params.controller, Passive) and params.c_l > 0
-
 
 # ---------------------------------------------------------------------------
 # parameter access by name
@@ -77,7 +72,7 @@ def _check_name(params: Params, name: str) -> None:
     if name == "alpha_stop":
         raise ValueError("alpha_stop cannot be swept (it may be None, no stop); set it in the "
                          "parameters of each run")
-    if name in _SOLVED or (name == "leg_thrust" and _thrust_solved(params)):
+    if name in _SOLVED or (name == "leg_thrust" and thrust_solved(params)):
         raise ValueError(f"{name!r} is solved for by the gait search (Section 2.8); it cannot "
                          "be a continuation parameter")
     if name in _FIELDS or name == "omega_r_bar":
@@ -258,7 +253,7 @@ class Branch(Result):
         """
         ctrl = self.params.controller
         ref = next((n for n in ("alphad_ref", "tau_c") if hasattr(ctrl, n)), None)
-        thrust = _thrust_solved(self.params)
+        thrust = thrust_solved(self.params)
         rows = []
         for i, g in enumerate(self.gaits):
             row: dict[str, object] = {

@@ -114,6 +114,12 @@ def checked_replace(obj: _T, **changes: Any) -> _T:
 # ---------------------------------------------------------------------------
 
 
+def thrust_solved(params: Params) -> bool:
+    """Whether the gait search solves ``leg_thrust``: a passive hip with leg damping, whose
+    loss only the thrust can make up (otherwise ``leg_thrust`` is a fixed parameter)."""
+    return isinstance(params.controller, Passive) and params.c_l > 0
+
+
 def _unknown_names(params: Params) -> tuple[str, ...]:
     """Free variables: ``(delta, phi, phid, alpha_r)`` and the controller reference.
 
@@ -133,7 +139,7 @@ def _unknown_names(params: Params) -> tuple[str, ...]:
         names.append("alphad_ref")
     elif isinstance(ctrl, ConstantTorque) and (params.c_l > 0 or ctrl.c_h > 0):
         names.append("tau_c")
-    elif isinstance(ctrl, Passive) and params.c_l > 0:
+    elif thrust_solved(params):
         names.append("leg_thrust")  # powered running: the thrust replaces what the damper takes
     a = ctrl.torque_coefficients()
     if params.r == 0.0 and a[1] == 0.0:

@@ -47,10 +47,10 @@ import numpy as np
 from .._codehash import code_hash, module_digest
 from ..gait.continuation import _solve_point, get_param, set_param
 from ..gait.fixed_point import Gait, GaitProblem, _search, find_gait
+from ..gait.problem import thrust_solved
 from ..gait.robustness import KINDS, robustness_report
 from ..gait.stability import floquet
 from ..gait.stride import stride_properties
-from ..model.controllers import Passive
 from ..model.parameters import Params
 from .spec import StudySpec
 
@@ -341,9 +341,7 @@ def _unknowns(g: Gait) -> dict[str, float]:
 def _thrust(g: Gait) -> dict[str, float]:
     """``leg_thrust`` where the gait search solved it (passive hip, leg damping), else
     nothing: the other studies' records keep their columns."""
-    p = g.params
-    return ({"leg_thrust": _num(p.leg_thrust)}
-            if isinstance(p.controller, Passive) and p.c_l > 0 else {})
+    return {"leg_thrust": _num(g.params.leg_thrust)} if thrust_solved(g.params) else {}
 
 
 def analyse_point(spec: StudySpec, item: Pending, neutral_tol: float | None = None
