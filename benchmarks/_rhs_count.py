@@ -2,9 +2,12 @@
 
 The kernels run as plain Python (``NUMBA_DISABLE_JIT=1``) in a subprocess, and
 a profile hook (``sys.setprofile``) counts every call of the code object of
-:func:`tslip.simulation._stance.rhs`, however the calling module reached it
+:func:`tslip.simulation._stance.put_rhs`, however the calling module reached it
 (``_stepper`` and ``_stride`` bind it by name at import; replacing
-``_kernels.rhs``, as ``bench_rk.py`` once did, counts none of those calls).
+``_kernels.rhs``, as ``bench_rk.py`` once did, counts none of those calls). Every
+right-hand side runs it once, whichever function asked for it (``rhs``,
+``rhs_inline`` in the stage loop, ``rhs_events_inline`` at a step's last stage);
+counting ``rhs`` alone missed the stages and counted 2 a stride.
 Every call counts: the stages of accepted and rejected steps, the first
 ``f(y0)``, the initial-step estimate and, for a pair that has them, dense-output
 stages.
@@ -30,7 +33,9 @@ _SCRIPT = r"""
 import json, sys
 import tslip
 from tslip.simulation import _stance
-code = _stance.rhs.__code__
+# the function every right-hand side runs once, in this checkout (older ones: rhs_inline)
+code = next(getattr(_stance, n).__code__ for n in ("put_rhs", "rhs_inline", "rhs")
+            if hasattr(_stance, n))
 calls = [0]
 
 def hook(frame, event, arg):

@@ -45,6 +45,7 @@ Definitions:
 from __future__ import annotations
 
 import argparse
+import inspect
 import os
 import time
 
@@ -80,26 +81,37 @@ def _rhs_loop(P, Y, reps):  # noqa: N803
 _DOPRI5 = pk.M_DOPRI5
 
 
-@njit(cache=False)
-def _steps_loop(P, y0, hs, reps):  # noqa: N803
-    """``reps`` replays of the stance's steps (sizes ``hs``) from ``y0``: the stages and
-    their right-hand sides alone (plus ``f(y0)``), without error control, events or
-    step-size choice."""
-    ns = _rk.n_stages(_DOPRI5)
-    K = np.empty((_rk.NK, 6))
-    y, ytmp, ynew = np.empty(6), np.empty(6), np.empty(6)
-    acc = 0.0
-    for _ in range(reps):
-        for i in range(6):
-            y[i] = y0[i]
-        _stance.rhs(P, y, K[0])
-        for h in hs:
-            rk_step(P, _DOPRI5, y, h, K, ytmp, ynew)
+def _make_steps_loop(with_events: bool):  # noqa: ANN202 - a compiled function
+    """``_steps_loop(P, y0, hs, reps)``: ``reps`` replays of the stance's steps (sizes ``hs``)
+    from ``y0``, the stages and their right-hand sides alone (plus ``f(y0)``), without error
+    control, events or step-size choice. ``with_events``: ``rk_step`` takes the event
+    values' array (its last stage computes them; checkouts before that take no such array)."""
+
+    @njit(cache=False)
+    def _steps_loop(P, y0, hs, reps):  # noqa: N803
+        ns = _rk.n_stages(_DOPRI5)
+        K = np.empty((_rk.NK, 6))
+        y, ytmp, ynew, gv = np.empty(6), np.empty(6), np.empty(6), np.empty(8)
+        acc = 0.0
+        for _ in range(reps):
             for i in range(6):
-                y[i] = ynew[i]
-                K[0, i] = K[ns, i]
-        acc += y[0]
-    return acc
+                y[i] = y0[i]
+            _stance.rhs(P, y, K[0])
+            for h in hs:
+                if with_events:
+                    rk_step(P, _DOPRI5, y, h, K, ytmp, ynew, gv)
+                else:
+                    rk_step(P, _DOPRI5, y, h, K, ytmp, ynew)
+                for i in range(6):
+                    y[i] = ynew[i]
+                    K[0, i] = K[ns, i]
+            acc += y[0]
+        return acc
+
+    return _steps_loop
+
+
+_steps_loop = _make_steps_loop(len(inspect.signature(rk_step.py_func).parameters) == 8)
 
 
 @njit(cache=False)

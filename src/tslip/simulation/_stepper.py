@@ -30,14 +30,16 @@ from numba import njit
 from .._kernel_cache import check as _check_cache
 from . import _rk
 from ._rk import _INLINE, _JIT
-from ._stance import NEVENTS, NSTATE, event_values, grf, rhs, rhs_inline
+from ._stance import NEVENTS, NSTATE, event_values, grf, rhs, rhs_events_inline, rhs_inline
 
 
 @njit(**_INLINE)
-def rk_step(P, method, y, h, K, ytmp, ynew):
+def rk_step(P, method, y, h, K, ytmp, ynew, gv):
     """One step of size ``h`` from ``y`` with ``K[0] = f(y)`` (see :mod:`._rk`).
 
-    Fills the stages ``K[1..ns]`` and ``ynew``; ``K[ns] = f(ynew)`` (FSAL). With
+    Fills the stages ``K[1..ns]`` and ``ynew``; ``K[ns] = f(ynew)`` (FSAL), and the
+    event values at ``ynew`` into ``gv`` (event detection needs them once the step is
+    accepted; they share the last stage's sines and cosines). With
     a constant ``method`` the loops over the tableau compile like a hand-unrolled
     stepper, which the cheap stance right-hand side makes worth it
     (``benchmarks/bench_rk.py``).
@@ -47,7 +49,7 @@ def rk_step(P, method, y, h, K, ytmp, ynew):
         _rk.stage_state(method, NSTATE, y, h, K, s, ytmp)
         rhs_inline(P, ytmp, K[s])
     _rk.stage_state(method, NSTATE, y, h, K, ns, ynew)
-    rhs_inline(P, ynew, K[ns])
+    rhs_events_inline(P, ynew, K[ns], gv)
 
 
 @njit(**_INLINE)

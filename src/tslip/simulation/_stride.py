@@ -359,8 +359,9 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
                 if status != ST_OK:
                     break
             if ev < 0 or h > 0.0:
-                # one Runge-Kutta step (the one loop holds the stage arithmetic once)
-                rk_step(P, method, y, h, K, ytmp, ynew)
+                # one Runge-Kutta step (the one loop holds the stage arithmetic once),
+                # with the event values at its end
+                rk_step(P, method, y, h, K, ytmp, ynew, gv_new)
             if ev == 4:
                 # that was the exact step to the thrust's switch: the stance goes on
                 t += h
@@ -386,7 +387,6 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
                     continue
                 n_acc += 1
                 # event detection, dense output, event location (and grid samples)
-                event_values(P, ynew, gv_new)
                 event = crossed(gv_old, gv_new)
                 if event or on_grid:
                     dense_output(P, method, y, ynew, h, K, R, ytmp)
