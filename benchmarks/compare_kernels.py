@@ -15,7 +15,9 @@ batches on step terrain, and ``find_gait`` with its Floquet multipliers (1408
 arrays). ``compare`` reports every array whose bits differ (exit status 1 if any).
 A stride's output vector is saved without the slots a checkout added after
 another (``_OUT_ADDED``, e.g. the leg thrust's ``OUT_TSW``), so checkouts on either
-side of that change compare.
+side of that change compare. Likewise a recorded stance is saved in the layout of the
+first checkouts, ``t, y, F_x, F_y, tau`` a row: where the kernel records ``t, y`` alone
+(no ``REC_FX``), the forces are derived from them as ``StepResult.grf`` derives them.
 """
 import sys
 
@@ -28,6 +30,19 @@ def _old_out(out: np.ndarray, pk) -> np.ndarray:  # noqa: ANN001 - the _pack mod
     """``out`` (or rows of it) without the slots of :data:`_OUT_ADDED` this checkout has."""
     drop = [getattr(pk, name) for name in _OUT_ADDED if hasattr(pk, name)]
     return np.delete(out, drop, axis=-1)
+
+
+def _old_rec(rows: np.ndarray, P: np.ndarray, at_steps: bool, pk) -> np.ndarray:  # noqa: ANN001
+    """Stance record ``rows`` as ``t, y, F_x, F_y, tau``: the forces derived if this checkout
+    records ``t, y`` only (no leg thrust here: the stance alone reports no switch)."""
+    if hasattr(pk, "REC_FX"):
+        return rows
+    from tslip.simulation._record import stance_forces
+
+    assert P[pk.P_THRUST] == 0.0, "a thrust's switch time is not known here"
+    grf = np.empty((len(rows), 4))
+    stance_forces(P, np.ascontiguousarray(rows), np.nan, at_steps, grf)
+    return np.column_stack((rows, grf[:, 1:]))
 
 
 def dump(path: str) -> None:
@@ -91,8 +106,8 @@ def dump(path: str) -> None:
                         stats = np.empty(5)
                         yout = np.empty(6)
                         c = kn.integrate_stance(P, O, y0, yout, rec, dt, stats)
-                        res[f"stance{dt}/{key}"] = np.r_[rec[: int(stats[3])].ravel(), yout,
-                                                         stats, c]
+                        rows = _old_rec(rec[: int(stats[3])], P, dt <= 0.0, pk)
+                        res[f"stance{dt}/{key}"] = np.r_[rows.ravel(), yout, stats, c]
         # batches: serial and parallel, with terrain
         S = np.array([states["s1"], states["s2"], states["s3"], states["slow"]] * 5)
         terr = [tslip.Terrain.step(0.4, -0.02 * i) for i in range(len(S))]

@@ -151,3 +151,40 @@ def test_stride_work_closes_with_the_thrust():
     _, _, l_min = reference_stance(p, g.state.section())
     closed = spring(p, l_min, p.l0 * (1 + p.leg_thrust))[1] - spring(p, l_min, p.l0)[1]
     assert abs(w.thrust - closed) < 1e-9
+
+
+@pytest.mark.parametrize("method", ["dopri5", "dop853"])
+def test_recorded_forces_are_the_ground_force_of_the_recorded_state(method):
+    """The forces of ``step`` (rows at each step) and ``simulate`` (grid rows: its strides'
+    ``grf`` and its ``Fx, Fy, tau`` columns) are derived from the recorded state: they are
+    ``dynamics.ground_reaction_force`` and ``hip_torque`` there, with the switched rest
+    length on the rows the kernel wrote after the thrust's switch: a step's from
+    ``t >= t_sw`` (the switch's own row), the grid's from ``t > t_sw``."""
+    from tslip.model import _pack as pk
+    from tslip.model import dynamics as dyn
+
+    p = _params("table6.1", leg_thrust=0.2)
+    q = np.array([0.93, 0.0, 1.9, -0.35, 0.0])
+    o = tslip.IntegratorOptions(method=method)
+    t_sw = tslip.step_batch(p, q[None, :], options=o).raw[0, pk.OUT_TSW]
+
+    def forces(st, after):  # st: rows (t, l, beta, phi, ld, betad, phid)
+        rows = []
+        for y, sw in zip(st[:, 1:], after):
+            fx, fy = dyn.ground_reaction_force(p, y, p.l0 * (1.0 + p.leg_thrust) if sw else None)
+            rows.append([fx, fy, dyn.hip_torque(p, y[:3], y[3:])])
+        return np.array(rows)
+
+    r = tslip.step(p, q, options=o)
+    assert r.ok and np.count_nonzero(r.stance[:, 0] == t_sw) == 1
+    np.testing.assert_array_equal(r.grf[:, 0], r.stance[:, 0])
+    np.testing.assert_allclose(r.grf[:, 1:], forces(r.stance, r.stance[:, 0] >= t_sw),
+                               rtol=0, atol=1e-12)
+    tr = tslip.simulate(p, tslip.TouchdownState.from_section(q), 1, dt=0.01, options=o)
+    st = tr.steps[0]
+    assert st.ok and np.any(st.stance[:, 0] > t_sw) and np.any(st.stance[:, 0] < t_sw)
+    want = forces(st.stance, st.stance[:, 0] > t_sw)
+    np.testing.assert_allclose(st.grf[:, 1:], want, rtol=0, atol=1e-12)
+    d = tr.to_dataframe()
+    np.testing.assert_allclose(d.loc[d["stance"], ["Fx", "Fy", "tau"]].to_numpy(), want,
+                               rtol=0, atol=1e-12)

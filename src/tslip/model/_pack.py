@@ -50,9 +50,9 @@ OUT_RECOVF = 26  # 1.0 if the record buffer overflowed
 OUT_TSW = 27  # time of the leg thrust's switch since touch-down (NaN if none)
 NOUT = 28
 
-# -- record row -----------------------------------------------------------
-REC_T, REC_L, REC_BETA, REC_PHI, REC_LD, REC_BETAD, REC_PHID, REC_FX, REC_FY, REC_TAU = range(10)
-NREC = 10
+# -- record row (time since touch-down, stance state y; the forces are derived from it) --
+REC_T, REC_L, REC_BETA, REC_PHI, REC_LD, REC_BETAD, REC_PHID = range(7)
+NREC = 7
 
 # -- trajectory row (tslip.simulate; the columns of Trajectory.data) ------------------
 TRAJ_COLUMNS = (

@@ -2,9 +2,12 @@
 
 Private (see :mod:`._kernels`). :data:`RECORD_RUN` holds one kernel per
 integrator method (:func:`._stride.specialise`): the strides and their stance
-record rows as the stride kernel writes them. :func:`fill_table` derives the
-trajectory's columns from those when they are first read (the row builders are
-``inline="always"``), so a run that is not looked at row by row never pays for them.
+record rows (time and stance state) as the stride kernel writes them.
+:func:`fill_table` derives the trajectory's columns from those when they are first
+read (the row builders are ``inline="always"``), so a run that is not looked at row
+by row never pays for them; :func:`stance_forces` derives a stride's ground force
+and hip torque (``StepResult.grf``). Both compute the forces as the stride kernel's
+:func:`._stance.grf` would (:func:`._stance.grf_at`), bit for bit.
 """
 
 from __future__ import annotations
@@ -33,6 +36,12 @@ from ..model._pack import (
     P_M,
     P_R,
     P_THRUST,
+    REC_BETA,
+    REC_BETAD,
+    REC_L,
+    REC_LD,
+    REC_PHI,
+    REC_PHID,
     REC_T,
     RI_LOFY,
     RI_NSTANCE,
@@ -69,7 +78,7 @@ from ..model._pack import (
 from ._flight import flight_leg_angle, flight_state, retraction_start
 from ._rk import _INLINE, _JIT
 from ._specialise import specialise
-from ._stance import _com_velocity, spring_energy
+from ._stance import _com_velocity, grf_at, spring_energy
 from ._stride import stride_of
 
 
@@ -82,7 +91,8 @@ def _energy(P, y, xd, yd, phid, l):
 
 @njit(**_INLINE)
 def _stance_row(P, t0, i, xf, h, r, row):
-    """Trajectory row from the stance record row ``r`` (eq. A.3-A.5: CoM, hip from the leg)."""
+    """Trajectory row from the stance record row ``r`` (eq. A.3-A.5: CoM, hip from the leg;
+    eqs 2.5-2.6: the ground force)."""
     rp = P[P_R]
     l, b, ph, ld, bd, phd = r[1], r[2], r[3], r[4], r[5], r[6]
     sb = math.sin(b)
@@ -109,9 +119,7 @@ def _stance_row(P, t0, i, xf, h, r, row):
     row[TR_FOOTY] = h
     row[TR_HIPX] = xf - l * cb
     row[TR_HIPY] = h + l * sb
-    row[TR_FX] = r[7]
-    row[TR_FY] = r[8]
-    row[TR_TAU] = r[9]
+    row[TR_FX], row[TR_FY], row[TR_TAU] = grf_at(P, l, ph, ld, bd, phd, sb, cb)
     row[TR_ENERGY] = _energy(P, y, xd, yd, phd, l)
 
 
@@ -156,15 +164,16 @@ def _make_record_run(method: int) -> Callable:
 
         Starts from the touch-down state ``td`` (7) at time ``pos[1]`` and writes
         from row ``pos[0]`` of ``rows`` (n x NREC), one row per trajectory sample:
-        each stance's record rows as the stride kernel writes them (``REC_*``, on the
-        grid of :func:`._stride._make_stride`, touch-down and lift-off rows
-        included), then one row per flight sample holding only its time since
-        lift-off in ``REC_T`` (``dt, 2 dt, ...``, and the touch-down instant closing
-        the last stride if ``close``; otherwise the next stride's first row is that
-        instant). Stride ``s`` fills ``starts[s]`` (its touch-down state),
-        ``outs[s]`` (:func:`._stride._make_stride`'s output) and ``info[s]``
-        (``RI_*``). :func:`fill_table` derives the trajectory's columns from them
-        when they are first read.
+        each stance's record rows as the stride kernel writes them (``REC_*``: time
+        since touch-down and stance state, on the grid of
+        :func:`._stride._make_stride`, touch-down and lift-off rows included), then
+        one row per flight sample holding only its time since lift-off in ``REC_T``
+        (``dt, 2 dt, ...``, and the touch-down instant closing the last stride if
+        ``close``; otherwise the next stride's first row is that instant). Stride
+        ``s`` fills ``starts[s]`` (its touch-down state), ``outs[s]``
+        (:func:`._stride._make_stride`'s output) and ``info[s]`` (``RI_*``).
+        :func:`fill_table` derives the trajectory's columns (forces included) from
+        them when they are first read.
 
         Returns the status of the last stride run (it stops at the first that is
         not OK), or ``RUN_FULL`` if the next stride's rows would not fit; then
@@ -233,9 +242,10 @@ def fill_table(P, rows, starts, outs, info, n, table):
     ``rows``, ``starts``, ``outs`` and ``info`` hold strides ``0 .. n - 1`` as
     :func:`_make_record_run`'s ``record_run`` wrote them; ``table`` is
     ``NTRAJ x rows`` (column-major: a column of the trajectory is a row here).
-    Stance rows come from the record rows by eqs A.3-A.5, flight rows from the
-    lift-off state in closed form (eq. 2.7). A stance row after the leg thrust's
-    switch (``OUT_TSW``) takes the switched rest length.
+    Stance rows come from the record rows by eqs A.3-A.5 (their forces by eqs
+    2.5-2.6), flight rows from the lift-off state in closed form (eq. 2.7). A stance
+    row after the leg thrust's switch (``OUT_TSW``) takes the switched rest length,
+    as the stride kernel's grid did (:func:`stance_forces`).
     """
     lo = np.empty(6)
     fs = np.empty(10)
@@ -258,6 +268,32 @@ def fill_table(P, rows, starts, outs, info, n, table):
             lo[j] = out[OUT_LO + j]
         for k in range(row + nrec, int(inf[RI_ROW1])):
             _flight_row(P, t_lo, s, lo, rows[k, REC_T], fs, table[:, k])
+
+
+@njit(**_JIT)
+def stance_forces(P, rec, tsw, at_steps, grf):
+    """A stance's ground force and hip torque from its record rows ``rec`` (n x NREC):
+    ``grf`` (n x 4) receives ``t, F_x, F_y, tau`` (``StepResult.grf``) as the stride
+    kernel computes them (:func:`._stance.grf`), bit for bit.
+
+    With a leg thrust the kernel ran on the switched rest length from the switch on
+    (``tsw``, its ``OUT_TSW``; NaN without a switch): rows recorded at each accepted
+    step (``at_steps``, :func:`tslip.step`) hold the state after the switch from
+    ``t >= tsw`` on, the switch's own row included; grid rows (``tslip.simulate``,
+    as :func:`fill_table` reads them) only from ``t > tsw``: a grid row at ``tsw`` was
+    sampled from the step that ends there, before the switch.
+    """
+    Pw = P.copy()  # the switched parameters of a thrust's rows after the switch
+    Pw[P_THRUST] = -P[P_THRUST]
+    for k in range(rec.shape[0]):
+        r = rec[k]
+        t = r[REC_T]
+        after = t >= tsw if at_steps else t > tsw  # False for NaN: no switch
+        b = r[REC_BETA]
+        grf[k, 0] = t
+        grf[k, 1], grf[k, 2], grf[k, 3] = grf_at(Pw if after else P, r[REC_L], r[REC_PHI],
+                                                 r[REC_LD], r[REC_BETAD], r[REC_PHID],
+                                                 math.sin(b), math.cos(b))
 
 
 #: ``(P, O, td, tx, th, first, last, close, dt, rows, starts, outs, info, pos)

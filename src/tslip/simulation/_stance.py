@@ -184,11 +184,17 @@ def rhs_events_inline(P, y, out, gv):
 @njit(**_INLINE)
 def grf(P, y):
     """Ground reaction force ``(F_x, F_y, tau)`` (eqs 2.5-2.6)."""
-    l, b = y[0], y[1]
-    tau = hip_torque(P, y[2], y[4], y[5])
-    fl = leg_force(P, l, y[3])
-    sb = math.sin(b)
-    cb = math.cos(b)
+    b = y[1]
+    return grf_at(P, y[0], y[2], y[3], y[4], y[5], math.sin(b), math.cos(b))
+
+
+@njit(**_INLINE)
+def grf_at(P, l, ph, ld, bd, phd, sb, cb):
+    """:func:`grf` with ``sin(beta), cos(beta)`` given: the formula's one copy, shared with
+    the recorded run's rows (:func:`._record.fill_table`, :func:`._record.stance_forces`),
+    which derive the forces from the recorded state, bit for bit what :func:`grf` gives."""
+    tau = hip_torque(P, ph, bd, phd)
+    fl = leg_force(P, l, ld)
     return -fl * cb + tau / l * sb, fl * sb + tau / l * cb, tau
 
 

@@ -30,7 +30,7 @@ from numba import njit
 from .._kernel_cache import check as _check_cache
 from . import _rk
 from ._rk import _INLINE, _JIT
-from ._stance import NEVENTS, NSTATE, event_values, grf, rhs, rhs_events_inline, rhs_inline
+from ._stance import NEVENTS, NSTATE, event_values, rhs, rhs_events_inline, rhs_inline
 
 
 @njit(**_INLINE)
@@ -132,38 +132,35 @@ def first_event(P, method, R, gv_old, gv_new, ytmp, gv_tmp, st):
 
 
 @njit(**_JIT)
-def record_row(P, rec, row, t, y):
-    """Stance record row ``row``: ``t, y, F_x, F_y, tau``.
+def record_row(rec, row, t, y):
+    """Stance record row ``row``: ``t, y`` (the forces are derived from it when read:
+    :func:`._record.fill_table`, :func:`._record.stance_forces`).
 
     Compiled on its own, not inlined: :func:`append_row` and :func:`record_grid` call it.
     """
     rec[row, 0] = t
     for i in range(NSTATE):
         rec[row, 1 + i] = y[i]
-    fx, fy, tau = grf(P, y)
-    rec[row, 7] = fx
-    rec[row, 8] = fy
-    rec[row, 9] = tau
 
 
 @njit(**_JIT)
-def append_row(P, rec, row, t, y):
+def append_row(rec, row, t, y):
     """Record row ``row`` if ``rec`` has room: ``(rows used, 1.0 if it had none else 0.0)``."""
     if row < rec.shape[0]:
-        record_row(P, rec, row, t, y)
+        record_row(rec, row, t, y)
         return row + 1, 0.0
     return row, 1.0
 
 
 @njit(**_JIT)
-def record_grid(P, method, R, rec, row, t, h, t_stop, t_next, dt, ytmp):
+def record_grid(method, R, rec, row, t, h, t_stop, t_next, dt, ytmp):
     """Record the grid times ``t_next, t_next + dt, ...`` up to ``t_stop`` of the step
     ``[t, t + h]`` from its dense output ``R``: ``(rows used, next grid time, overflow)``."""
     while t_next <= t_stop:
         if row >= rec.shape[0]:
             return row, t_next, 1.0
         _rk.dense_eval_inline(method, R, (t_next - t) / h, ytmp)
-        record_row(P, rec, row, t_next, ytmp)
+        record_row(rec, row, t_next, ytmp)
         row += 1
         t_next += dt
     return row, t_next, 0.0

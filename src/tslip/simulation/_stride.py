@@ -233,10 +233,10 @@ def thrust_switch(Pw, O, method, y, K, gv, ytmp, fly, t, out):
 
 
 @njit(**_INLINE)
-def record_close(P, rec, nrec, t, y, on_grid, status):
+def record_close(rec, nrec, t, y, on_grid, status):
     """Close a grid record with the lift-off row: ``(rows used, overflow)``."""
     if on_grid and status == ST_OK:
-        return append_row(P, rec, nrec, t, y)
+        return append_row(rec, nrec, t, y)
     return nrec, 0.0
 
 
@@ -250,12 +250,12 @@ def stance_out(y, stats, out):
 
 
 @njit(**_INLINE)
-def record_start(P, rec, rec_dt, y):
+def record_start(rec, rec_dt, y):
     """How a stance is recorded into ``rec``, and its first row: ``(on a grid, at each
     step, rows used, overflow)`` (no recording if ``rec`` has no rows)."""
     if rec.shape[0] == 0:
         return False, False, 0, 0.0
-    nrec, overflow = append_row(P, rec, 0, 0.0, y)
+    nrec, overflow = append_row(rec, 0, 0.0, y)
     return rec_dt > 0.0, rec_dt <= 0.0, nrec, overflow
 
 
@@ -359,10 +359,15 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         step's dense output, and then ends the stance with one exact step to that
         event (a full-order event state), or moves on to the next step.
 
-        If it has rows, ``rec`` (rows x NREC) receives ``t, y, F_x, F_y, tau``: at
-        each accepted step if ``rec_dt <= 0``, else on a uniform grid of spacing
-        ``rec_dt`` from the dense output; without, ``rec`` and ``rec_dt`` are not
-        read. ``stats`` = ``[t_end, n_accepted, n_rejected, n_recorded, overflow]``.
+        If it has rows, ``rec`` (rows x NREC) receives ``t, y``: at each accepted
+        step if ``rec_dt <= 0``, else on a uniform grid of spacing ``rec_dt`` from
+        the dense output; without, ``rec`` and ``rec_dt`` are not read. The forces
+        are derived from those rows when read (``._record.stance_forces``): with
+        the switched rest length from the switch on, which a row at each step
+        records at ``t >= OUT_TSW`` (the switch's own row is written after it) and
+        a grid row at ``t > OUT_TSW`` (the grid up to the switch is sampled from the
+        step before it). ``stats`` = ``[t_end, n_accepted, n_rejected, n_recorded,
+        overflow]``.
         """
         y, ynew, ytmp, gv_old, gv_new, gv_tmp, st, stats, K, R, scratch = work_arrays()
         P0 = P
@@ -374,7 +379,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
             copy_state(y, td)
         rtol = O[O_RTOL]
         atol = O[O_ATOL]
-        on_grid, at_steps, nrec, overflow = record_start(P, rec, rec_dt, y)
+        on_grid, at_steps, nrec, overflow = record_start(rec, rec_dt, y)
         t = 0.0
         t_next_rec = rec_dt
         status, h = stance_begin(P, O, method, y, K, gv_old, ytmp)
@@ -423,7 +428,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
                 theta_ev, ev = (first_event(P, method, R, gv_old, gv_new, ytmp, gv_tmp, st)
                                 if event else (2.0, -1))
                 if on_grid:
-                    nrec, t_next_rec, ovf = record_grid(P, method, R, rec, nrec, t, h,
+                    nrec, t_next_rec, ovf = record_grid(method, R, rec, nrec, t, h,
                                                         t + h * min(theta_ev, 1.0),
                                                         t_next_rec, rec_dt, ytmp)
                     overflow = max(overflow, ovf)
@@ -438,9 +443,9 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
                 status = ST_ERR_NONFINITE
                 ended = True
             if at_steps:
-                nrec, ovf = append_row(P, rec, nrec, t, y)
+                nrec, ovf = append_row(rec, nrec, t, y)
                 overflow = max(overflow, ovf)
-        nrec, ovf = record_close(P, rec, nrec, t, y, on_grid, status)  # the lift-off row
+        nrec, ovf = record_close(rec, nrec, t, y, on_grid, status)  # the lift-off row
         overflow = max(overflow, ovf)
         stats[0] = t
         stats[1] = n_acc

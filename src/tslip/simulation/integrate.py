@@ -127,9 +127,9 @@ def _section(q: Sequence[float] | np.ndarray, h: float) -> np.ndarray:
     return np.array(vals)
 
 
-#: Bytes a recorded stride holds per sample row (a compact row: the stance record row)
-#: and per stride (the kernel's start, output and info rows); checked against
-#: tracemalloc for Table 2.1 and 6.1 (tests/simulation/test_input_checks.py). The
+#: Bytes a recorded stride holds per sample row (a compact row: the stance record row,
+#: time and state) and per stride (the kernel's start, output and info rows); checked
+#: against tracemalloc for Table 2.1 and 6.1 (tests/simulation/test_input_checks.py). The
 #: columns derived on first read (``Trajectory.data``) take ``NTRAJ / NREC`` times more.
 _ROW_BYTES = 8.0 * pk.NREC
 _STRIDE_BYTES = 8.0 * (pk.NTD + pk.NOUT + pk.NRI)
@@ -212,7 +212,7 @@ def step(
         pk.pack_params(params), _options(options), start.as_array(), terrain or _FLAT, 0.0,
         _REC_ROWS,
     )
-    result = StepResult.from_kernel(params, start, status, out, rec)
+    result = StepResult.from_kernel(params, start, status, out, rec, at_steps=True)
     if raise_on_failure and result.status.is_error:
         raise IntegrationError(result.status.reason)
     return result

@@ -217,8 +217,14 @@ class StepResult(Result, Outcome):
 
     @classmethod
     def from_kernel(cls, params: Params, start: TouchdownState, status: int, out: np.ndarray,
-                    rec: np.ndarray) -> StepResult:
-        """From :func:`~tslip.simulation._kernels.stride`'s output ``out`` and stance record."""
+                    rec: np.ndarray, *, at_steps: bool) -> StepResult:
+        """From :func:`~tslip.simulation._kernels.stride`'s output ``out`` and stance record.
+
+        ``rec`` holds the record rows (``REC_*``: time and stance state) as the kernel
+        wrote them, at each accepted step (``at_steps``, :func:`tslip.step`) or on
+        :func:`tslip.simulate`'s grid; the forces are derived from them
+        (:func:`._record.stance_forces`, which needs to know which).
+        """
         st = Status(status)
         nxt = TouchdownState(*out[pk.OUT_TD : pk.OUT_TD + 7].tolist()) if st == Status.OK else None
         nstep = out[pk.OUT_NSTEP]
@@ -228,7 +234,7 @@ class StepResult(Result, Outcome):
             flight_time=float(out[pk.OUT_TF]),
             status=st,
             liftoff=LiftoffState.from_out(out),
-            grf=rec[:, [pk.REC_T, pk.REC_FX, pk.REC_FY, pk.REC_TAU]].copy(),
+            grf=_forces(params, rec, float(out[pk.OUT_TSW]), at_steps),
             stance=rec[:, : pk.REC_PHID + 1].copy(),
             foot_x=float(out[pk.OUT_XF]),
             foot_clearance=float(out[pk.OUT_CLEAR]),
@@ -253,6 +259,15 @@ class StepResult(Result, Outcome):
         )
 
 
+def _forces(params: Params, rec: np.ndarray, tsw: float, at_steps: bool) -> np.ndarray:
+    """``StepResult.grf`` (``t, F_x, F_y, tau`` a row) of the record rows ``rec``."""
+    from ._record import stance_forces
+
+    grf = np.empty((len(rec), 4))
+    stance_forces(pk.packed_params(params), np.ascontiguousarray(rec), tsw, at_steps, grf)
+    return grf
+
+
 @dataclass(frozen=True, slots=True)
 class Event:
     """A touch-down, lift-off or fall, with time and CoM / foot position."""
@@ -269,10 +284,9 @@ class Event:
 #: Columns of :attr:`Trajectory.data`, in order (the kernels write them: ``_pack.TR_*``).
 TRAJECTORY_COLUMNS: tuple[str, ...] = pk.TRAJ_COLUMNS
 
-#: Trajectory columns that hold a stance record row ``(l, beta, phi, ld, betad, phid,
-#: F_x, F_y, tau)`` (``_pack.REC_L ..``), after its time since touch-down.
-_REC_FROM_TRAJ = [pk.TR_L, pk.TR_BETA, pk.TR_PHI, pk.TR_LD, pk.TR_BETAD, pk.TR_PHID, pk.TR_FX,
-                  pk.TR_FY, pk.TR_TAU]
+#: Trajectory columns that hold a stance record row ``(l, beta, phi, ld, betad, phid)``
+#: (``_pack.REC_L ..``), after its time since touch-down.
+_REC_FROM_TRAJ = [pk.TR_L, pk.TR_BETA, pk.TR_PHI, pk.TR_LD, pk.TR_BETAD, pk.TR_PHID]
 
 
 class StepList(Sequence[StepResult]):
@@ -282,7 +296,8 @@ class StepList(Sequence[StepResult]):
     touch-down states ``starts`` (n, 7), the stride outputs ``outs`` (n, NOUT),
     the ``info`` rows (n, NRI; status and rows of each stride), and ``rec``, one
     row (NREC) per trajectory sample: a stance sample's record row (``REC_*``,
-    time since touch-down first), a flight sample's time since lift-off.
+    time since touch-down and stance state, on the grid: the forces are derived
+    from it), a flight sample's time since lift-off.
     Building a thousand result objects would cost more than the run.
     """
 
@@ -325,7 +340,7 @@ class StepList(Sequence[StepResult]):
         rec = self._rec[a:b]
         start = TouchdownState(*self._starts[k].tolist())
         return StepResult.from_kernel(self._params, start, int(inf[pk.RI_STATUS]), self._outs[k],
-                                      rec)
+                                      rec, at_steps=False)
 
     def __iter__(self) -> Iterator[StepResult]:
         return (self[k] for k in range(len(self)))
