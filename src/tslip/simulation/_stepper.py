@@ -131,13 +131,13 @@ def first_event(P, method, R, gv_old, gv_new, ytmp, gv_tmp, st):
     return theta_ev, first
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def record_row(rec, row, t, y):
     """Stance record row ``row``: ``t, y`` (the forces are derived from it when read:
     :func:`._record.fill_table`, :func:`._record.stance_forces`).
 
-    Compiled on its own, not inlined: :func:`append_row` and :func:`record_grid` call it.
-    """
+    Inlined into :func:`append_row` and :func:`record_grid` (seven stores: a call per
+    sample cost more than the row)."""
     rec[row, 0] = t
     for i in range(NSTATE):
         rec[row, 1 + i] = y[i]
@@ -168,4 +168,4 @@ def record_grid(method, R, rec, row, t, h, t_stop, t_next, dt, ytmp):
 
 # numba does not notice when a kernel called from another file changes; drop
 # cached kernels compiled against other sources (see tslip._kernel_cache).
-_check_cache(record_row, __file__)
+_check_cache(append_row, __file__)
