@@ -188,3 +188,28 @@ def test_recorded_forces_are_the_ground_force_of_the_recorded_state(method):
     d = tr.to_dataframe()
     np.testing.assert_allclose(d.loc[d["stance"], ["Fx", "Fy", "tau"]].to_numpy(), want,
                                rtol=0, atol=1e-12)
+
+
+def test_a_grid_row_at_the_switch_has_the_force_before_it():
+    """The grid's side of the rule (``after_switch``): a grid row at exactly ``t_sw`` was
+    sampled from the step that ends at the switch, so its forces are those of the rest
+    length ``l0`` (a row at each step there is written after the switch: ``l0 (1 + d)``).
+    The grid's first sample is at ``dt``: with ``dt = t_sw`` it falls on the switch."""
+    from tslip.model import _pack as pk
+    from tslip.model import dynamics as dyn
+
+    p = _params("table6.1", leg_thrust=0.2)
+    q = np.array([0.93, 0.0, 1.9, -0.35, 0.0])
+    t_sw = float(tslip.step_batch(p, q[None, :]).raw[0, pk.OUT_TSW])
+    tr = tslip.simulate(p, tslip.TouchdownState.from_section(q), 1, dt=t_sw)
+    st = tr.steps[0]
+    at = np.flatnonzero(st.stance[:, 0] == t_sw)
+    assert st.ok and len(at) == 1
+    y = st.stance[at[0], 1:]
+    before = dyn.ground_reaction_force(p, y, None)
+    after = dyn.ground_reaction_force(p, y, p.l0 * (1.0 + p.leg_thrust))
+    assert abs(after[1] - before[1]) > 0.1  # the two sides differ
+    np.testing.assert_allclose(st.grf[at[0], 1:3], before, rtol=0, atol=1e-12)
+    d = tr.to_dataframe()
+    row = d[d["stance"] & (d["t"] == t_sw)]
+    np.testing.assert_allclose(row[["Fx", "Fy"]].to_numpy()[0], before, rtol=0, atol=1e-12)

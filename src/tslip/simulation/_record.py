@@ -235,6 +235,16 @@ def _make_record_run(method: int) -> Callable:
     return record_run
 
 
+@njit(**_INLINE)
+def after_switch(t, tsw, at_steps):
+    """Whether the record row at ``t`` holds a state the kernel integrated with the leg
+    thrust's switched rest length (switch at ``tsw``; NaN without one: never). Rows
+    recorded at each accepted step (``at_steps``) are so from ``t >= tsw`` on, the
+    switch's own row included; grid rows only from ``t > tsw``: a grid row at ``tsw`` was
+    sampled from the step that ends there, before the switch."""
+    return t >= tsw if at_steps else t > tsw
+
+
 @njit(**_JIT)
 def fill_table(P, rows, starts, outs, info, n, table):
     """The trajectory columns (``TR_*``, one row of ``table`` each) of a recorded run.
@@ -261,7 +271,7 @@ def fill_table(P, rows, starts, outs, info, n, table):
         h = starts[s, 6]
         tsw = out[OUT_TSW]  # NaN without a switch: no row is after it
         for k in range(nrec):
-            Pk = Pw if rows[row + k, REC_T] > tsw else P
+            Pk = Pw if after_switch(rows[row + k, REC_T], tsw, False) else P
             _stance_row(Pk, t0, s, xf, h, rows[row + k], table[:, row + k])
         t_lo = t0 + out[OUT_TS]
         for j in range(6):
@@ -277,23 +287,21 @@ def stance_forces(P, rec, tsw, at_steps, grf):
     kernel computes them (:func:`._stance.grf`), bit for bit.
 
     With a leg thrust the kernel ran on the switched rest length from the switch on
-    (``tsw``, its ``OUT_TSW``; NaN without a switch): rows recorded at each accepted
-    step (``at_steps``, :func:`tslip.step`) hold the state after the switch from
-    ``t >= tsw`` on, the switch's own row included; grid rows (``tslip.simulate``,
-    as :func:`fill_table` reads them) only from ``t > tsw``: a grid row at ``tsw`` was
-    sampled from the step that ends there, before the switch.
+    (``tsw``, its ``OUT_TSW``): which rows that covers depends on how they were recorded,
+    at each accepted step (``at_steps``, :func:`tslip.step`) or on the grid
+    (``tslip.simulate``, as :func:`fill_table` reads them): :func:`after_switch`.
     """
     Pw = P.copy()  # the switched parameters of a thrust's rows after the switch
     Pw[P_THRUST] = -P[P_THRUST]
     for k in range(rec.shape[0]):
         r = rec[k]
         t = r[REC_T]
-        after = t >= tsw if at_steps else t > tsw  # False for NaN: no switch
         b = r[REC_BETA]
+        Pk = Pw if after_switch(t, tsw, at_steps) else P
         grf[k, 0] = t
-        grf[k, 1], grf[k, 2], grf[k, 3] = grf_at(Pw if after else P, r[REC_L], r[REC_PHI],
-                                                 r[REC_LD], r[REC_BETAD], r[REC_PHID],
-                                                 math.sin(b), math.cos(b))
+        grf[k, 1], grf[k, 2], grf[k, 3] = grf_at(Pk, r[REC_L], r[REC_PHI], r[REC_LD],
+                                                 r[REC_BETAD], r[REC_PHID], math.sin(b),
+                                                 math.cos(b))
 
 
 #: ``(P, O, td, tx, th, first, last, close, dt, rows, starts, outs, info, pos)
