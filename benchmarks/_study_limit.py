@@ -9,7 +9,8 @@ run does) and returns the median over the rounds of
   the points), and
 * the seconds per point spent inside the compiled stride kernels it calls,
   measured by wrapping every such call with a timer (the same clock): the stride map
-  (``tslip.simulation._kernels.STRIDE``, what ``_packed.stride_map`` calls)
+  (``tslip.simulation._kernels.SECTION_MAP``, what ``_packed.stride_map`` calls; on
+  checkouts before it, ``STRIDE``)
   and the stride with its exact Jacobian
   (``tslip.simulation._variational.stride_jacobian``). The timer's own
   overhead (two ``perf_counter`` calls) falls inside the kernel time.
@@ -74,8 +75,10 @@ def measure(rounds: int, clock: str = "wall") -> tuple[float, float]:
     whole, call = CLOCKS[clock]
     spec = study(STUDY, quick=True).with_resolution([GRID, GRID])
     acc = [0.0]
-    saved = kn.STRIDE, va.stride_jacobian
-    kn.STRIDE = tuple(_timed(f, acc, call) for f in saved[0])  # type: ignore[misc]
+    # the map's kernel: its own since SECTION_MAP (it calls STRIDE inside), STRIDE before
+    maps = "SECTION_MAP" if hasattr(kn, "SECTION_MAP") else "STRIDE"
+    saved = getattr(kn, maps), va.stride_jacobian
+    setattr(kn, maps, tuple(_timed(f, acc, call) for f in saved[0]))
     va.stride_jacobian = _timed(saved[1], acc, call)  # type: ignore[assignment]
     try:
         _one_round(spec, acc, whole)  # loads the kernels
@@ -85,7 +88,8 @@ def measure(rounds: int, clock: str = "wall") -> tuple[float, float]:
             points.append(w)
             kernels.append(k)
     finally:
-        kn.STRIDE, va.stride_jacobian = saved  # type: ignore[misc]
+        setattr(kn, maps, saved[0])
+        va.stride_jacobian = saved[1]  # type: ignore[assignment]
     return statistics.median(points), statistics.median(kernels)
 
 

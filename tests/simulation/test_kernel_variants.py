@@ -20,7 +20,7 @@ _TUPLES = {
     "stride": _stride.STRIDE, "run_row": _stride.RUN_ROW,
     "run_batch": _stride.RUN_BATCH, "run_batch_serial": _stride.RUN_BATCH_SERIAL,
     "stride_batch": _stride.STRIDE_BATCH, "stride_batch_serial": _stride.STRIDE_BATCH_SERIAL,
-    "stance_rec": _stride.STANCE_REC,
+    "stance_rec": _stride.STANCE_REC, "section_map": _stride.SECTION_MAP,
     "record_run": _record.RECORD_RUN, "jacobian": _variational.STRIDE_JACOBIAN,
 }
 
@@ -43,9 +43,12 @@ def test_compiled_symbols_of_the_two_methods_differ():
     p = tslip.preset("table2.1")
     q = np.array([1.05, 0.0, 5.0, -0.3, 0.0])
     for method in ("dopri5", "dop853"):
-        tslip.step_map(p, q, options=tslip.IntegratorOptions(method=method))
-    symbols = [next(iter(k.overloads.values())).fndesc.mangled_name for k in kn.STRIDE]
-    assert "stride_dopri5" in symbols[0] and "stride_dop853" in symbols[1]
+        options = tslip.IntegratorOptions(method=method)
+        tslip.step_map(p, q, options=options)  # the map's kernel, kn.SECTION_MAP
+        tslip.step(p, q, options=options)  # the stride kernel, kn.STRIDE
+    for kernels, name in ((kn.STRIDE, "stride"), (kn.SECTION_MAP, "section_map")):
+        symbols = [next(iter(k.overloads.values())).fndesc.mangled_name for k in kernels]
+        assert f"{name}_dopri5" in symbols[0] and f"{name}_dop853" in symbols[1]
 
 
 _RUN = """

@@ -51,6 +51,7 @@ from ._stance import (
 from ._stride import (
     RUN_BATCH,
     RUN_BATCH_SERIAL,
+    SECTION_MAP,
     STANCE_REC,
     STRIDE,
     STRIDE_BATCH,
@@ -58,7 +59,7 @@ from ._stride import (
 )
 
 __all__ = [
-    "L_COLLAPSE", "NEVENTS", "NSTATE", "RECORD_RUN",
+    "L_COLLAPSE", "NEVENTS", "NSTATE", "RECORD_RUN", "SECTION_MAP",
     "STRIDE", "com_velocity",
     "event_values", "find_touchdown", "flight_leg_angle", "flight_samples", "flight_state",
     "grf", "hip_torque", "integrate_stance", "record_run", "retraction_start", "rhs",

@@ -32,7 +32,6 @@ from ._stride import RUN_ROW
 __all__ = ["touchdown", "stride_map", "stride_jacobian", "check_exact", "alpha_r_column", "run"]
 
 _TX = np.empty(0)  # flat ground: no terrain breakpoints
-_NO_REC = np.empty((0, pk.NREC))  # the stride kernels record nothing into it
 
 
 def touchdown(q: np.ndarray, h: float = 0.0) -> np.ndarray:
@@ -49,8 +48,7 @@ def stride_map(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E
 
     The next section is ``out[OUT_TD:OUT_TD + 5]``; as :func:`tslip.step_map`.
     """
-    th = np.array([h])
-    return int(kn.STRIDE[int(O[pk.O_METHOD])](P, O, touchdown(q, h), _TX, th, _NO_REC, 0.0, out))
+    return int(kn.SECTION_MAP[int(O[pk.O_METHOD])](P, O, *q.tolist(), h, out))
 
 
 #: The last exact Jacobians, keyed by their exact inputs (P, O, q, h): gait search

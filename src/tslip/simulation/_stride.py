@@ -36,6 +36,7 @@ from ..model._pack import (
     M_DOPRI5,
     NOUT,
     NREC,
+    NTD,
     O_ATOL,
     O_H0,
     O_HMIN,
@@ -463,6 +464,41 @@ def stride_of(method, P, O, td, tx, th, rec, rec_dt, out):
     if method == M_DOPRI5:
         return _STRIDE_DOPRI5(P, O, td, tx, th, rec, rec_dt, out)
     return _STRIDE_DOP853(P, O, td, tx, th, rec, rec_dt, out)
+
+
+def _make_section_map(method: int) -> Callable:
+    def section_map(P, O, beta, phi, xd, yd, phid, h, out):
+        """The Poincare map's stride (``tslip.step_map``, the analyses' ``_packed.stride_map``):
+        from the section ``(beta, phi, xd, yd, phid)`` just after touch-down at ``x = 0``
+        on level ground at height ``h``, nothing recorded; fills ``out``, returns the status.
+
+        The stride kernel's arrays (touch-down state, terrain, empty record) are built
+        here, from the section's floats: numba's dispatch of a float costs less
+        than of an array, and NumPy's construction of a small array from Python
+        costs more than the stride's own arithmetic outside the stance (about 1 us
+        a map call, measured apart).
+        """
+        W = np.empty(NTD + 1)
+        td = W[0:NTD]
+        td[0] = beta
+        td[1] = phi
+        td[2] = xd
+        td[3] = yd
+        td[4] = phid
+        td[5] = 0.0
+        td[6] = h
+        th = W[NTD:NTD + 1]  # the ground's one segment, at h
+        th[0] = h
+        tx = W[NTD + 1:]  # no breakpoints
+        rec = tx.reshape((0, NREC))  # no rows: nothing recorded
+        return stride_of(method, P, O, td, tx, th, rec, 0.0, out)
+
+    return section_map
+
+
+#: ``(P, O, beta, phi, xd, yd, phid, h, out) -> status`` by method: the map's stride
+#: from the section on level ground (:func:`_make_section_map`).
+SECTION_MAP = specialise(_make_section_map, "section_map")
 
 
 # ---------------------------------------------------------------------------

@@ -55,10 +55,6 @@ __all__ = [
 
 _FLAT = Terrain.flat(0.0)
 _REC_ROWS = 4096
-#: ``rec`` of a stride that records nothing: the map calls the method's stride kernel
-#: ``kn.STRIDE[method]`` itself, as every caller does (a wrapper kernel would be one
-#: more level to compile)
-_NO_REC = np.empty((0, pk.NREC))
 
 
 @dataclass(frozen=True, slots=True)
@@ -87,9 +83,7 @@ class Disturbance:
 _DEFAULT_OPTIONS = IntegratorOptions()
 #: ... packed once, with their stride kernel (never written into)
 _DEFAULT_O = _DEFAULT_OPTIONS.packed()
-_DEFAULT_STRIDE = kn.STRIDE[int(_DEFAULT_O[pk.O_METHOD])]
-_TX = np.empty(0)  # flat ground: no terrain breakpoints ...
-_TH0 = np.zeros(1)  # ... at height 0
+_DEFAULT_MAP = kn.SECTION_MAP[int(_DEFAULT_O[pk.O_METHOD])]
 _F64 = np.dtype(float)
 #: ``Status`` by code (the enum's own lookup costs a microsecond, once a stride in ``step_map``)
 _STATUS = {int(s): s for s in Status}
@@ -113,8 +107,8 @@ def _as_state(state: TouchdownState | Sequence[float] | np.ndarray) -> Touchdown
     )
 
 
-def _section(q: Sequence[float] | np.ndarray, h: float) -> np.ndarray:
-    """The touch-down vector ``(beta, phi, xd, yd, phid, x=0, h)`` of a checked section."""
+def _section_values(q: Sequence[float] | np.ndarray, h: float) -> tuple[list[float], float]:
+    """The entries ``[beta, phi, xd, yd, phid]`` of a checked section, and the checked ``h``."""
     qa = q if type(q) is np.ndarray and q.dtype is _F64 else np.asarray(q, dtype=float)
     if qa.shape != (5,):
         raise ValueError(f"q (beta, phi, xd, yd, phid) must have 5 entries, got shape {qa.shape}")
@@ -123,8 +117,15 @@ def _section(q: Sequence[float] | np.ndarray, h: float) -> np.ndarray:
     vals = qa.tolist()
     if not math.isfinite(sum(vals)) and not all(map(math.isfinite, vals)):
         raise ValueError(f"q (beta, phi, xd, yd, phid) must be finite, got {vals}")
-    vals += (0.0, h if type(h) is float and math.isfinite(h) else check_number(h, "h", unit="L"))
-    return np.array(vals)
+    if not (type(h) is float and math.isfinite(h)):
+        h = float(check_number(h, "h", unit="L"))
+    return vals, h
+
+
+def _section(q: Sequence[float] | np.ndarray, h: float) -> np.ndarray:
+    """The touch-down vector ``(beta, phi, xd, yd, phid, x=0, h)`` of a checked section."""
+    vals, h = _section_values(q, h)
+    return np.array([*vals, 0.0, h])
 
 
 #: Bytes a recorded stride holds per sample row (a compact row: the stance record row,
@@ -244,15 +245,14 @@ def step_map(
     """
     # lean, as it runs once a stride in every analysis (benchmarks/bench_limit.py)
     P = pk.packed_params(_check_params(params)) if packed is None else packed
-    td = _section(q, h)  # checks h too
+    vals, h = _section_values(q, h)
     out = np.empty(pk.NOUT)
     if options is None:
-        O, stride = _DEFAULT_O, _DEFAULT_STRIDE
+        O, section_map = _DEFAULT_O, _DEFAULT_MAP
     else:
         O = options.packed()
-        stride = kn.STRIDE[int(O[pk.O_METHOD])]
-    th = _TH0 if h == 0.0 else td[pk.TD_H :]
-    status = stride(P, O, td, _TX, th, _NO_REC, 0.0, out)
+        section_map = kn.SECTION_MAP[int(O[pk.O_METHOD])]
+    status = section_map(P, O, *vals, h, out)
     return _new_tuple(MapResult, (out[pk.OUT_TD : pk.OUT_TD + 5], out.item(pk.OUT_TS),
                                   out.item(pk.OUT_TF), _STATUS[status]))
 
