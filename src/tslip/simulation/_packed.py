@@ -48,7 +48,7 @@ def stride_map(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E
 
     The next section is ``out[OUT_TD:OUT_TD + 5]``; as :func:`tslip.step_map`.
     """
-    return int(kn.SECTION_MAP[int(O[pk.O_METHOD])](P, O, *q.tolist(), h, out))
+    return int(kn.SECTION_MAP[int(O[pk.O_METHOD])](P, O, *q.tolist(), float(h), out))
 
 
 #: The last exact Jacobians, keyed by their exact inputs (P, O, q, h): gait search

@@ -473,10 +473,10 @@ def _make_section_map(method: int) -> Callable:
         on level ground at height ``h``, nothing recorded; fills ``out``, returns the status.
 
         The stride kernel's arrays (touch-down state, terrain, empty record) are built
-        here, from the section's floats: numba's dispatch of a float costs less
-        than of an array, and NumPy's construction of a small array from Python
-        costs more than the stride's own arithmetic outside the stance (about 1 us
-        a map call, measured apart).
+        here, from the section's floats: built in Python (NumPy arrays from lists,
+        three more arrays for numba to dispatch) they cost about 1 us a map call,
+        a tenth of a Table 6.1 stride (``step_map`` 1.33 -> 1.23 times the stride
+        kernel, ``benchmarks/bench_limit.py``).
         """
         W = np.empty(NTD + 1)
         td = W[0:NTD]
