@@ -92,7 +92,8 @@ def check(dispatcher: object, module_file: str) -> None:
 FAMILIES: dict[str, tuple[str, tuple[str, ...]]] = {
     "TSLIP gait search and analyses": ("simulation", (
         "_stride.stride_dopri5", "_stride.stride_dop853", "_stride.section_map_dop853",
-        "_variational.stride_jacobian_dop853", "_stride.run_row_dopri5")),
+        "_variational.stride_jacobian_dop853", "_stride.run_row_dopri5",
+        "_flight.alpha_r_column")),
     "TSLIP recorded runs": ("simulation", (
         "_record.record_run_dopri5", "_stride.run_batch_serial_dopri5", "_flight.flight_state")),
     "biped (dopri5)": ("biped", ("_stride._integrate_dopri5", "_tmt.kinematics",

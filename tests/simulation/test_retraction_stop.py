@@ -201,6 +201,26 @@ def test_alpha_r_column_matches_finite_differences(name, where):
     assert (np.max(np.abs(col)) == 0.0) == (where < 1.0)
 
 
+@pytest.mark.parametrize("name", list(_BASE))
+def test_alpha_r_column_is_zero_from_the_stop_time_on(name):
+    """The rule that decides the held column, on both sides of the stop time.
+
+    A touch-down at the stop time (this file's ``_stop_time``, from the rule)
+    is held there (column 0); one a step of the last bit earlier is not
+    (column not 0). The stride's ``out`` is the real one but for its flight
+    time, as a stride ending at that instant would have it.
+    """
+    p, s = _with_stop(name, 0.6)
+    P, O = pk.pack_params(p), TIGHT.packed()
+    out = np.empty(pk.NOUT)
+    assert _packed.stride_map(P, O, s.section(), 0.0, out) == 0
+    t_stop = _stop_time(p, out[pk.OUT_LO + 3])
+    out[pk.OUT_TF] = t_stop
+    assert np.max(np.abs(_packed.alpha_r_column(P, out))) == 0.0
+    out[pk.OUT_TF] = math.nextafter(t_stop, 0.0)
+    assert np.max(np.abs(_packed.alpha_r_column(P, out))) > 0.1
+
+
 # -- None is today's code path ------------------------------------------------------------
 
 @pytest.mark.parametrize("name", list(_BASE))

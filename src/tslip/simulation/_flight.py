@@ -16,6 +16,9 @@ from numba import njit
 from .._kernel_cache import check as _check_cache
 from ..model._pack import (
     O_TMAX_FLIGHT,
+    OUT_LO,
+    OUT_TD,
+    OUT_TF,
     P_ALPHA,
     P_APEX,
     P_G,
@@ -253,6 +256,36 @@ def flight_samples(P, lo, ts, out):
     """:func:`flight_state` at each time in ``ts``; ``out`` has shape (n, 10)."""
     for i in range(ts.shape[0]):
         flight_state(P, lo, ts[i], out[i])
+
+
+@njit(**_JIT)
+def alpha_r_column(P, out, col):
+    """``dq'/d alpha_r`` of a completed stride into ``col`` (5), from its output ``out``.
+
+    The derivation is :func:`tslip.simulation._packed.alpha_r_column`'s, which
+    calls this. It is compiled because in Python its four small kernel calls
+    and a dozen scalar reads of ``P`` cost about 3 us, once per Newton Jacobian
+    of every gait search. A touch-down held at the retraction stop does not depend
+    on ``alpha_r`` (0), unless the reset is beyond the stop and is held at ``alpha_r``.
+    """
+    g, r, l0 = P[P_G], P[P_R], P[P_L0]
+    tf = out[OUT_TF]
+    phi0, yd0, phid0 = out[OUT_LO + 4], out[OUT_LO + 3], out[OUT_LO + 5]
+    ta = retraction_start(P, yd0)
+    if tf >= stop_time(P, ta) and stop_angle(P) != P[P_ALPHA]:
+        for i in range(5):
+            col[i] = 0.0
+        return
+    b = out[OUT_TD]  # beta(t_TD)
+    _, bdot = flight_leg_angle(P, phi0, phid0, tf, ta)
+    ph = phi0 + phid0 * tf
+    dfdt = yd0 - g * tf - r * math.sin(ph) * phid0 - l0 * math.cos(b) * bdot
+    dt = l0 * math.cos(b) / dfdt
+    col[0] = 1.0 + bdot * dt
+    col[1] = phid0 * dt
+    col[2] = 0.0
+    col[3] = -g * dt
+    col[4] = 0.0
 
 
 # numba does not notice when a kernel called from another file changes; drop

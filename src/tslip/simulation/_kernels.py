@@ -26,6 +26,7 @@ import numpy as np
 from .._kernel_cache import check as _check_cache
 from ..model._pack import O_METHOD
 from ._flight import (
+    alpha_r_column,
     find_touchdown,
     flight_leg_angle,
     flight_samples,
@@ -60,7 +61,7 @@ from ._stride import (
 
 __all__ = [
     "L_COLLAPSE", "NEVENTS", "NSTATE", "RECORD_RUN", "SECTION_MAP",
-    "STRIDE", "com_velocity",
+    "STRIDE", "alpha_r_column", "com_velocity",
     "event_values", "find_touchdown", "flight_leg_angle", "flight_samples", "flight_state",
     "grf", "hip_torque", "integrate_stance", "record_run", "retraction_start", "rhs",
     "run_batch", "run_batch_serial", "stance_accel", "stance_initial", "stop_angle",

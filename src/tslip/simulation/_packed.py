@@ -19,7 +19,6 @@ same as the public functions', so the results are identical bit for bit.
 
 from __future__ import annotations
 
-import math
 import threading
 from typing import Any
 
@@ -134,17 +133,9 @@ def alpha_r_column(P: np.ndarray, out: np.ndarray) -> np.ndarray:
     stop (:func:`stop_binds`) does not depend on ``alpha_r``: the column is 0
     (a reset beyond the stop is held at ``alpha_r``, as without retraction).
     """
-    g, r, l0 = P[pk.P_G], P[pk.P_R], P[pk.P_L0]
-    tf = out[pk.OUT_TF]
-    phi0, yd0, phid0 = out[pk.OUT_LO + 4], out[pk.OUT_LO + 3], out[pk.OUT_LO + 5]
-    if stop_binds(P, yd0, tf) and kn.stop_angle(P) != P[pk.P_ALPHA]:
-        return np.zeros(5)
-    b = out[pk.OUT_TD]  # beta(t_TD)
-    _, bdot = kn.flight_leg_angle(P, phi0, phid0, tf, kn.retraction_start(P, yd0))
-    ph = phi0 + phid0 * tf
-    dfdt = yd0 - g * tf - r * math.sin(ph) * phid0 - l0 * math.cos(b) * bdot
-    dt = l0 * math.cos(b) / dfdt
-    return np.array([1.0 + bdot * dt, phid0 * dt, 0.0, -g * dt, 0.0])
+    col = np.empty(5)
+    kn.alpha_r_column(P, out, col)  # compiled (:func:`._flight.alpha_r_column`)
+    return col
 
 
 def run(P: np.ndarray, O: np.ndarray, td: np.ndarray, n_steps: int,  # noqa: E741
