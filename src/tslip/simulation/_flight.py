@@ -3,8 +3,10 @@
 Private (see :mod:`._kernels`). Flight is ballistic (eq. 2.7) with the leg reset
 of eq. 2.17 (signs in docs/conventions.md) and the optional retraction stop
 (Section 7.5, ``Params.alpha_stop``); only the touch-down time needs a
-search (:func:`find_touchdown`, which compiles on its own; the other functions
-are ``inline="always"``, copied into the kernels that call them).
+search (:func:`find_touchdown`, which compiles on its own, as does
+:func:`alpha_r_column`, the touch-down's derivative in ``alpha_r`` for the gait
+search; the other functions are ``inline="always"``, copied into the kernels
+that call them).
 """
 
 from __future__ import annotations
