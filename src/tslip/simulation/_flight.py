@@ -67,6 +67,13 @@ def stop_time(P, ta):
 
 
 @njit(**_INLINE)
+def stop_binds(P, yd0, tf):
+    """Whether a flight of ``tf`` after a lift-off at ``ydot = yd0`` touches down stopped:
+    at or after :func:`stop_time` (never without a stop or with ``omega_r = 0``)."""
+    return tf >= stop_time(P, retraction_start(P, yd0))
+
+
+@njit(**_INLINE)
 def stop_angle(P):
     """Angle held once stopped: ``max(alpha_r, alpha_stop)`` (``min`` if ``omega_r < 0``)."""
     return P[P_STOP] if (P[P_STOP] - P[P_ALPHA]) * P[P_OMEGA] > 0.0 else P[P_ALPHA]
@@ -273,13 +280,12 @@ def alpha_r_column(P, out, col):
     g, r, l0 = P[P_G], P[P_R], P[P_L0]
     tf = out[OUT_TF]
     phi0, yd0, phid0 = out[OUT_LO + 4], out[OUT_LO + 3], out[OUT_LO + 5]
-    ta = retraction_start(P, yd0)
-    if tf >= stop_time(P, ta) and stop_angle(P) != P[P_ALPHA]:
+    if stop_binds(P, yd0, tf) and stop_angle(P) != P[P_ALPHA]:
         for i in range(5):
             col[i] = 0.0
         return
     b = out[OUT_TD]  # beta(t_TD)
-    _, bdot = flight_leg_angle(P, phi0, phid0, tf, ta)
+    _, bdot = flight_leg_angle(P, phi0, phid0, tf, retraction_start(P, yd0))
     ph = phi0 + phid0 * tf
     dfdt = yd0 - g * tf - r * math.sin(ph) * phid0 - l0 * math.cos(b) * bdot
     dt = l0 * math.cos(b) / dfdt

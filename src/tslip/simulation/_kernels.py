@@ -33,6 +33,7 @@ from ._flight import (
     flight_state,
     retraction_start,
     stop_angle,
+    stop_binds,
     stop_time,
 )
 from ._record import RECORD_RUN
@@ -64,7 +65,7 @@ __all__ = [
     "STRIDE", "alpha_r_column", "com_velocity",
     "event_values", "find_touchdown", "flight_leg_angle", "flight_samples", "flight_state",
     "grf", "hip_torque", "integrate_stance", "record_run", "retraction_start", "rhs",
-    "run_batch", "run_batch_serial", "stance_accel", "stance_initial", "stop_angle",
+    "run_batch", "run_batch_serial", "stance_accel", "stance_initial", "stop_angle", "stop_binds",
     "stop_time", "stride",
     "stride_batch", "stride_batch_serial",
 ]

@@ -113,9 +113,10 @@ def stop_binds(P: np.ndarray, yd0: float, tf: float) -> bool:
 
     The retraction stop (Section 7.5; docs/conventions.md) holds the hip angle
     at ``max(alpha_r, alpha_stop)`` (``min`` for ``omega_r < 0``) from
-    :func:`._kernels.stop_time` on; False without a stop or with ``omega_r = 0``.
+    :func:`._kernels.stop_time` on; False without a stop or with ``omega_r = 0``
+    (the kernels' rule, :func:`._flight.stop_binds`).
     """
-    return bool(tf >= kn.stop_time(P, kn.retraction_start(P, yd0)))
+    return bool(kn.stop_binds(P, yd0, tf))
 
 
 def alpha_r_column(P: np.ndarray, out: np.ndarray) -> np.ndarray:
