@@ -32,11 +32,12 @@ Definitions:
   batch kernel without recording, one :func:`tslip.run_batch` call.
 * **simulate**: :func:`tslip.simulate` of those strides at ``dt = --dt``;
   **simulate + to_dataframe**: the same and ``Trajectory.to_dataframe()`` (all
-  columns). A context line gives that line's floor with libm's trigonometry: the
-  sine and cosine of both angles (``beta``, ``phi``) of every sample, which every
-  derived position, velocity and force needs and which ``to_dataframe`` takes
-  from libm bit for bit as the stride kernel does, plus writing a fresh table
-  of all columns once.
+  columns). A context line gives that line's floor: the sine and cosine of both
+  angles (``beta``, ``phi``) of every sample, which every derived position,
+  velocity and force needs, as ``to_dataframe`` computes them (vectorised,
+  ``simulation/_sincos.py``; libm's on a checkout without it, which took them
+  from libm as the stride kernel does), plus writing a fresh table of all
+  columns once.
 * **step_map**: one :func:`tslip.step_map` call from the gait's section (a
   loop of ``--maps`` calls, divided by ``--maps``), against one stride kernel.
 * **study point / its compiled work**: the wall time of one serial continuation
@@ -53,6 +54,7 @@ import inspect
 import math
 import os
 import time
+from collections.abc import Callable
 
 import numba
 import numpy as np
@@ -83,13 +85,24 @@ def _rhs_loop(P, Y, reps):  # noqa: N803
 
 
 @njit(cache=False)
-def _trig_loop(beta, phi):
-    """The sines and cosines ``to_dataframe`` cannot do without: of both angles of each sample
-    (libm's, as in ``_record.fill_table``); the sum keeps the calls alive."""
+def _libm_trig(beta, phi):
+    """libm's sines and cosines of both angles of each sample; the sum keeps the calls alive."""
     acc = 0.0
     for i in range(beta.shape[0]):
         acc += math.sin(beta[i]) + math.cos(beta[i]) + math.sin(phi[i]) + math.cos(phi[i])
     return acc
+
+
+def _trig_loop(beta: np.ndarray, phi: np.ndarray) -> Callable[[], object]:
+    """The sines and cosines ``to_dataframe`` cannot do without, of both angles of each
+    sample, as this checkout's ``_record.fill_table`` computes them: vectorised
+    (``_sincos.sincos_array``), or libm's on a checkout without that module."""
+    try:
+        from tslip.simulation._sincos import sincos_array
+    except ImportError:
+        return lambda: _libm_trig(beta, phi)
+    out = np.empty((4, len(beta)))
+    return lambda: (sincos_array(beta, out[0], out[1]), sincos_array(phi, out[2], out[3]))
 
 
 #: The method of the loops below, a compile-time constant there (as in the kernels).
@@ -184,7 +197,7 @@ def main() -> None:
         "simulate": lambda: tslip.simulate(p, s, a.steps, dt=a.dt),
         "simulate + df": lambda: tslip.simulate(p, s, a.steps, dt=a.dt).to_dataframe(),
         "step_map": maps,
-        "trig": lambda: _trig_loop(beta, phi),
+        "trig": _trig_loop(beta, phi),
         "fresh table": lambda: np.empty((pk.NTRAJ, len(beta))).fill(1.0),
         "steps": lambda: _steps_loop(P, y0, hs, a.reps),
         "stance": lambda: _stance_loop(stance, P, O, y0, a.reps),
@@ -222,7 +235,7 @@ def main() -> None:
           f"per-stride work (touch-down, flight, batch loop) {(stride - t_stance) * 1e6:.2f} us")
     floor = t["simulate"] + t["trig"] + t["fresh table"]
     print(f"to_dataframe adds {(t['simulate + df'] - t['simulate']) * 1e3:.2f} ms; its floor: "
-          f"libm sin and cos of both angles of each sample {t['trig'] * 1e3:.2f} ms, a fresh "
+          f"sin and cos of both angles of each sample {t['trig'] * 1e3:.2f} ms, a fresh "
           f"table written once {t['fresh table'] * 1e3:.2f} ms; simulate + these / unrecorded "
           f"strides: {floor / t['strides']:.2f}")
     if study is not None:

@@ -134,6 +134,7 @@ def dump(path: str) -> None:
 def compare(a: str, b: str) -> int:
     A, B = np.load(a), np.load(b)
     bad = 0
+    worst = 0.0
     if set(A.files) != set(B.files):
         print("key sets differ", set(A.files) ^ set(B.files))
         bad += 1
@@ -141,8 +142,20 @@ def compare(a: str, b: str) -> int:
         x, y = A[k], B[k]
         if x.shape != y.shape or not np.array_equal(x.view(np.uint64), y.view(np.uint64)):
             bad += 1
-            print("DIFF", k, x.shape, y.shape)
-    print(f"{len(A.files)} arrays compared, {bad} differ")
+            if x.shape != y.shape:
+                print("DIFF", k, x.shape, y.shape)
+                continue
+            # how far: the largest difference relative to the array's largest value
+            # (where NaN sits in both, it counts as equal)
+            both = np.isnan(x) & np.isnan(y)
+            d = np.where(both, 0.0, np.abs(x - y))
+            scale = np.nanmax(np.abs(x)) if np.isfinite(x).any() else 1.0
+            rel = np.nanmax(d) / scale if scale > 0 else np.nanmax(d)
+            worst = max(worst, rel)
+            print(f"DIFF {k} {x.shape}: {int((d != 0).sum())} values, largest difference "
+                  f"{rel:.2e} of the array's largest value")
+    print(f"{len(A.files)} arrays compared, {bad} differ"
+          + (f" (largest relative difference {worst:.2e})" if bad else ""))
     return bad
 
 

@@ -40,7 +40,8 @@ _ROOT = Path(__file__).parent
 SOURCES: tuple[str, ...] = (
     "model/_pack.py", "simulation/_rk.py", "simulation/_specialise.py", "simulation/_stance.py",
     "simulation/_flight.py", "simulation/_stepper.py", "simulation/_stride.py",
-    "simulation/_record.py", "simulation/_kernels.py", "simulation/_variational.py",
+    "simulation/_sincos.py", "simulation/_record.py", "simulation/_kernels.py",
+    "simulation/_variational.py",
     "biped/_pack.py", "biped/_jit.py", "biped/_tmt.py", "biped/_control.py", "biped/_contact.py",
     "biped/_rhs.py", "biped/_events.py", "biped/_stride.py", "biped/_kernels.py", "_nrt.py",
 )

@@ -112,25 +112,36 @@ def flight_state(P, lo, t, out):
 
     Writes ``(x, y, xd, yd, phi, phid, beta, foot_x, foot_y, hip_y)`` to ``out``.
     """
+    ph = lo[4] + lo[5] * t
+    b, _ = flight_leg_angle(P, lo[4], lo[5], t, retraction_start(P, lo[3]))
+    x, y, yd, _, hip_y, foot_x, foot_y = flight_point(P, lo, t, math.sin(ph), math.cos(ph),
+                                                       math.sin(b), math.cos(b))
+    out[0] = x
+    out[1] = y
+    out[2] = lo[2]
+    out[3] = yd
+    out[4] = ph
+    out[5] = lo[5]
+    out[6] = b
+    out[7] = foot_x
+    out[8] = foot_y
+    out[9] = hip_y
+
+
+@njit(**_INLINE)
+def flight_point(P, lo, t, sp, cp, sb, cb):
+    """``(x, y, yd, hip_x, hip_y, foot_x, foot_y)`` ``t`` after lift-off from ``lo`` (eq.
+    2.7), given the sine and cosine of ``phi(t)`` (``sp, cp``) and of ``beta(t)`` (``sb,
+    cb``): the formula's one copy, for :func:`flight_state` (libm's sines) and the
+    recorded run's table (:func:`._record.fill_table`, vectorised ones)."""
     g = P[P_G]
     r = P[P_R]
     l0 = P[P_L0]
     x = lo[0] + lo[2] * t
     y = lo[1] + lo[3] * t - 0.5 * g * t * t
-    ph = lo[4] + lo[5] * t
-    b, _ = flight_leg_angle(P, lo[4], lo[5], t, retraction_start(P, lo[3]))
-    hip_x = x - r * math.sin(ph)
-    hip_y = y + r * math.cos(ph)
-    out[0] = x
-    out[1] = y
-    out[2] = lo[2]
-    out[3] = lo[3] - g * t
-    out[4] = ph
-    out[5] = lo[5]
-    out[6] = b
-    out[7] = hip_x + l0 * math.cos(b)
-    out[8] = hip_y - l0 * math.sin(b)
-    out[9] = hip_y
+    hip_x = x - r * sp
+    hip_y = y + r * cp
+    return x, y, lo[3] - g * t, hip_x, hip_y, hip_x + l0 * cb, hip_y - l0 * sb
 
 
 @njit(**_INLINE)

@@ -4,10 +4,12 @@ Private (see :mod:`._kernels`). :data:`RECORD_RUN` holds one kernel per
 integrator method (:func:`._stride.specialise`): the strides and their stance
 record rows (time and stance state) as the stride kernel writes them.
 :func:`fill_table` derives the trajectory's columns from those when they are first
-read (the row builders are ``inline="always"``), so a run that is not looked at row
-by row never pays for them; :func:`stance_forces` derives a stride's ground force
-and hip torque (``StepResult.grf``). Both compute the forces as the stride kernel's
-:func:`._stance.grf` would (:func:`._stance.grf_at`), bit for bit.
+read, so a run that is not looked at row by row never pays for them;
+:func:`stance_forces` derives a stride's ground force and hip torque
+(``StepResult.grf``). Both use the stride kernel's formulas (:func:`._stance.grf_at`,
+:func:`._flight.flight_point`) with the sines and cosines of
+:func:`._sincos.sincos_array` (within 1 ulp of libm's, which the kernel uses), so the
+two agree with each other bit for bit.
 """
 
 from __future__ import annotations
@@ -17,10 +19,14 @@ from collections.abc import Callable
 
 import numpy as np
 from numba import njit
+from numba.extending import overload
+from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from .._kernel_cache import check as _check_cache
+from .._nrt import without_nrt
 from ..model._pack import (
     NOUT,
+    NP,
     NTD,
     OUT_LO,
     OUT_NREC,
@@ -34,6 +40,7 @@ from ..model._pack import (
     P_J,
     P_L0,
     P_M,
+    P_NEXP,
     P_R,
     P_THRUST,
     REC_BETA,
@@ -75,8 +82,9 @@ from ..model._pack import (
     TR_Y,
     TR_YD,
 )
-from ._flight import flight_leg_angle, flight_state, retraction_start
+from ._flight import flight_leg_angle, flight_point, retraction_start
 from ._rk import _INLINE, _JIT
+from ._sincos import sincos_array
 from ._specialise import specialise
 from ._stance import _com_velocity, grf_at, spring_energy
 from ._stride import stride_of
@@ -87,70 +95,6 @@ def _energy(P, y, xd, yd, phid, l):
     """Total mechanical energy: kinetic + gravity + leg spring ``V`` [MgL]."""
     return (0.5 * P[P_M] * (xd * xd + yd * yd) + 0.5 * P[P_J] * phid * phid
             + P[P_M] * P[P_G] * y + spring_energy(P, l))
-
-
-@njit(**_INLINE)
-def _stance_row(P, t0, i, xf, h, rows, k, tab):
-    """Trajectory column ``k`` of ``tab`` from the stance record row ``rows[k]`` (eq.
-    A.3-A.5: CoM, hip from the leg; eqs 2.5-2.6: the ground force).
-
-    Indices, not a row view and a column view per sample: those cost 3-9 % of
-    :func:`fill_table` (numba counts their references)."""
-    rp = P[P_R]
-    l, b, ph = rows[k, REC_L], rows[k, REC_BETA], rows[k, REC_PHI]
-    ld, bd, phd = rows[k, REC_LD], rows[k, REC_BETAD], rows[k, REC_PHID]
-    sb = math.sin(b)
-    cb = math.cos(b)
-    sp = math.sin(ph)
-    cp = math.cos(ph)
-    y = h + l * sb - rp * cp
-    xd, yd = _com_velocity(rp, l, sb, cb, sp, cp, ld, bd, phd)
-    tab[TR_T, k] = t0 + rows[k, REC_T]
-    tab[TR_STEP, k] = i
-    tab[TR_STANCE, k] = 1.0
-    tab[TR_X, k] = xf - l * cb + rp * sp
-    tab[TR_Y, k] = y
-    tab[TR_XD, k] = xd
-    tab[TR_YD, k] = yd
-    tab[TR_PHI, k] = ph
-    tab[TR_PHID, k] = phd
-    tab[TR_L, k] = l
-    tab[TR_BETA, k] = b
-    tab[TR_LD, k] = ld
-    tab[TR_BETAD, k] = bd
-    tab[TR_ALPHA, k] = b + ph
-    tab[TR_FOOTX, k] = xf
-    tab[TR_FOOTY, k] = h
-    tab[TR_HIPX, k] = xf - l * cb
-    tab[TR_HIPY, k] = h + l * sb
-    tab[TR_FX, k], tab[TR_FY, k], tab[TR_TAU, k] = grf_at(P, l, ph, ld, bd, phd, sb, cb)
-    tab[TR_ENERGY, k] = _energy(P, y, xd, yd, phd, l)
-
-
-@njit(**_INLINE)
-def _flight_row(P, t_lo, i, lo, tau, fs, tab, c):
-    """Column ``c`` of ``tab``: the state ``tau`` after lift-off at ``t_lo`` (closed-form
-    flight, eq. 2.7)."""
-    flight_state(P, lo, tau, fs)
-    l0 = P[P_L0]
-    tab[TR_T, c] = t_lo + tau
-    tab[TR_STEP, c] = i
-    tab[TR_STANCE, c] = 0.0
-    for j in range(6):  # x, y, xd, yd, phi, phid
-        tab[TR_X + j, c] = fs[j]
-    tab[TR_L, c] = l0
-    tab[TR_BETA, c] = fs[6]
-    tab[TR_LD, c] = 0.0
-    tab[TR_BETAD, c] = flight_leg_angle(P, lo[4], lo[5], tau, retraction_start(P, lo[3]))[1]
-    tab[TR_ALPHA, c] = fs[6] + fs[4]
-    tab[TR_FOOTX, c] = fs[7]
-    tab[TR_FOOTY, c] = fs[8]
-    tab[TR_HIPX, c] = fs[0] - P[P_R] * math.sin(fs[4])
-    tab[TR_HIPY, c] = fs[9]
-    tab[TR_FX, c] = 0.0
-    tab[TR_FY, c] = 0.0
-    tab[TR_TAU, c] = 0.0
-    tab[TR_ENERGY, c] = _energy(P, fs[1], fs[2], fs[3], fs[5], l0)
 
 
 @njit(**_INLINE)
@@ -250,6 +194,172 @@ def after_switch(t, tsw, at_steps):
     return t >= tsw if at_steps else t > tsw
 
 
+#: :func:`fill_table`'s passes: they make no arrays, so they keep no reference counts
+#: (:mod:`tslip._nrt`)
+_FAST = without_nrt(**_JIT)
+
+#: Rows :func:`fill_table` derives at a time (whole strides, this many or a stride's
+#: more): a group's columns stay in the core's own (L2) cache from pass to pass.
+GROUP_ROWS = 2048
+
+
+def _param_tuple(P):  # noqa: N803 - the kernels' name
+    """The packed parameters ``P`` as a tuple of ``NP`` floats: values, not memory, so a
+    compiled loop knows that its stores leave them unchanged (:func:`_columns`)."""
+    return tuple(P)
+
+
+@overload(_param_tuple, jit_options={"cache": True})
+def _param_tuple_jit(P):  # noqa: N803
+    return lambda P: to_fixed_tuple(P, NP)
+
+
+@njit(**_INLINE)
+def _fill(col, a, b, v):
+    """``col[a:b] = v``, as a loop from 0 (no negative index for numba to wrap): packed stores."""
+    c = col[a:b]
+    for k in range(b - a):
+        c[k] = v
+
+
+@njit(**_FAST)
+def _record_columns(P, rows, starts, outs, info, s0, s1, table):
+    """:func:`fill_table`'s first pass over strides ``s0 .. s1 - 1``: what needs no sine
+    or cosine. Time, stride and phase; a stance row's state as recorded and its foot; a
+    flight row's leg and pitch (eq. 2.17, ``phi`` linear in time) and, for now, a foot at
+    0.0 (:func:`_flight_rows` writes it)."""
+    for s in range(s0, s1):
+        t0 = info[s, RI_T0]
+        r0 = int(info[s, RI_ROW0])
+        r1 = r0 + int(info[s, RI_NSTANCE])
+        r2 = int(info[s, RI_ROW1])
+        for k in range(r0, r1):
+            table[TR_T, k] = t0 + rows[k, REC_T]
+            table[TR_L, k] = rows[k, REC_L]
+            table[TR_BETA, k] = rows[k, REC_BETA]
+            table[TR_PHI, k] = rows[k, REC_PHI]
+            table[TR_LD, k] = rows[k, REC_LD]
+            table[TR_BETAD, k] = rows[k, REC_BETAD]
+            table[TR_PHID, k] = rows[k, REC_PHID]
+        _fill(table[TR_STEP], r0, r2, s)
+        _fill(table[TR_STANCE], r0, r1, 1.0)
+        _fill(table[TR_STANCE], r1, r2, 0.0)
+        _fill(table[TR_FOOTX], r0, r1, outs[s, OUT_XF])
+        _fill(table[TR_FOOTX], r1, r2, 0.0)
+        _fill(table[TR_FOOTY], r0, r1, starts[s, 6])
+        _fill(table[TR_FOOTY], r1, r2, 0.0)
+        _fill(table[TR_L], r1, r2, P[P_L0])
+        _fill(table[TR_LD], r1, r2, 0.0)
+        t_lo = t0 + outs[s, OUT_TS]
+        lo = outs[s, OUT_LO:OUT_LO + 6]
+        ta = retraction_start(P, lo[3])
+        for k in range(r1, r2):
+            tau = rows[k, REC_T]
+            b, bd = flight_leg_angle(P, lo[4], lo[5], tau, ta)
+            table[TR_T, k] = t_lo + tau
+            table[TR_BETA, k] = b
+            table[TR_PHI, k] = lo[4] + lo[5] * tau
+            table[TR_BETAD, k] = bd
+            table[TR_PHID, k] = lo[5]
+
+
+@njit(**_INLINE)
+def _stance_columns(P, a, b, trig, table):
+    """Rows ``a .. b - 1`` as stance rows: CoM and hip (eqs A.3-A.5), ``alpha``, the
+    ground force and hip torque (eqs 2.5-2.6) and the energy, one column a loop (see
+    :func:`_columns`); ``trig[:, k - a]`` holds row ``k``'s ``sin beta, cos beta, sin
+    phi, cos phi``. The loops run over views from row ``a`` on, so that their indices
+    start at 0 (no negative index for numba to wrap)."""
+    rp = P[P_R]
+    m = b - a
+    sb, cb, sp, cp = trig[0][:m], trig[1][:m], trig[2][:m], trig[3][:m]
+    l, be, ph = table[TR_L][a:b], table[TR_BETA][a:b], table[TR_PHI][a:b]
+    ld, bd, phd = table[TR_LD][a:b], table[TR_BETAD][a:b], table[TR_PHID][a:b]
+    xf, h = table[TR_FOOTX][a:b], table[TR_FOOTY][a:b]
+    x, y = table[TR_X][a:b], table[TR_Y][a:b]
+    xd, yd = table[TR_XD][a:b], table[TR_YD][a:b]
+    hip_x, hip_y = table[TR_HIPX][a:b], table[TR_HIPY][a:b]
+    for k in range(m):
+        hip_x[k] = xf[k] - l[k] * cb[k]
+    for k in range(m):
+        hip_y[k] = h[k] + l[k] * sb[k]
+    for k in range(m):  # xf - l cb + rp sp
+        x[k] = hip_x[k] + rp * sp[k]
+    for k in range(m):  # h + l sb - rp cp
+        y[k] = hip_y[k] - rp * cp[k]
+    for k in range(m):
+        xd[k] = _com_velocity(rp, l[k], sb[k], cb[k], sp[k], cp[k], ld[k], bd[k], phd[k])[0]
+    for k in range(m):
+        yd[k] = _com_velocity(rp, l[k], sb[k], cb[k], sp[k], cp[k], ld[k], bd[k], phd[k])[1]
+    col = table[TR_ALPHA][a:b]
+    for k in range(m):
+        col[k] = be[k] + ph[k]
+    col = table[TR_FX][a:b]
+    for k in range(m):
+        col[k] = grf_at(P, l[k], ph[k], ld[k], bd[k], phd[k], sb[k], cb[k])[0]
+    col = table[TR_FY][a:b]
+    for k in range(m):
+        col[k] = grf_at(P, l[k], ph[k], ld[k], bd[k], phd[k], sb[k], cb[k])[1]
+    col = table[TR_TAU][a:b]
+    for k in range(m):
+        col[k] = grf_at(P, l[k], ph[k], ld[k], bd[k], phd[k], sb[k], cb[k])[2]
+    col = table[TR_ENERGY][a:b]
+    for k in range(m):
+        col[k] = _energy(P, y[k], xd[k], yd[k], phd[k], l[k])
+
+
+@njit(**_FAST)
+def _columns(P, a, b, trig, table):
+    """:func:`fill_table`'s third pass: rows ``a .. b - 1`` as stance rows
+    (:func:`_stance_columns`); :func:`_flight_rows` redoes the flight rows. ``P`` is a
+    tuple, so that its values are no memory the stores could change: each loop, storing
+    one contiguous column, compiles to packed (SIMD) arithmetic; for the linear spring
+    (``n = 1``), known as such in its branch, without the power law's ``pow``."""
+    if P[P_NEXP] == 1.0:
+        _stance_columns(P, a, b, trig, table)
+    else:
+        _stance_columns(P, a, b, trig, table)
+
+
+@njit(**_FAST)
+def _flight_rows(P, Pw, rows, outs, info, s0, s1, a, trig, table):
+    """:func:`fill_table`'s last pass over strides ``s0 .. s1 - 1`` (first row ``a``): the
+    flight rows in closed form (:func:`._flight.flight_point`, eq. 2.7), and a thrust's
+    stance rows after its switch (:func:`after_switch`) again with the switched
+    parameters ``Pw``."""
+    l0 = P[P_L0]
+    for s in range(s0, s1):
+        r0 = int(info[s, RI_ROW0])
+        r1 = r0 + int(info[s, RI_NSTANCE])
+        tsw = outs[s, OUT_TSW]  # NaN without a switch: no row is after it
+        if tsw == tsw:
+            for k in range(r0, r1):
+                if after_switch(rows[k, REC_T], tsw, False):
+                    l, ph, phd = table[TR_L, k], table[TR_PHI, k], table[TR_PHID, k]
+                    table[TR_FX, k], table[TR_FY, k], table[TR_TAU, k] = grf_at(
+                        Pw, l, ph, table[TR_LD, k], table[TR_BETAD, k], phd, trig[0, k - a],
+                        trig[1, k - a])
+                    table[TR_ENERGY, k] = _energy(Pw, table[TR_Y, k], table[TR_XD, k],
+                                                  table[TR_YD, k], phd, l)
+        lo = outs[s, OUT_LO:OUT_LO + 6]
+        for k in range(r1, int(info[s, RI_ROW1])):
+            i = k - a
+            x, y, yd, hip_x, hip_y, foot_x, foot_y = flight_point(
+                P, lo, rows[k, REC_T], trig[2, i], trig[3, i], trig[0, i], trig[1, i])
+            table[TR_X, k] = x
+            table[TR_Y, k] = y
+            table[TR_XD, k] = lo[2]
+            table[TR_YD, k] = yd
+            table[TR_FOOTX, k] = foot_x
+            table[TR_FOOTY, k] = foot_y
+            table[TR_HIPX, k] = hip_x
+            table[TR_HIPY, k] = hip_y
+            table[TR_FX, k] = 0.0
+            table[TR_FY, k] = 0.0
+            table[TR_TAU, k] = 0.0
+            table[TR_ENERGY, k] = _energy(P, y, lo[2], yd, lo[5], l0)
+
+
 @njit(**_JIT)
 def fill_table(P, rows, starts, outs, info, n, table):
     """The trajectory columns (``TR_*``, one row of ``table`` each) of a recorded run.
@@ -261,33 +371,47 @@ def fill_table(P, rows, starts, outs, info, n, table):
     2.5-2.6), flight rows from the lift-off state in closed form (eq. 2.7). A stance
     row after the leg thrust's switch (``OUT_TSW``) takes the switched rest length,
     as the stride kernel's grid did (:func:`stance_forces`).
+
+    Column by column where it can, a group of strides (:data:`GROUP_ROWS`) at a time,
+    so that most of the work compiles to packed (SIMD) arithmetic and stores (row by
+    row, a row's 22 scalar stores and libm's ``sincos`` cost more than its arithmetic):
+    the columns that need no trigonometry (:func:`_record_columns`), the sines and
+    cosines of every ``beta`` and ``phi`` (:func:`._sincos.sincos_array`, within 1 ulp
+    of libm), every row as a stance row (:func:`_columns`), then the flight rows and a
+    thrust's rows after its switch (:func:`_flight_rows`). Each value is computed with
+    the stride kernel's operations in its order; only the sines and cosines are not libm's.
     """
-    lo = np.empty(6)
-    fs = np.empty(10)
+    if n == 0:
+        return
     Pw = P.copy()  # the switched parameters of a thrust's stance rows
     Pw[P_THRUST] = -P[P_THRUST]
+    pt, pw = _param_tuple(P), _param_tuple(Pw)
+    most = 0  # rows of the longest stride: a group has fewer than GROUP_ROWS + most
     for s in range(n):
-        t0 = info[s, RI_T0]
-        row = int(info[s, RI_ROW0])
-        nrec = int(info[s, RI_NSTANCE])
-        xf = outs[s, OUT_XF]
-        h = starts[s, 6]
-        tsw = outs[s, OUT_TSW]  # NaN without a switch: no row is after it
-        for k in range(row, row + nrec):
-            Pk = Pw if after_switch(rows[k, REC_T], tsw, False) else P
-            _stance_row(Pk, t0, s, xf, h, rows, k, table)
-        t_lo = t0 + outs[s, OUT_TS]
-        for j in range(6):
-            lo[j] = outs[s, OUT_LO + j]
-        for k in range(row + nrec, int(info[s, RI_ROW1])):
-            _flight_row(P, t_lo, s, lo, rows[k, REC_T], fs, table, k)
+        most = max(most, int(info[s, RI_ROW1] - info[s, RI_ROW0]))
+    trig = np.empty((4, GROUP_ROWS + most))  # sin beta, cos beta, sin phi, cos phi
+    s0 = 0
+    while s0 < n:
+        a = int(info[s0, RI_ROW0])
+        s1 = s0 + 1
+        while s1 < n and info[s1, RI_ROW0] - a < GROUP_ROWS:
+            s1 += 1
+        b = int(info[s1 - 1, RI_ROW1])
+        _record_columns(pt, rows, starts, outs, info, s0, s1, table)
+        sincos_array(table[TR_BETA, a:b], trig[0, :b - a], trig[1, :b - a])
+        sincos_array(table[TR_PHI, a:b], trig[2, :b - a], trig[3, :b - a])
+        _columns(pt, a, b, trig, table)
+        _flight_rows(pt, pw, rows, outs, info, s0, s1, a, trig, table)
+        s0 = s1
 
 
 @njit(**_JIT)
 def stance_forces(P, rec, tsw, at_steps, grf):
     """A stance's ground force and hip torque from its record rows ``rec`` (n x NREC):
-    ``grf`` (n x 4) receives ``t, F_x, F_y, tau`` (``StepResult.grf``) as the stride
-    kernel computes them (:func:`._stance.grf`), bit for bit.
+    ``grf`` (n x 4) receives ``t, F_x, F_y, tau`` (``StepResult.grf``) by the stride
+    kernel's formula (:func:`._stance.grf_at`) with the sines and cosines of
+    :func:`._sincos.sincos_array`, as :func:`fill_table` computes them: a simulated
+    stride's ``grf`` is its rows' ``Fx, Fy, tau``, bit for bit.
 
     With a leg thrust the kernel ran on the switched rest length from the switch on
     (``tsw``, its ``OUT_TSW``): which rows that covers depends on how they were recorded,
@@ -296,16 +420,19 @@ def stance_forces(P, rec, tsw, at_steps, grf):
     """
     Pw = P.copy()  # the switched parameters of a thrust's rows after the switch
     Pw[P_THRUST] = -P[P_THRUST]
-    for k in range(rec.shape[0]):
+    n = rec.shape[0]
+    trig = np.empty((3, n))  # beta, its sine and cosine
+    for k in range(n):
+        trig[0, k] = rec[k, REC_BETA]
+    sincos_array(trig[0], trig[1], trig[2])
+    for k in range(n):
         r = rec[k]
         t = r[REC_T]
-        b = r[REC_BETA]
         Pk = Pw if after_switch(t, tsw, at_steps) else P
         grf[k, 0] = t
         grf[k, 1], grf[k, 2], grf[k, 3] = grf_at(Pk, r[REC_L], r[REC_PHI], r[REC_LD],
-                                                 r[REC_BETAD], r[REC_PHID], math.sin(b),
-                                                 math.cos(b))
-
+                                                 r[REC_BETAD], r[REC_PHID], trig[1, k],
+                                                 trig[2, k])
 
 #: ``(P, O, td, tx, th, first, last, close, dt, rows, starts, outs, info, pos)
 #: -> status`` by method (:func:`_make_record_run`).
@@ -314,4 +441,4 @@ RECORD_RUN = specialise(_make_record_run, "record_run")
 
 # numba does not notice when a kernel called from another file changes; drop
 # cached kernels compiled against other sources (see tslip._kernel_cache).
-_check_cache(_stance_row, __file__)
+_check_cache(fill_table, __file__)

@@ -192,7 +192,8 @@ def grf(P, y):
 def grf_at(P, l, ph, ld, bd, phd, sb, cb):
     """:func:`grf` with ``sin(beta), cos(beta)`` given: the formula's one copy, shared with
     the recorded run's rows (:func:`._record.fill_table`, :func:`._record.stance_forces`),
-    which derive the forces from the recorded state, bit for bit what :func:`grf` gives."""
+    which derive the forces from the recorded state with vectorised sines and cosines
+    (:mod:`._sincos`, within 1 ulp of libm's that :func:`grf` uses)."""
     tau = hip_torque(P, ph, bd, phd)
     fl = leg_force(P, l, ld)
     return -fl * cb + tau / l * sb, fl * sb + tau / l * cb, tau
