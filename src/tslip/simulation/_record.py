@@ -86,15 +86,21 @@ from ._flight import flight_leg_angle, flight_point, retraction_start
 from ._rk import _INLINE, _JIT
 from ._sincos import sincos_array
 from ._specialise import specialise
-from ._stance import _com_velocity, grf_at, spring_energy
+from ._stance import _com_velocity, grf_at, grf_of, hip_torque, leg_force, spring_energy
 from ._stride import stride_of
 
 
 @njit(**_INLINE)
 def _energy(P, y, xd, yd, phid, l):
     """Total mechanical energy: kinetic + gravity + leg spring ``V`` [MgL]."""
+    return _energy_of(P, y, xd, yd, phid, spring_energy(P, l))
+
+
+@njit(**_INLINE)
+def _energy_of(P, y, xd, yd, phid, v):
+    """:func:`_energy` with the spring's energy ``v`` given."""
     return (0.5 * P[P_M] * (xd * xd + yd * yd) + 0.5 * P[P_J] * phid * phid
-            + P[P_M] * P[P_G] * y + spring_energy(P, l))
+            + P[P_M] * P[P_G] * y + v)
 
 
 @njit(**_INLINE)
@@ -205,7 +211,7 @@ GROUP_ROWS = 2048
 
 def _param_tuple(P):  # noqa: N803 - the kernels' name
     """The packed parameters ``P`` as a tuple of ``NP`` floats: values, not memory, so a
-    compiled loop knows that its stores leave them unchanged (:func:`_columns`)."""
+    compiled loop knows that its stores leave them unchanged (:func:`_stance_columns`)."""
     return tuple(P)
 
 
@@ -263,13 +269,15 @@ def _record_columns(P, rows, starts, outs, info, s0, s1, table):
             table[TR_PHID, k] = lo[5]
 
 
-@njit(**_INLINE)
+@njit(**_FAST)
 def _stance_columns(P, a, b, trig, table):
-    """Rows ``a .. b - 1`` as stance rows: CoM and hip (eqs A.3-A.5), ``alpha``, the
-    ground force and hip torque (eqs 2.5-2.6) and the energy, one column a loop (see
-    :func:`_columns`); ``trig[:, k - a]`` holds row ``k``'s ``sin beta, cos beta, sin
-    phi, cos phi``. The loops run over views from row ``a`` on, so that their indices
-    start at 0 (no negative index for numba to wrap)."""
+    """:func:`fill_table`'s third pass: rows ``a .. b - 1`` as stance rows, CoM and hip
+    (eqs A.3-A.5) and ``alpha``, one column a loop; ``trig[:, k - a]`` holds row ``k``'s
+    ``sin beta, cos beta, sin phi, cos phi`` (:func:`_flight_rows` redoes the flight
+    rows). ``P`` is a tuple, so that its values are no memory the stores could change:
+    each loop, storing one contiguous column, compiles to packed (SIMD) arithmetic. The
+    loops run over views from row ``a`` on, so that their indices start at 0 (no
+    negative index for numba to wrap)."""
     rp = P[P_R]
     m = b - a
     sb, cb, sp, cp = trig[0][:m], trig[1][:m], trig[2][:m], trig[3][:m]
@@ -294,31 +302,54 @@ def _stance_columns(P, a, b, trig, table):
     col = table[TR_ALPHA][a:b]
     for k in range(m):
         col[k] = be[k] + ph[k]
-    col = table[TR_FX][a:b]
-    for k in range(m):
-        col[k] = grf_at(P, l[k], ph[k], ld[k], bd[k], phd[k], sb[k], cb[k])[0]
-    col = table[TR_FY][a:b]
-    for k in range(m):
-        col[k] = grf_at(P, l[k], ph[k], ld[k], bd[k], phd[k], sb[k], cb[k])[1]
-    col = table[TR_TAU][a:b]
-    for k in range(m):
-        col[k] = grf_at(P, l[k], ph[k], ld[k], bd[k], phd[k], sb[k], cb[k])[2]
-    col = table[TR_ENERGY][a:b]
-    for k in range(m):
-        col[k] = _energy(P, y[k], xd[k], yd[k], phd[k], l[k])
+
+
+@njit(**_INLINE)
+def _spring_loops(P, l, ld, fl, v):
+    """:func:`_spring_columns`'s loops: leg force ``fl`` (eq. 2.1) and spring energy ``v``
+    of the legs ``l``, ``ld``."""
+    for k in range(l.shape[0]):
+        fl[k] = leg_force(P, l[k], ld[k])
+    for k in range(l.shape[0]):
+        v[k] = spring_energy(P, l[k])
 
 
 @njit(**_FAST)
-def _columns(P, a, b, trig, table):
-    """:func:`fill_table`'s third pass: rows ``a .. b - 1`` as stance rows
-    (:func:`_stance_columns`); :func:`_flight_rows` redoes the flight rows. ``P`` is a
-    tuple, so that its values are no memory the stores could change: each loop, storing
-    one contiguous column, compiles to packed (SIMD) arithmetic; for the linear spring
-    (``n = 1``), known as such in its branch, without the power law's ``pow``."""
+def _spring_columns(P, a, b, trig, table):
+    """:func:`fill_table`'s fourth pass: the leg force and the spring's energy of rows
+    ``a .. b - 1`` as stance rows, into ``trig[4]`` and ``trig[5]``. For the linear
+    spring (``n = 1``), known as such in its branch, the loops compile without the power
+    law's ``pow`` and vectorise (the table took three times as long without)."""
+    m = b - a
+    l, ld, fl, v = table[TR_L][a:b], table[TR_LD][a:b], trig[4][:m], trig[5][:m]
     if P[P_NEXP] == 1.0:
-        _stance_columns(P, a, b, trig, table)
+        _spring_loops(P, l, ld, fl, v)
     else:
-        _stance_columns(P, a, b, trig, table)
+        _spring_loops(P, l, ld, fl, v)
+
+
+@njit(**_FAST)
+def _force_columns(P, a, b, trig, table):
+    """:func:`fill_table`'s fifth pass (see :func:`_stance_columns`): the ground force,
+    hip torque (eqs 2.5-2.6) and energy of rows ``a .. b - 1`` as stance rows, from the
+    leg force and spring energy in ``trig[4]``, ``trig[5]`` (:func:`_spring_columns`)."""
+    m = b - a
+    sb, cb, fl, v = trig[0][:m], trig[1][:m], trig[4][:m], trig[5][:m]
+    l, ph = table[TR_L][a:b], table[TR_PHI][a:b]
+    bd, phd = table[TR_BETAD][a:b], table[TR_PHID][a:b]
+    y, xd, yd = table[TR_Y][a:b], table[TR_XD][a:b], table[TR_YD][a:b]
+    tau = table[TR_TAU][a:b]
+    for k in range(m):
+        tau[k] = hip_torque(P, ph[k], bd[k], phd[k])
+    col = table[TR_FX][a:b]
+    for k in range(m):
+        col[k] = grf_of(fl[k], tau[k], l[k], sb[k], cb[k])[0]
+    col = table[TR_FY][a:b]
+    for k in range(m):
+        col[k] = grf_of(fl[k], tau[k], l[k], sb[k], cb[k])[1]
+    col = table[TR_ENERGY][a:b]
+    for k in range(m):
+        col[k] = _energy_of(P, y[k], xd[k], yd[k], phd[k], v[k])
 
 
 @njit(**_FAST)
@@ -377,9 +408,10 @@ def fill_table(P, rows, starts, outs, info, n, table):
     row, a row's 22 scalar stores and libm's ``sincos`` cost more than its arithmetic):
     the columns that need no trigonometry (:func:`_record_columns`), the sines and
     cosines of every ``beta`` and ``phi`` (:func:`._sincos.sincos_array`, within 1 ulp
-    of libm), every row as a stance row (:func:`_columns`), then the flight rows and a
-    thrust's rows after its switch (:func:`_flight_rows`). Each value is computed with
-    the stride kernel's operations in its order; only the sines and cosines are not libm's.
+    of libm), every row as a stance row (:func:`_stance_columns`, :func:`_spring_columns`,
+    :func:`_force_columns`), then the flight rows and a thrust's rows after its switch
+    (:func:`_flight_rows`). Each value is computed with the stride kernel's operations
+    in its order; only the sines and cosines are not libm's.
     """
     if n == 0:
         return
@@ -389,7 +421,8 @@ def fill_table(P, rows, starts, outs, info, n, table):
     most = 0  # rows of the longest stride: a group has fewer than GROUP_ROWS + most
     for s in range(n):
         most = max(most, int(info[s, RI_ROW1] - info[s, RI_ROW0]))
-    trig = np.empty((4, GROUP_ROWS + most))  # sin beta, cos beta, sin phi, cos phi
+    # sin beta, cos beta, sin phi, cos phi, leg force, spring energy of a group's rows
+    trig = np.empty((6, GROUP_ROWS + most))
     s0 = 0
     while s0 < n:
         a = int(info[s0, RI_ROW0])
@@ -400,7 +433,9 @@ def fill_table(P, rows, starts, outs, info, n, table):
         _record_columns(pt, rows, starts, outs, info, s0, s1, table)
         sincos_array(table[TR_BETA, a:b], trig[0, :b - a], trig[1, :b - a])
         sincos_array(table[TR_PHI, a:b], trig[2, :b - a], trig[3, :b - a])
-        _columns(pt, a, b, trig, table)
+        _stance_columns(pt, a, b, trig, table)
+        _spring_columns(pt, a, b, trig, table)
+        _force_columns(pt, a, b, trig, table)
         _flight_rows(pt, pw, rows, outs, info, s0, s1, a, trig, table)
         s0 = s1
 

@@ -195,8 +195,16 @@ def grf_at(P, l, ph, ld, bd, phd, sb, cb):
     which derive the forces from the recorded state with vectorised sines and cosines
     (:mod:`._sincos`, within 1 ulp of libm's that :func:`grf` uses)."""
     tau = hip_torque(P, ph, bd, phd)
-    fl = leg_force(P, l, ld)
-    return -fl * cb + tau / l * sb, fl * sb + tau / l * cb, tau
+    fx, fy = grf_of(leg_force(P, l, ld), tau, l, sb, cb)
+    return fx, fy, tau
+
+
+@njit(**_INLINE)
+def grf_of(fl, tau, l, sb, cb):
+    """Ground force ``(F_x, F_y)`` (eqs 2.5-2.6) from the leg force ``fl`` (eq. 2.1), the
+    hip torque ``tau`` and the leg: :func:`grf_at`'s arithmetic, for a caller that has
+    the leg force already (:func:`._record.fill_table`)."""
+    return -fl * cb + tau / l * sb, fl * sb + tau / l * cb
 
 
 @njit(**_INLINE)
