@@ -469,6 +469,7 @@ def stance_forces(P, rec, tsw, at_steps, grf):
                                                  r[REC_BETAD], r[REC_PHID], trig[1, k],
                                                  trig[2, k])
 
+
 #: ``(P, O, td, tx, th, first, last, close, dt, rows, starts, outs, info, pos)
 #: -> status`` by method (:func:`_make_record_run`).
 RECORD_RUN = specialise(_make_record_run, "record_run")
