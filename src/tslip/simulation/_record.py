@@ -73,8 +73,6 @@ from ..model._pack import (
     TR_LD,
     TR_PHI,
     TR_PHID,
-    TR_STANCE,
-    TR_STEP,
     TR_T,
     TR_TAU,
     TR_X,
@@ -229,11 +227,11 @@ def _fill(col, a, b, v):
 
 
 @njit(**_FAST)
-def _record_columns(P, rows, starts, outs, info, s0, s1, table):
+def _record_columns(P, rows, starts, outs, info, s0, s1, table, step, stance):
     """:func:`fill_table`'s first pass over strides ``s0 .. s1 - 1``: what needs no sine
-    or cosine. Time, stride and phase; a stance row's state as recorded and its foot; a
-    flight row's leg and pitch (eq. 2.17, ``phi`` linear in time) and, for now, a foot at
-    0.0 (:func:`_flight_rows` writes it)."""
+    or cosine. Time, stride (into ``step``) and phase (into ``stance``); a stance row's
+    state as recorded and its foot; a flight row's leg and pitch (eq. 2.17, ``phi``
+    linear in time) and, for now, a foot at 0.0 (:func:`_flight_rows` writes it)."""
     for s in range(s0, s1):
         t0 = info[s, RI_T0]
         r0 = int(info[s, RI_ROW0])
@@ -247,9 +245,9 @@ def _record_columns(P, rows, starts, outs, info, s0, s1, table):
             table[TR_LD, k] = rows[k, REC_LD]
             table[TR_BETAD, k] = rows[k, REC_BETAD]
             table[TR_PHID, k] = rows[k, REC_PHID]
-        _fill(table[TR_STEP], r0, r2, s)
-        _fill(table[TR_STANCE], r0, r1, 1.0)
-        _fill(table[TR_STANCE], r1, r2, 0.0)
+        _fill(step, r0, r2, s)
+        _fill(stance, r0, r1, True)
+        _fill(stance, r1, r2, False)
         _fill(table[TR_FOOTX], r0, r1, outs[s, OUT_XF])
         _fill(table[TR_FOOTX], r1, r2, 0.0)
         _fill(table[TR_FOOTY], r0, r1, starts[s, 6])
@@ -392,12 +390,15 @@ def _flight_rows(P, Pw, rows, outs, info, s0, s1, a, trig, table):
 
 
 @njit(**_JIT)
-def fill_table(P, rows, starts, outs, info, n, table):
+def fill_table(P, rows, starts, outs, info, n, table, step, stance):
     """The trajectory columns (``TR_*``, one row of ``table`` each) of a recorded run.
 
     ``rows``, ``starts``, ``outs`` and ``info`` hold strides ``0 .. n - 1`` as
     :func:`_make_record_run`'s ``record_run`` wrote them; ``table`` is
-    ``NTRAJ x rows`` (column-major: a column of the trajectory is a row here).
+    ``NTRAJ x rows`` (column-major: a column of the trajectory is a row here). The
+    stride and phase columns go to ``step`` (integers) and ``stance`` (booleans), as
+    the trajectory's frame types them; ``table``'s ``TR_STEP`` and ``TR_STANCE`` rows
+    are left as they are (a frame never reads them, so their pages are never touched).
     Stance rows come from the record rows by eqs A.3-A.5 (their forces by eqs
     2.5-2.6), flight rows from the lift-off state in closed form (eq. 2.7). A stance
     row after the leg thrust's switch (``OUT_TSW``) takes the switched rest length,
@@ -430,7 +431,7 @@ def fill_table(P, rows, starts, outs, info, n, table):
         while s1 < n and info[s1, RI_ROW0] - a < GROUP_ROWS:
             s1 += 1
         b = int(info[s1 - 1, RI_ROW1])
-        _record_columns(pt, rows, starts, outs, info, s0, s1, table)
+        _record_columns(pt, rows, starts, outs, info, s0, s1, table, step, stance)
         sincos_array(table[TR_BETA, a:b], trig[0, :b - a], trig[1, :b - a])
         sincos_array(table[TR_PHI, a:b], trig[2, :b - a], trig[3, :b - a])
         _stance_columns(pt, a, b, trig, table)

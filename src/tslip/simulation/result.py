@@ -372,12 +372,25 @@ class RunTable:
 
     def columns(self) -> np.ndarray:
         """A new ``(NTRAJ, rows)`` array: trajectory column ``j`` is its row ``j``."""
+        table, step, stance = self.typed()
+        table[pk.TR_STEP] = step
+        table[pk.TR_STANCE] = stance
+        return table
+
+    def typed(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(table, step, stance)``: new arrays as :meth:`columns` but for the stride and
+        phase columns, which come as integers and booleans (``(1, rows)`` each, as the
+        trajectory's frame holds them) and are not in ``table``'s rows ``TR_STEP`` and
+        ``TR_STANCE`` (left unset)."""
         from ._record import fill_table
 
         sl = self._steps
-        table = np.empty((pk.NTRAJ, len(sl._rec)))
-        fill_table(self._P, sl._rec, sl._starts, sl._outs, sl._info, len(sl), table)
-        return table
+        n = len(sl._rec)
+        table = np.empty((pk.NTRAJ, n))
+        step, stance = np.empty((1, n), dtype=np.int64), np.empty((1, n), dtype=bool)
+        fill_table(self._P, sl._rec, sl._starts, sl._outs, sl._info, len(sl), table, step[0],
+                   stance[0])
+        return table, step, stance
 
 
 class _Data:
@@ -513,9 +526,10 @@ class Trajectory(Result):
         """Time series as a tidy ``pandas.DataFrame``, one row per sample (units in attrs)."""
 
         value = self.__dict__["_data"]
-        # a new column-major table that the frame owns and takes without a copy
-        table = value.columns() if isinstance(value, RunTable) else self.data.T.copy()
-        return with_units(_frame(table), COLUMN_UNITS)
+        # new column-major arrays that the frame owns and takes without a copy
+        if isinstance(value, RunTable):
+            return with_units(_frame(*value.typed()), COLUMN_UNITS)
+        return with_units(_frame(self.data.T.copy()), COLUMN_UNITS)
 
     def plot(self, ax: Axes | None = None) -> Figure:
         """Four panels (:func:`~tslip.plotting.plot_trajectory`), or the CoM path on ``ax``."""
@@ -585,20 +599,23 @@ class Trajectory(Result):
         return with_units(pd.DataFrame(rows, columns=_STEP_COLUMNS), COLUMN_UNITS)
 
 
-def _frame(table: np.ndarray) -> pd.DataFrame:
+def _frame(table: np.ndarray, step: np.ndarray | None = None,
+           stance: np.ndarray | None = None) -> pd.DataFrame:
     """The frame of a column-major trajectory ``table`` (``NTRAJ x rows``), sharing its memory.
 
     Time and the columns from ``x`` on stay float blocks of ``table`` (pandas stores
-    a block column-major too); ``step`` and ``stance`` become integer and boolean
-    columns. pandas 3's block constructor does this without a copy; earlier
-    versions insert the three columns one by one.
+    a block column-major too); ``step`` and ``stance`` are integer and boolean
+    columns: the arrays given (``(1, rows)``, as :meth:`RunTable.typed` makes them),
+    or else ``table``'s rows converted. pandas 3's block constructor does this
+    without a copy; earlier versions insert the three columns one by one.
     """
     import pandas as pd
 
     names = list(TRAJECTORY_COLUMNS)
     first = pk.TR_X  # the typed columns come before it: time, step, stance
-    step = table[pk.TR_STEP : pk.TR_STEP + 1].astype(np.int64)
-    stance = table[pk.TR_STANCE : pk.TR_STANCE + 1].astype(bool)
+    if step is None or stance is None:
+        step = table[pk.TR_STEP : pk.TR_STEP + 1].astype(np.int64)
+        stance = table[pk.TR_STANCE : pk.TR_STANCE + 1].astype(bool)
     try:
         from pandas.api.internals import create_dataframe_from_blocks
     except ImportError:  # pandas < 3
