@@ -18,7 +18,10 @@ touch-down a switching condition that ends the stride):
    next step's first, FSAL);
 2. :func:`_step_error`, :func:`_rejected`: error control; a rejected step is
    retried shorter, an accepted one sets the next step size (Hairer's
-   controller, :func:`tslip.simulation._rk.step_factor`);
+   controller, :func:`tslip.simulation._rk.step_factor`); so is the first step
+   after a (re)start that jumped a whole hump of a switching function that
+   started at its zero (:func:`_jumped_hump`: a foot's lift-off function at its
+   touch-down);
 3. :func:`_first_event`: event detection, a crossing of a switching function
    of :func:`._events.event_g` from > 0 to <= 0 between the step's ends;
 4. :func:`_locate`: event location of each crossing on the dense output
@@ -241,24 +244,55 @@ def _locate(method, P, k, t, h, g_lo, g_hi, R, cs, tsw, yev, trig_ev, st):
 
 
 @njit(**INLINE)
-def _first_event(method, P, t, y, ynew, h, K, R, cs, ctl, tsw, active, g_old, g_new, yev,
-                 trig_ev, st, ws, aux):
-    """Event detection in the accepted step ``(t, y) -> (t + h, ynew)``: ``(k, theta, nfev)``.
-
-    The armed switching functions at the step's end go to ``g_new`` (their
-    values at its start are ``g_old``); each that crosses from > 0 to <= 0 is
-    located (:func:`_locate`) on the step's dense output, computed at the
-    first crossing (``nfev`` right-hand sides). ``k`` is the earliest event
-    (-1 if none) at ``t + theta h``.
-
-    ``g_new`` is complete before any crossing is located: it reads the sines
-    and cosines of ``ynew`` in ``ws[5]`` (the step's last right-hand side was
-    there), which the dense output's extra stages (dop853) overwrite.
-    """
+def _end_values(P, t, ynew, h, cs, tsw, active, g_new, ws):
+    """The armed switching functions at the end ``(t + h, ynew)`` of an accepted step, into
+    ``g_new``: complete before any crossing is located, as they read the sines and
+    cosines of ``ynew`` in ``ws[5]`` (the step's last right-hand side was there), which
+    the dense output's extra stages (dop853) overwrite."""
     trig = ws[5]
     for k in range(NEVK):
         if active[k]:
             g_new[k] = event_g(P, k, t + h, ynew, cs, tsw, trig)
+
+
+@njit(**INLINE)
+def _jumped_hump(P, t, y, cs, tsw, active, f, h, g_old, g_new, yp, trig_p):
+    """Whether the first step after a (re)start at ``(t, y)`` (``f = f(t, y)``, step ``h``)
+    jumped a whole hump of a switching function that starts at its zero
+    (:func:`tslip.simulation._rk.jumped_hump`); the loop then retries it shorter.
+
+    A foot's lift-off function ``min(F_z, k_z (z_TD - z_f))`` starts a contact a few
+    ulps from 0 (the touch-down is located to 1e-13 in time), so a contact shorter than
+    the step after it was jumped and its lift-off put at the touch-down. Only a step
+    that ends with a function at or below zero reads the probe ``(t + d, y + d f)``,
+    ``d = ZERO_PROBE h`` (``yp``, ``trig_p`` work arrays)."""
+    below = False
+    for k in range(NEVK):
+        below = below or (active[k] and g_new[k] <= 0.0)
+    if not below:
+        return False
+    d = _rk.ZERO_PROBE * h
+    for i in range(N):
+        yp[i] = y[i] + d * f[i]
+    state_trig(yp, trig_p)
+    for k in range(NEVK):
+        if active[k] and _rk.jumped_hump(g_old[k], g_new[k],
+                                         event_g(P, k, t + d, yp, cs, tsw, trig_p)):
+            return True
+    return False
+
+
+@njit(**INLINE)
+def _first_event(method, P, t, y, ynew, h, K, R, cs, ctl, tsw, active, g_old, g_new, yev,
+                 trig_ev, st, ws, aux):
+    """Event detection in the accepted step ``(t, y) -> (t + h, ynew)``: ``(k, theta, nfev)``.
+
+    The armed switching functions at the step's end are in ``g_new``
+    (:func:`_end_values`; their values at its start are ``g_old``); each that
+    crosses from > 0 to <= 0 is located (:func:`_locate`) on the step's dense
+    output, computed at the first crossing (``nfev`` right-hand sides). ``k`` is
+    the earliest event (-1 if none) at ``t + theta h``.
+    """
     theta_ev = 2.0
     k_ev = -1
     nfev = 0
@@ -449,6 +483,7 @@ def _integrate(method, P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend
     h = _start(P, O, t0, ctl, tsw, active)
     t = t0
     _restart(P, t, y, cs, ctl, tsw, K, g_old, ws, aux)
+    first = True  # the first step after a (re)start is still to be accepted
     nfev = 1
     nrec = _record(P, rec, 0, t, y, cs, ctl, ws, stats)
     nev = 0
@@ -474,6 +509,17 @@ def _integrate(method, P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend
             if status != ST_OK:
                 break
             continue
+        _end_values(P, t, ynew, hstep, cs, tsw, active, g_new, ws)
+        if first:
+            if _jumped_hump(P, t, y, cs, tsw, active, K[0], hstep, g_old, g_new, yev, trig_ev):
+                # it jumped a whole hump of a function that started at its zero
+                nrej += 1
+                h = hstep * _rk.HUMP_SHRINK
+                if h < hmin:
+                    status = ST_ERR_UNDERFLOW
+                    break
+                continue
+            first = False
         nacc += 1
         # 3.-4. event detection and location
         k_ev, theta, nfe = _first_event(method, P, t, y, ynew, hstep, K, R, cs, ctl, tsw,
@@ -488,6 +534,7 @@ def _integrate(method, P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend
                 t_last_td = t
                 done = nstr >= n_strides
             _restart(P, t, y, cs, ctl, tsw, K, g_old, ws, aux)
+            first = True
             nfev += 1
         else:
             t = t_end if at_end else t + hstep

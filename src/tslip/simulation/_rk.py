@@ -420,6 +420,41 @@ def root_update(st, c, fc, tol):
 
 
 # ---------------------------------------------------------------------------
+# Events that start at their zero. An event fires on a crossing from > 0 to <= 0
+# between a step's ends. A phase can start with an event function at its zero: a
+# lift-off function at touch-down, where the leg or foot force is exactly 0 (the
+# TSLIP's undamped leg at rest length), or a few ulps from it (the biped's foot,
+# located to 1e-13 in time). If the phase is a hump of that function shorter
+# than the first step, the step ends with it at or below zero again, and the
+# event is never seen (the stance is lost: a false fall) or is located at the
+# start. So the first accepted step of a phase that ends with an event function
+# at or below zero is checked: if that function left its zero upward at the
+# phase's start (:func:`jumped_hump`, from its values at ``y + ZERO_PROBE h f(y)``
+# that each model computes with its own event functions), the step jumped a
+# whole hump, and is retried HUMP_SHRINK times as long, until it ends inside the
+# hump, where the event is armed. An ordinary step computes nothing more.
+# ---------------------------------------------------------------------------
+
+#: Where an event function is probed for how it leaves its start: this fraction of the
+#: step (a first-order probe; only a hump shorter than it escapes).
+ZERO_PROBE = 1e-6
+#: The factor by which a first step that jumped a whole hump (:func:`jumped_hump`) is
+#: retried shorter, as a step whose stages were not finite is.
+HUMP_SHRINK = 0.1
+
+
+@njit(**_INLINE)
+def jumped_hump(g_start, g_end, g_probe):
+    """Whether a phase's first step jumped a whole hump of an event function with values
+    ``g_start``, ``g_end`` at the step's ends and ``g_probe`` at the probe
+    (``y + ZERO_PROBE h f(y)``): it ends at or below zero, and it left its zero upward at
+    the start, or within the probe's length before it (``g_probe > 0`` and
+    ``g_start <= g_probe - g_start``: the linear extrapolation back from the probe reaches
+    zero no earlier than one probe length before the start)."""
+    return g_end <= 0.0 and g_probe > 0.0 and 2.0 * g_start <= g_probe
+
+
+# ---------------------------------------------------------------------------
 # The same routines inlined: the TSLIP's stride kernels call these twins, so a
 # stride compiles as one function (each separately compiled callee costs a
 # compile and a re-optimisation in every caller); the biped calls the ones above

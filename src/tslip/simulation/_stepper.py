@@ -7,7 +7,8 @@ is the loop; its named steps are here, in the order a step takes them:
 * :func:`shrink_step` / :func:`grow_step`: error control, the next step size
   after a rejected / an accepted step;
 * :func:`crossed`: event detection, a sign change of an event function
-  (thesis Section 2.3) over the accepted step;
+  (thesis Section 2.3) over the accepted step; :func:`jumped_hump`: no first step
+  of a stance jumps a whole hump of an event function that starts at its zero;
 * :func:`dense_output`: the continuous extension of that step;
 * :func:`first_event`: event location, the earliest root on the dense output;
 * :func:`record_row`, :func:`append_row`, :func:`record_grid`: the stance record.
@@ -99,6 +100,34 @@ def grow_step(method, h, err, last_rejected):
     if last_rejected:
         fac = min(1.0, fac)
     return h * fac
+
+
+@njit(**_INLINE)
+def jumped_hump(P, y, f, h, gv_old, gv_new, ytmp, gv_tmp):
+    """Whether the first step of a stance (or of its part after the thrust's switch), from
+    ``y`` (``f = f(y)``) over ``h``, jumped a whole hump of an event function that starts at
+    its zero (:func:`._rk.jumped_hump`); the stride then retries it shorter.
+
+    The lift-off event starts exactly at 0 whenever the leg force vanishes at touch-down
+    (an undamped leg, no hip torque: ``F_y`` at rest length, or ``l_rest - l`` of
+    :func:`._stance.liftoff_on_spring`); after a near-vertical touch-down its whole hump
+    of ``F_y > 0`` can be far shorter than the first step, which then ends with ``F_y <= 0``
+    again: no crossing from > 0, the lift-off never seen, a false fall. Only a step that
+    ends with an event value at or below zero reads the probe.
+    """
+    below = False
+    for ev in range(NEVENTS):
+        below = below or gv_new[ev] <= 0.0
+    if not below:
+        return False
+    d = _rk.ZERO_PROBE * h
+    for i in range(NSTATE):
+        ytmp[i] = y[i] + d * f[i]
+    event_values(P, ytmp, gv_tmp)
+    for ev in range(NEVENTS):
+        if _rk.jumped_hump(gv_old[ev], gv_new[ev], gv_tmp[ev]):
+            return True
+    return False
 
 
 @njit(**_INLINE)

@@ -88,6 +88,7 @@ from ._stepper import (
     first_event,
     grow_step,
     initial_step,
+    jumped_hump,
     record_grid,
     rk_step,
     shrink_step,
@@ -342,7 +343,9 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         The stance (thesis Section 2.3): a stance that starts with the hip at the
         ground, ``xdot_m < 0`` or the leg lengthening ends at once with that fall
         (:func:`touchdown_fall`). Otherwise each pass of the loop takes one
-        Runge-Kutta step and either rejects it (error control: a smaller step) or
+        Runge-Kutta step and either rejects it (error control: a smaller step; or,
+        for a first step, that it jumped a whole hump of an event function that
+        started at its zero, :func:`._stepper.jumped_hump`) or
         accepts it, looks for the sign changes of the event functions over it
         (lift-off, eq. 2.8; falls, eqs 2.10-2.11), locates the earliest on the
         step's dense output, and then ends the stance with one exact step to that
@@ -372,6 +375,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         t = 0.0
         t_next_rec = rec_dt
         status, h = stance_begin(P, O, method, y, K, gv_old, ytmp)
+        first = True  # the stance's first step is still to be accepted (:func:`jumped_hump`)
         n_acc = 0
         n_rej = 0
         last_rejected = False
@@ -392,6 +396,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
                 if h > 0.0:
                     copy_state(y, ynew)
                 h = thrust_switch(P, O, method, y, K, gv_old, ytmp, fly, t, out)
+                first = True
                 ev = -1
                 last_rejected = False
             elif ev >= 0:
@@ -409,6 +414,14 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
                     n_rej += 1
                     last_rejected = True
                     continue
+                if first:
+                    if jumped_hump(P, y, K[0], h, gv_old, gv_new, ytmp, gv_tmp):
+                        # it jumped a whole hump of an event that started at its zero
+                        h *= _rk.HUMP_SHRINK
+                        n_rej += 1
+                        last_rejected = True
+                        continue
+                    first = False
                 n_acc += 1
                 # event detection, dense output, event location (and grid samples)
                 event = crossed(gv_old, gv_new)
