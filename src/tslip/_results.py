@@ -357,17 +357,25 @@ def _encode_array(a: np.ndarray, where: str) -> dict[str, Any]:
 # -- decoding -----------------------------------------------------------------
 _IDENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
+#: Classes a file may name where they lived before a module was split: the old name ->
+#: the class's own name now (``tslip.gait.viability`` was split after 0.3.0). Such files
+#: keep loading; saving writes the new name.
+MOVED = {"tslip.gait.viability:StateActionMap": "tslip.gait.statemap:StateActionMap",
+         "tslip.gait.viability:Basin": "tslip.gait.basins:Basin"}
+
 
 def _resolve(name: Any) -> type:
     """The class ``"module:Qual.Name"`` names, if a file may build it; else ``ValueError``.
 
     Allowed: dataclasses and enums defined in ``tslip`` (whose module is
     imported here if it is not yet), and :class:`Result` subclasses of any
-    module already imported. Nothing else is looked up or called, and no
+    module already imported; a name of :data:`MOVED` is read as the class's name
+    now. Nothing else is looked up or called, and no
     ``__main__`` (``python -m tslip`` runs the command line when imported).
     """
     if not isinstance(name, str) or name.count(":") != 1:
         raise ValueError(f"bad class name {name!r}")
+    name = MOVED.get(name, name)
     module, qual = name.split(":")
     mparts, qparts = module.split("."), qual.split(".")
     if not all(_IDENT.match(p) for p in mparts + qparts) or any(

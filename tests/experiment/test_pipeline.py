@@ -14,7 +14,7 @@ from tslip.cli.main import app
 
 
 def test_chain_recovers_model(tmp_path: Path) -> None:
-    """The README's run (1.6 s, 512 x 408 px, 500 fps). Measured: markers 0.066 and
+    """docs/reproducing.md's run (1.6 s, 512 x 408 px, 500 fps). Measured: markers 0.066 and
     0.076 px RMS; t_s 0.5876 and t_f 0.1231 against 0.5869 and 0.1244; k 7.97,
     beta0 0.929, c_l 0.329 against 8, 0.93, 0.32 (0.4, 0.1, 2.9 %); stance VAF
     >= 99.1 % for all but ld and betad (85, 92 %). Tolerances about twice the

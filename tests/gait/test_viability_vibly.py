@@ -193,8 +193,8 @@ def test_an_unknown_rule_is_one_line_naming_the_allowed(rule):
 # ---------------------------------------------------------------------------
 
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md")),
-         ROOT / "src" / "tslip" / "gait" / "viability.py",
-         ROOT / "src" / "tslip" / "gait" / "_viable.py"]
+         *(ROOT / "src" / "tslip" / "gait" / f"{m}.py"
+           for m in ("viability", "statemap", "mapstore", "basins", "_viable"))]
 
 
 def _sentences(text: str) -> list[str]:

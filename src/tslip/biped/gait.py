@@ -6,6 +6,8 @@ state is ``z = (q[1:], qd, rho_R)``: eq. E.35's state without ``x_b`` plus the
 right-leg phase at touch-down, which eq. E.36 leaves out. Without it a stride
 whose duration differs from ``T`` would count as periodic although the next
 stride starts at a different controller phase.
+
+Over 600 lines: one concept, the biped's section map and the analyses that iterate it.
 """
 
 from __future__ import annotations

@@ -22,6 +22,8 @@ the renderer and the tracking pipeline treat both recordings alike.
 
 :mod:`tslip.experiment.render` draws the frames. Image coordinates: x to the
 right (running direction), y down.
+
+Over 600 lines: one concept, a recording's truth: two models' motion in one camera layout.
 """
 
 from __future__ import annotations

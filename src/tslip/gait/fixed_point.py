@@ -33,6 +33,8 @@ point has 0.9944, and it moves the mass-offset stability limit from
 r = 0.849 (exact) to about 0.92. Multipliers near 1 from the thesis can
 therefore differ in the second or third decimal from the exact ones.
 ``C1`` here is eq. 2.20 on the 5-D section residual above.
+
+Over 600 lines: one concept, the two gait searches on one GaitProblem and their Gait result.
 """
 
 from __future__ import annotations

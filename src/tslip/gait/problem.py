@@ -10,6 +10,8 @@ these functions. Split from that module, which re-exports every name.
 What the search holds: the speed at the section (``fix="speed"``; the
 touch-down speed ``v0``, or the apex's forward speed) or the total energy
 (``fix="energy"``). At ``r = 0`` the undetermined pitch is held.
+
+Over 600 lines: one concept, the search in its unknowns z, whose packing all parts share.
 """
 
 from __future__ import annotations

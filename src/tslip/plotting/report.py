@@ -10,6 +10,8 @@ Each figure's PNG is kept in ``out_dir/figures/report-<figure>.png`` with the
 key it was drawn under in a text chunk of the PNG (:func:`figure_key`: its
 input data and the plotting code's hash): a rerun whose figure has the same
 key takes the file instead of drawing it again.
+
+Over 600 lines: one concept, the report: its keyed figures, its page and claims.json.
 """
 
 from __future__ import annotations
