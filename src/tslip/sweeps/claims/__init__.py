@@ -21,7 +21,7 @@ points (fewer than :data:`MIN_POINTS` for a rank correlation) returns
 
 ``data`` maps a study name (:data:`tslip.sweeps.catalogue.STUDIES`) to its
 :class:`~tslip.sweeps.StudyResult`, and a figure key ("4.1", "4.2", "4.3",
-"6.2", "4.4", "4.5", "4.7", "C.1", "table6.1", "E") to the analysis object that
+"6.2", "4.4", "4.5", "4.7", "C.1", "4.16", "table6.1", "E") to the analysis object that
 :mod:`tslip.sweeps.reproduce` computed for it; ``data["quick"]`` is True at
 quick resolution. Optional evidence is read with ``.get`` (shown as "not
 computed" when absent): ``table6.1`` ``pitch_rate_variants`` (label -> limit)
