@@ -262,8 +262,9 @@ def fig_mass_offset_boundary(step: float = 0.025, stop: float = 1.0,
     n = int(math.floor((stop - base.r) / step + 1e-9)) + 1
     values = base.r + step * np.arange(n)
 
-    def stable(branch: Any, i: int) -> bool:
-        return bool(branch.converged[i] and branch.max_nontrivial[i] < 1.0)
+    def stable(branch: Any, i: int) -> bool:  # a gait (never None then), inside the circle
+        return bool(branch.converged[i] and branch.gaits[i] is not None
+                    and branch.max_nontrivial[i] < 1.0)
 
     b = continue_gait(base, "r", values)
     bad = [i for i in range(n) if not stable(b, i)]
@@ -272,7 +273,7 @@ def fig_mass_offset_boundary(step: float = 0.025, stop: float = 1.0,
     lo, hi, gait = float(values[bad[0] - 1]), float(values[bad[0]]), b.gaits[bad[0] - 1]
     while hi - lo > tol:
         mid = 0.5 * (lo + hi)
-        m = continue_gait(gait, "r", [lo, mid])
+        m = continue_gait(gait, "r", [lo, mid])  # type: ignore[arg-type]  # stable: a gait
         if stable(m, 1):
             lo, gait = mid, m.gaits[1]
         else:
