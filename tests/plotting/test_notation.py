@@ -56,6 +56,11 @@ def test_number_keys_split_and_typeset_their_unit() -> None:
     assert split_unit("x_p/dphi") == ("x_p/dphi", None)
     assert key_html("a < b [L^2]") == "a &lt; b [L<sup>2</sup>]"
     assert key_html("ratio") == "ratio"
+    # a unit inside the key (a prefixed or suffixed label) is typeset too, not left as "^"
+    assert key_html("median [rad g^1/2 L^-1/2]: passive") == (
+        "median [rad g<sup>1/2</sup> L<sup>-1/2</sup>]: passive")
+    assert key_html("set-up: v0 [g^1/2 L^1/2] at r [L]") == (
+        "set-up: v0 [g<sup>1/2</sup> L<sup>1/2</sup>] at r [L]")
 
 
 @pytest.mark.parametrize(("x", "text"), [

@@ -387,7 +387,8 @@ def test_numbers_show_typeset_units_and_rendered_quotes(tmp_path) -> None:
     """Units of number keys as superscripts, -0 as 0, a range's ends apart, no raw LaTeX."""
     c = ClaimResult(id="6.1-push", figure="6.1", text="push", verdict=Verdict.FAILS,
                     numbers={"push limit [g^1/2 L^1/2]": -0.725, "tilt [rad]": -0.0,
-                             "stance time range [g^-1/2 L^1/2]": [0.19987, 0.20041]},
+                             "stance time range [g^-1/2 L^1/2]": [0.19987, 0.20041],
+                             "median [g^1/2 L^1/2]: passive": 2.1},
                     quote=r"push disturbance is $-0.73 \text{ g}^{1/2} \text{ L}^{1/2}$",
                     evidence={"by reading": {"slope [rad g^1/2 L^-1/2]": 1.0}})
     text = report.write_report(tmp_path / "index.html", {}, [c]).read_text(encoding="utf-8")
@@ -396,6 +397,7 @@ def test_numbers_show_typeset_units_and_rendered_quotes(tmp_path) -> None:
     assert "<td>tilt [rad]</td><td>0</td>" in sec
     assert "[0.1999, 0.2004]" in sec  # 3 digits would print [0.2, 0.2]
     assert "slope [rad g<sup>1/2</sup> L<sup>-1/2</sup>]: 1" in sec
+    assert "median [g<sup>1/2</sup> L<sup>1/2</sup>]: passive" in sec  # a unit inside a key
     assert "is -0.73 g<sup>1/2</sup> L<sup>1/2</sup>”" in sec
     assert "$" not in sec and "\\" not in sec and "^" not in sec
 

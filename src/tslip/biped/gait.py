@@ -214,13 +214,20 @@ def strides_until_fall(params: BipedParams, state: BipedState | NDArray[np.float
 
 @dataclass(frozen=True)
 class TrackingErrors:
-    """RMS and max controller tracking errors over a run (Figure E.2)."""
+    """RMS and max controller tracking errors over a run (Figure E.2).
+
+    ``thigh_ref_range`` [L] and ``hip_ref_range`` [rad]: max - min of each
+    reference over the same samples, the scale that makes the two errors
+    comparable (an error in L against one in rad); NaN if not computed.
+    """
 
     thigh_rms: float
     thigh_max: float
     hip_rms: float
     hip_max: float
     shank_range: tuple[float, float]
+    thigh_ref_range: float = math.nan
+    hip_ref_range: float = math.nan
 
 
 def tracking_errors(tr: Trajectory, leg: int = 0, t_from: float = -math.inf,
@@ -235,7 +242,9 @@ def tracking_errors(tr: Trajectory, leg: int = 0, t_from: float = -math.inf,
     ls = tr[f"l_s{side}"][m]
     return TrackingErrors(float(np.sqrt(np.mean(e_l**2))), float(np.abs(e_l).max()),
                           float(np.sqrt(np.mean(e_h**2))), float(np.abs(e_h).max()),
-                          (float(ls.min()), float(ls.max())))
+                          (float(ls.min()), float(ls.max())),
+                          float(np.ptp(ref[:, 0])) if t.size else math.nan,
+                          float(np.ptp(ref[:, 2])) if t.size else math.nan)
 
 
 @dataclass(frozen=True, repr=False)

@@ -50,10 +50,21 @@ def axis_label(quantity: str, unit: str) -> str:
     return f"{quantity} [{unit_tex(unit)}]"
 
 
+#: A unit in brackets anywhere in a key: ``"[g^1/2 L^1/2]"``.
+_UNIT_ANY = re.compile(r"\[([^\[\]]+)\]")
+
+
 def key_html(key: str) -> str:
-    """A number key with its trailing unit typeset (the rest escaped)."""
-    name, unit = split_unit(key)
-    return html.escape(name) + (f" [{unit_html(unit)}]" if unit else "")
+    """A number key with its units typeset (the rest escaped).
+
+    Every bracketed unit is typeset, the trailing one and any inside the key
+    (``"median [g^1/2 L^1/2]: passive"``), so no plain ``^`` reaches the page.
+    """
+    out, at = [], 0
+    for m in _UNIT_ANY.finditer(key):
+        out += [html.escape(key[at:m.start()]), f"[{unit_html(m.group(1))}]"]
+        at = m.end()
+    return "".join(out) + html.escape(key[at:])
 
 
 def number(x: float, digits: int = 4) -> str:

@@ -308,12 +308,13 @@ def _figure_jobs(res: str) -> dict[str, Callable[[], Any]]:
         "4.5": catalogue.fig_step_down,
         "4.7": catalogue.fig_velocity_angle,
         "C.1": catalogue.fig_friction,
+        "4.16": catalogue.fig_mass_offset_boundary,
     }
 
 
 #: Estimated seconds of each figure of :func:`_figure_jobs` (warm compile cache, one core).
 FIGURE_SECONDS = {"4.1": 0.02, "4.2": 0.04, "4.3": 0.02, "6.2": 0.02, "4.4": 1.5, "4.5": 0.02,
-                  "4.7": 0.02, "C.1": 0.03}
+                  "4.7": 0.02, "C.1": 0.03, "4.16": 1.5}
 
 
 def single_figures(quick: bool | str = False, progress: Progress | None = None,

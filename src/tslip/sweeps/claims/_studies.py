@@ -12,11 +12,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ._eigen import _measures, _speed_quickest
 from ._rules import (
+    _TOO_FEW,
     CLOSE,
     MIN_POINTS,
     MULT_TOL,
-    PRINTED,
     REL,
     TEND,
     Check,
@@ -28,6 +29,7 @@ from ._rules import (
     _judge,
     _n,
     _opt_frame,
+    _printed,
     _r,
     _readings,
     _stable,
@@ -36,18 +38,43 @@ from ._rules import (
     stable_range,
 )
 
-_SPEED_READINGS = (("omega_r held (study velocity)", "velocity"),
-                   ("omega_r_bar = omega_r l0 / v0 held (eq. 2.18, study velocity_bar)",
-                    "velocity_bar"))
+#: Figures 4.8-4.9's set-up, Section 3.4.1: v0 varied with "the passive TSLIP model with
+#: the configuration in Table 2.1", whose retraction is the absolute rate omega_r = 1.0.
+THESIS_SPEED = ("omega_r held (Section 3.4.1's set-up, study velocity)", "velocity")
+#: The other set-up, shown as evidence only: omega_r_bar = omega_r l0 / v0 held (eq. 2.18).
+OTHER_SPEED = ("omega_r_bar = omega_r l0 / v0 held (eq. 2.18, study velocity_bar; evidence, "
+               "not judged)", "velocity_bar")
+
+
+def _as_check(out: Check | tuple[Numbers, bool | None]) -> Check:
+    if isinstance(out, Check):
+        return out
+    nums, ok = out
+    if ok is None:
+        return Check(nums, Verdict.NOT_ASSESSED, {}, _TOO_FEW)
+    return Check(nums, Verdict.HOLDS if ok else Verdict.FAILS)
 
 
 def _by_speed(d: Mapping[str, Any],
-              fn: Callable[[pd.DataFrame], tuple[Numbers, bool | None]]) -> Check:
-    parts = {}
-    for label, name in _SPEED_READINGS:
-        f = _opt_frame(d, name)
-        parts[label] = None if f is None else fn(f)
-    return _readings(parts)
+              fn: Callable[[pd.DataFrame], Check | tuple[Numbers, bool | None]]) -> Check:
+    """Judge a Figure 4.8-4.9 claim in the thesis's set-up; the other set-up's numbers beside.
+
+    Every 4.8-4.9 claim is judged with omega_r held (:data:`THESIS_SPEED`),
+    never with whichever set-up favours it; the omega_r_bar-held study's
+    numbers and verdict are in the evidence.
+    """
+    main = _as_check(fn(_frame(d, THESIS_SPEED[1])))
+    evidence: Numbers = {f"{THESIS_SPEED[0]}: {k}": v for k, v in main.evidence.items()}
+    other = _opt_frame(d, OTHER_SPEED[1])
+    if other is None:
+        evidence[OTHER_SPEED[0]] = "not computed"
+    else:
+        o = _as_check(fn(other))
+        evidence.update({f"{OTHER_SPEED[0]}: {k}": v for k, v in o.numbers.items()})
+        evidence[f"{OTHER_SPEED[0]}: verdict"] = o.verdict.value
+    note = f"judged with {THESIS_SPEED[0]}; the other set-up's numbers are in the evidence"
+    return Check(main.numbers, main.verdict, evidence,
+                 f"{main.note}; {note}" if main.note else note)
 
 
 _V = "[g^1/2 L^1/2]"
@@ -71,25 +98,6 @@ def _speed_above(f: pd.DataFrame) -> tuple[Numbers, bool]:
                      f"fastest v0 swept {_V}": _r(v.max()),
                      f"unstable or no gait above the minimum at v0 {_V}": [_r(x) for x in gaps]}
     return nums, bool(math.isfinite(lo) and not gaps.size and hi == v.max())
-
-
-def _speed_quickest(f: pd.DataFrame) -> tuple[Numbers, bool | None]:
-    """'Most quickly just over the minimum': the slowest stable gait's max|lambda| smallest."""
-    s = f[stable_mask(f)]
-    vs, mnt = s["v0"].to_numpy(float), s["max_nontrivial"].to_numpy(float)
-    if vs.size < 2:
-        return {"stable points": int(vs.size)}, None
-    i = int(np.argmin(mnt))
-    rho = _trend(vs, mnt, +1)[0]
-    nums: Numbers = {
-        f"slowest stable v0 (just over the minimum) {_V}": _r(vs[0]),
-        "max|lambda| there": _r(mnt[0], 4),
-        f"fastest convergence (smallest max|lambda|) at v0 {_V}": _r(vs[i]),
-        "smallest max|lambda|": _r(mnt[i], 4),
-        "max|lambda| at the fastest stable v0": _r(mnt[-1], 4),
-        f"fastest stable v0 {_V}": _r(vs[-1]),
-        "rank corr(v0, max|lambda|), stable gaits": _r(rho)}
-    return nums, bool(mnt[0] <= mnt[i] + MULT_TOL)
 
 
 def _c48_minimum(d: Mapping[str, Any]) -> Check:
@@ -281,11 +289,17 @@ def _c412(d: Mapping[str, Any]) -> Check:
         _r(x) for x in worse]
     nums["every damped gait has a sorted |lambda| below the undamped one"] = below
     rho, more = _trend(c, mags[:, 0], -1)
-    return _readings({"adding damping (every c_l > 0: each sorted |lambda| at most the "
+    shown: Numbers = {}  # the eigenvalue rule's two measures, shown beside (not judged)
+    for label, y in _measures(f).items():
+        shown[f"{label} at c_l = 0 / the largest c_l (shown, not judged)"] = [
+            _r(y[0], 4), _r(y[-1], 4)]
+        shown[f"rank corr(c_l, {label}) (shown, not judged)"] = _r(_trend(c, y, -1)[0])
+    check = _readings({"adding damping (every c_l > 0: each sorted |lambda| at most the "
                       "undamped one's, one lower)": (nums, not_above and below),
                       "more damping, more stable": (
                           {"rank corr(c_l, largest |lambda|, the undamped trivial 1 counted)":
                            _r(rho)}, more)})
+    return Check(check.numbers, check.verdict, {**check.evidence, **shown}, check.note)
 
 
 _LIMIT_UNITS = {"step_down": "L", "push": "g^1/2 L^1/2", "pitch_rate": "rad g^1/2 L^-1/2"}
@@ -298,7 +312,7 @@ def _c413(d: Mapping[str, Any]) -> Check:
     top = float(f["c_l"].max())
     high = c >= 2.0 / 3.0 * top
     high_n: Numbers = {"high damping: c_l >= [Mg^1/2 L^-1/2]": _r(2.0 / 3.0 * top)}
-    best_n: Numbers = dict(high_n)
+    best_n: Numbers = {}
     trend_n: Numbers = {}
     ok_high = ok_best = ok_trend = bool(c.size) and c[0] == 0 and bool(high.any())
     for k in ("step_down", "push", "pitch_rate"):
@@ -306,40 +320,22 @@ def _c413(d: Mapping[str, Any]) -> Check:
         u = _LIMIT_UNITS[k]
         none = float(v[0]) if c.size and c[0] == 0 else math.nan
         med = float(np.nanmedian(v[high])) if high.any() else math.nan
-        best = float(np.nanmax(v)) if np.isfinite(v).any() else math.nan
         i = int(np.nanargmax(v)) if np.isfinite(v).any() else 0
         high_n[f"|{k}| at c_l = 0, median high [{u}]"] = [_r(none), _r(med)]
-        best_n[f"|{k}| best, median high [{u}]"] = [_r(best), _r(med)]
-        best_n[f"|{k}| best at c_l [Mg^1/2 L^-1/2]"] = _r(c[i]) if c.size else math.nan
         ok_high &= med < none
-        ok_best &= bool(c.size) and c[i] < 2.0 / 3.0 * top and med < best
+        # from the best value on, the limit falls with damping: the trend form of 4.9, 4.23
+        rho_b, falls = _trend(c[i:], v[i:], -1)
+        best_n[f"|{k}| best at c_l [Mg^1/2 L^-1/2]"] = _r(c[i]) if c.size else math.nan
+        best_n[f"rank corr(c_l, |{k}|) at and above the best c_l"] = _r(rho_b)
+        best_n[f"points at and above the best c_l ({k})"] = int(np.isfinite(v[i:]).sum())
+        ok_best &= falls
         rho, ok = _trend(c, v, -1)
         trend_n[f"rank corr(c_l, |{k}|)"] = _r(rho)
         ok_trend &= ok
     return _readings({"high damping against none (caption)": (high_n, bool(ok_high)),
                       "more damping, less robust (text)": (trend_n, bool(ok_trend)),
-                      "high damping lowers each limit from its best value":
+                      "damping beyond each limit's best value lowers it (rank corr <= -0.8)":
                       (best_n, bool(ok_best))})
-
-
-def _mean_nontrivial(g: pd.DataFrame) -> np.ndarray:
-    """Mean of each gait's non-trivial |lambda| (those not 1 to :data:`MULT_TOL`)."""
-    mags = g[[f"abs_lambda_{j}" for j in range(1, 6)]].to_numpy(float)
-    mags = np.where(np.abs(mags - 1) < MULT_TOL, np.nan, mags)  # trivial multipliers
-    if not mags.size:
-        return np.array([])
-    n = np.isfinite(mags).sum(axis=1)
-    return np.where(n > 0, np.nansum(mags, axis=1) / np.maximum(n, 1), np.nan)
-
-
-def _c414(d: Mapping[str, Any]) -> Check:
-    g = _converged(_frame(d, "hip_damping"))
-    mean = _mean_nontrivial(g)
-    c = g["controller.c_h"].to_numpy(float)
-    rho, ok = _trend(c, mean, -1)
-    nums = {"mean non-trivial |lambda| at c_h = 0 / largest": [_r(mean[0], 4), _r(mean[-1], 4)]
-            if mean.size else [], "rank corr(c_h, mean non-trivial |lambda|)": _r(rho)}
-    return _judge(nums, ok, {"rank corr(c_h, mean non-trivial |lambda|)": _n(c, mean)})
 
 
 def _c415(d: Mapping[str, Any]) -> Check:
@@ -354,18 +350,32 @@ def _c415(d: Mapping[str, Any]) -> Check:
 
 
 def _c416(d: Mapping[str, Any]) -> Check:
+    """Stable for 0 < r up to the boundary located by bisection, matched to the printed 0.86.
+
+    The boundary comes from ``d["4.16"]`` (:func:`tslip.sweeps.reproduce.mass_offset_boundary`:
+    the largest r with a stable gait, bisected to ``tol``), never from the grid's bracket,
+    which is shown.
+    """
     f = _frame(d, "mass_offset")
+    located = d["4.16"]
     lo, hi = stable_range(f, "r")
     m = stable_mask(f)
     r = f["r"].to_numpy(float)
     neg = int(m[r < 0].sum())
     nxt = r[r > hi].min() if math.isfinite(hi) and (r > hi).any() else math.nan
     gaps = int(((r > 0) & (r <= hi) & ~m).sum()) if math.isfinite(hi) else 0
-    nums = {"stable r [L]": [_r(lo), _r(hi)], "boundary between r [L]": [_r(hi), _r(nxt)],
-            "stable points with r < 0": neg, "unstable points inside (0, last stable r]": gaps}
-    # the boundary lies in [hi, nxt]; 0.86 is printed to two decimals
-    ok = (neg == 0 and lo >= 0 and gaps == 0 and math.isfinite(nxt)
-          and hi <= 0.86 + PRINTED and nxt >= 0.86 - PRINTED)
+    boundary = float(located["boundary"])
+    printed, ok_printed = _printed(boundary, 0.86, unit="L")
+    nums: Numbers = {"located boundary (last stable r) [L]": _r(boundary, 4),
+                     "bisection bracket [L]": [_r(x, 4) for x in located["bracket"]],
+                     "bisection tolerance [L]": located["tol"],
+                     **{f"boundary against the printed 0.86: {k}": v for k, v in
+                        printed.items()},
+                     "stable r on the grid [L]": [_r(lo), _r(hi)],
+                     "grid bracket of the boundary [L]": [_r(hi), _r(nxt)],
+                     "stable points with r < 0": neg,
+                     "unstable points inside (0, last stable r]": gaps}
+    ok = neg == 0 and lo >= 0 and gaps == 0 and ok_printed
     return Check(nums, Verdict.HOLDS if ok else Verdict.FAILS)
 
 
@@ -380,38 +390,6 @@ def _c417(d: Mapping[str, Any]) -> Check:
     return _judge(nums, ok_sd and ok_p,
                   {"rank corr(r, |step_down|)": _n(r, _abs(s, "step_down")),
                    "rank corr(r, |pitch_rate|)": _n(r, _abs(s, "pitch_rate"))})
-
-
-def _c418(d: Mapping[str, Any]) -> Check:
-    f = _frame(d, "stiffness")
-    lo, hi = stable_range(f, "k")
-    k = f["k"].to_numpy(float)
-    conv = f["converged"].to_numpy(bool)
-    m = stable_mask(f)
-    low_none = bool(not conv[0])
-    above = np.flatnonzero(k > hi) if math.isfinite(hi) else np.array([], int)
-    unstable_next = bool(above.size and conv[above[0]] and not m[above[0]])
-    s = f[m & (k <= (lo + hi) / 2)] if math.isfinite(lo) else f[m]
-    ks = s["k"].to_numpy(float)
-    common: Numbers = {"stable k [MgL^-1]": [_r(lo, 1), _r(hi, 1)],
-                       "stable k max / min": _r(hi / lo) if math.isfinite(lo) and lo > 0
-                       else math.nan,
-                       f"no gait at k = {k[0]:g} [MgL^-1]": low_none,
-                       "unstable gait just above the stable range": unstable_next,
-                       "stable points in the lower half": int(len(s))}
-    ok = bool(math.isfinite(lo) and hi >= 2 * lo and low_none and unstable_next)
-    if not ok or len(s) < MIN_POINTS:  # a part failing decides; else too few points
-        return _judge(common, ok, {} if not ok else {"a rank correlation over the lower half":
-                                                     len(s)})
-    parts: dict[str, tuple[Numbers, bool | None] | None] = {}
-    for label, y in (("largest non-trivial |lambda|", s["max_nontrivial"].to_numpy(float)),
-                     ("mean non-trivial |lambda| (the measure of 4.14)",
-                      _mean_nontrivial(s))):
-        rho, improves = _trend(ks, y, -1)
-        parts[label] = ({**common, f"rank corr(k, {label}), lower half of the stable range":
-                         _r(rho), f"{label} at the lowest / highest k of the lower half":
-                         [_r(y[0], 4), _r(y[-1], 4)]}, ok and improves)
-    return _readings(parts)
 
 
 def _c419(d: Mapping[str, Any]) -> Check:
@@ -448,23 +426,6 @@ def _c421(d: Mapping[str, Any]) -> Check:
                    "rank corr(beta0, |push|)": _n(b, _abs(s, "push"))})
 
 
-def _c422(d: Mapping[str, Any]) -> Check:
-    f = _frame(d, "retraction")
-    lo, hi = stable_range(f, "omega_r_bar")
-    w = f["omega_r_bar"].to_numpy(float)
-    m = stable_mask(f)
-    zero_stable = bool(m[w == 0].any())
-    g = f[f["converged"].to_numpy(bool) & (w > 0)]
-    wg, mg = g["omega_r_bar"].to_numpy(float), g["max_nontrivial"].to_numpy(float)
-    i = int(np.nanargmin(mg)) if np.isfinite(mg).any() else 0
-    rho, grows = _trend(wg[i:], mg[i:], +1)
-    nums = {"stable omega_r_bar": [_r(lo), _r(hi)], "stable without retraction": zero_stable,
-            "most stable rate": _r(wg[i]) if wg.size else math.nan,
-            "rank corr(omega_r_bar, max|lambda|) above it": _r(rho)}
-    ok = bool(m.any()) and (w == 0).any() and not zero_stable and grows
-    return Check(nums, Verdict.HOLDS if ok else Verdict.FAILS)
-
-
 def _c423(d: Mapping[str, Any]) -> Check:
     f = _frame(d, "retraction")
     s = _stable(f)
@@ -488,122 +449,3 @@ def _c423(d: Mapping[str, Any]) -> Check:
                 "|step_down| there [L]": [_r(x) for x in sp[i:]]}
     return _judge(nums, bool(ok), {"rank corr(omega_r_bar, |pitch_rate|)":
                                    _n(w, _abs(s, "pitch_rate"))}, evidence)
-
-
-_CONTROLLERS = {"passive": "mass_offset", "global PD": "controller_global_pd",
-                "local velocity": "controller_local_velocity",
-                "constant torque": "controller_constant_torque"}
-
-
-def _c424_passive(d: Mapping[str, Any]) -> Check:
-    f = _frame(d, "mass_offset")
-    lo, hi = stable_range(f, "r")
-    nums = {"passive stable r [L]": [_r(lo), _r(hi)]}
-    return Check(nums, Verdict.HOLDS if lo >= 0 else Verdict.FAILS)
-
-
-def _c424_lv(d: Mapping[str, Any]) -> Check:
-    lv = _frame(d, "controller_local_velocity")
-    asym = lv[lv["stability"].eq("asymptotic") & stable_mask(lv)]
-    n_pos = int((asym["r"] > 0).sum())
-    nums = {"asymptotically stable points (r > 0 / all)": [n_pos, int(len(asym))]}
-    ok = len(asym) >= 3 and n_pos > len(asym) / 2
-    return Check(nums, Verdict.HOLDS if ok else Verdict.FAILS)
-
-
-def _c424_pd(d: Mapping[str, Any]) -> Check:
-    f = _frame(d, "controller_global_pd")
-    g = f[f["converged"].astype(bool)]
-    top = g["abs_lambda_1"].to_numpy(float)
-    second = g["abs_lambda_2"].to_numpy(float)
-    res = g["residual"].to_numpy(float)
-    dev = np.abs(top - 1.0)
-    rest_inside = bool(np.all(second < 1.0 - MULT_TOL)) if g.size else False
-    nums: Numbers = {"global PD gaits": int(len(g)),
-                     "max | |lambda_1| - 1 |": float(f"{dev.max():.1e}") if dev.size else math.nan,
-                     "largest other |lambda|": _r(second.max(), 4) if second.size else math.nan,
-                     "max periodicity residual": float(f"{res.max():.1e}") if res.size
-                     else math.nan}
-    exact = (nums, bool(dev.size) and bool(np.all(dev <= MULT_TOL)) and rest_inside)
-    own = ({"points with | |lambda_1| - 1 | > max(1e-6, residual)":
-            int(np.sum(dev > np.maximum(MULT_TOL, res)))},
-           bool(dev.size) and bool(np.all(dev <= np.maximum(MULT_TOL, res))) and rest_inside)
-    return _readings({"|lambda| = 1 within the multipliers' accuracy (1e-6)": exact,
-                      "|lambda| = 1 within the gait's own periodicity residual": own}, nums)
-
-
-def _by_r(d: Mapping[str, Any], col: str, names: Mapping[str, str]) -> pd.DataFrame:
-    """|col| of each controller (columns) at the r > 0 that every one has a limit for (rows)."""
-    out = {}
-    for label, name in names.items():
-        f = _frame(d, name)
-        f = f[(f["r"] > 0) & np.isfinite(f[col].to_numpy(float))]
-        out[label] = pd.Series(np.abs(f[col].to_numpy(float)), index=np.round(
-            f["r"].to_numpy(float), 9))
-    t = pd.DataFrame(out).dropna()
-    return t.sort_index()
-
-
-#: Table 2.1's mass offset [L], where Figure 4.25's controllers are usually compared.
-R_TABLE21 = 0.3
-
-
-def _near(t: pd.DataFrame, r: float) -> Any:
-    return t.index[int(np.argmin(np.abs(t.index.to_numpy(float) - r)))] if len(t) else None
-
-
-def _c425_pitch(d: Mapping[str, Any]) -> Check:
-    t = _by_r(d, "pitch_rate", _CONTROLLERS)
-    u = "[rad g^1/2 L^-1/2]"
-    if len(t) < MIN_POINTS:
-        return _judge({}, False, {"r > 0 with a limit for every controller": len(t)})
-    med = t.median()
-    others = [k for k in _CONTROLLERS if k != "global PD"]
-    best_other = float(med[others].max())
-    ratio = float(med["global PD"]) / best_other
-    nums: Numbers = {f"median |pitch_rate| over the shared r {u}: {k}": _r(v)
-                     for k, v in med.items()}
-    nums["shared r > 0 (every controller has a limit) [L]"] = [_r(t.index.min()),
-                                                               _r(t.index.max())]
-    nums["shared r points"] = int(len(t))
-    nums["global PD / best other (medians)"] = _r(ratio)
-    per_r = t["global PD"] / t[others].max(axis=1)
-    r0 = _near(t, R_TABLE21)
-    evidence: Numbers = {
-        "r [L]": [_r(x) for x in t.index],
-        "global PD / best other at each r": [_r(x) for x in per_r],
-        f"global PD / best other at r = {_r(r0)} L (nearest Table 2.1's {R_TABLE21})":
-            _r(per_r.loc[r0])}
-    return _judge(nums, ratio > 1 + REL, evidence=evidence)
-
-
-def _c425_similar(d: Mapping[str, Any]) -> Check:
-    names = {k: n for k, n in _CONTROLLERS.items() if k != "global PD"}
-    t = _by_r(d, "pitch_rate", names)
-    u = "[rad g^1/2 L^-1/2]"
-    if len(t) < MIN_POINTS:
-        return _judge({}, False, {"r > 0 with a limit for every controller": len(t)})
-    med = t.median()
-    nums: Numbers = {f"median |pitch_rate| over the shared r {u}: {k}": _r(v)
-                     for k, v in med.items()}
-    rel = float((med.max() - med.min()) / med.max())
-    nums["relative spread of the medians"] = _r(rel)
-    spread = (t.max(axis=1) - t.min(axis=1)) / t.max(axis=1)
-    evidence: Numbers = {
-        "r [L]": [_r(x) for x in t.index],
-        "relative spread at each r": [_r(x) for x in spread],
-        "r where similar (spread < 0.25) [L]": [_r(x) for x in t.index[spread < REL]],
-        "r where not similar [L]": [_r(x) for x in t.index[spread >= REL]]}
-    return _judge(nums, rel < REL, evidence=evidence)
-
-
-def _c425_push(d: Mapping[str, Any]) -> Check:
-    t = _by_r(d, "push", _CONTROLLERS)
-    if len(t) < MIN_POINTS:
-        return _judge({}, False, {"r > 0 with a limit for every controller": len(t)})
-    med = t.median()
-    nums: Numbers = {f"median |push| over the shared r [g^1/2 L^1/2]: {k}": _r(v)
-                     for k, v in med.items()}
-    lv = float(med["local velocity"])
-    ok = all(lv < float(v) for k, v in med.items() if k != "local velocity")
-    return _judge(nums, ok)
