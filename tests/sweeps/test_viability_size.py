@@ -75,9 +75,13 @@ def test_a_grid_that_does_not_fit_is_refused_in_one_line(monkeypatch):
     small.check_fits()
 
 
-def test_run_viability_refuses_before_it_makes_its_folder(tmp_path):
+def test_run_viability_refuses_before_it_makes_its_folder(tmp_path, monkeypatch):
+    def computed(*args):  # a run that starts instead of refusing fails here, not hangs
+        raise AssertionError("a chunk was computed")
+
+    monkeypatch.setattr(sv, "_chunk_task", computed)
     with pytest.raises(ValueError, match="cells .* of memory"):
-        sv.run_viability(_grid(HUGE, third=HUGE), tmp_path / "o")
+        sv.run_viability(_grid(HUGE, third=HUGE), tmp_path / "o", workers=1)
     assert not (tmp_path / "o").exists()
 
 
