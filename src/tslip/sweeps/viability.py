@@ -66,6 +66,7 @@ import io
 import itertools
 import json
 import math
+import os
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -92,7 +93,7 @@ from ..model.parameters import Params, preset
 from ..simulation.options import IntegratorOptions
 from . import _pool
 from ._lock import folder_lock
-from ._schedule import Task, choose_workers, run_tasks
+from ._schedule import STARTUP_SECONDS, Task, choose_workers, run_tasks
 from .run import StudyInterrupted, _cached_names
 from .spec import Axis, read_spec
 
@@ -477,14 +478,22 @@ def _run(spec: ViabilitySpec, out: Path | None, n_workers: int | None,
 
     if progress:
         progress(0, total)
-    # the work left, for the worker count: the cache's files taken for chunks of this grid
-    per = slices[0].stop * n_a
-    left = max(len(slices) - len(names), 1)
+    # the first tasks, as many as tell the worker count (choose_workers: every core only
+    # when each gets 4 start-ups of work); the others are made as these finish
+    enough = (os.cpu_count() or 1) * 4 * STARTUP_SECONDS
+    first: list[Task] = []
+    cost = 0.0
+    for task in feed:
+        first.append(task)
+        cost += task.cost
+        if cost >= enough:
+            break
+    more = cost >= enough  # else every chunk left is in ``first``
     workers = (1 if scheduler is not None else
-               choose_workers(min(left * per, total) * CELL_SECONDS, n_workers, width=left))
+               choose_workers(cost, n_workers, width=None if more else len(first)))
     window = _DASK_WINDOW if scheduler is not None else 2 * (workers + 1)
-    run_tasks(list(itertools.islice(feed, window)), on_done, workers, tick=tick,
-              scheduler=scheduler)
+    first += itertools.islice(feed, max(0, window - len(first)))
+    run_tasks(first, on_done, workers, tick=tick, scheduler=scheduler)
     if len(keys) != len(slices):  # pragma: no cover - every task's on_done pulls the next
         raise RuntimeError(f"{len(slices) - len(keys)} chunks were never handed out")
     n_cached = state["cached"]
