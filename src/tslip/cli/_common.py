@@ -36,7 +36,8 @@ if TYPE_CHECKING:  # the model is imported when parameters are built: `tslip --h
 __all__ = [
     "SchedulerOpt", "WorkersOpt",
     "DATA_SUFFIXES", "Failed", "ParamsOpt", "PresetOpt", "SetOpt", "build_params",
-    "build_params_and_preset", "check_plot_suffix", "check_suffix", "echo_error", "errors",
+    "build_params_and_preset", "check_plot_suffix", "check_scheduler", "check_suffix",
+    "echo_error", "errors",
     "fail", "file_size", "interruptible", "make_console", "progress_bar", "run", "stopped",
 ]
 
@@ -95,7 +96,43 @@ ParamsOpt = Annotated[
 WorkersOpt = Annotated[int | None, typer.Option("--workers", min=1,
                                                 help="Worker processes (default: all cores).")]
 SchedulerOpt = Annotated[str | None, typer.Option(
-    "--scheduler", help="Dask scheduler address (needs tslip\\[dask]).")]
+    "--scheduler", help="Dask scheduler address, e.g. tcp://127.0.0.1:8786 (needs "
+    "tslip\\[dask]); refused if no scheduler answers within 10 s.")]
+
+#: Seconds ``--scheduler`` is given to answer (:func:`check_scheduler`).
+SCHEDULER_SECONDS = 10.0
+
+
+def check_scheduler(address: str | None, echo: Any, seconds: float | None = None) -> None:
+    """Refuse a ``--scheduler`` that is empty, malformed or does not answer, before any work
+    (and before an output folder is made).
+
+    One ``ValueError`` line naming ``--scheduler`` and what was wrong. The wait for an
+    answer is announced (``echo``, one line) and lasts at most ``seconds`` (default
+    :data:`SCHEDULER_SECONDS`).
+    """
+    if address is None:
+        return
+    seconds = SCHEDULER_SECONDS if seconds is None else seconds
+    if not address.strip():
+        raise ValueError("--scheduler is empty; give a Dask scheduler's address, e.g. "
+                         "tcp://127.0.0.1:8786")
+    try:
+        from dask.distributed import Client
+    except ImportError:
+        raise ValueError("--scheduler needs Dask: pip install 'tslip[dask]'") from None
+    echo(f"connecting to the Dask scheduler at {address} (giving up after {seconds:g} s)")
+    try:
+        with Client(address, timeout=seconds):
+            pass
+    except (OSError, TimeoutError) as exc:
+        why = " ".join(str(exc).split()) or type(exc).__name__
+        raise ValueError(f"--scheduler {address!r}: no Dask scheduler answered within "
+                         f"{seconds:g} s ({why})") from None
+    except Exception as exc:  # noqa: BLE001 - Dask's refusal of the address, whatever its type
+        why = " ".join(str(exc).split())[:200] or type(exc).__name__
+        raise ValueError(f"--scheduler {address!r} is not a Dask scheduler's address "
+                         f"({type(exc).__name__}: {why})") from None
 
 
 def make_console(stderr: bool = False) -> Console:

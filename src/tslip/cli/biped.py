@@ -113,8 +113,9 @@ def simulate_cmd(
         if tr.n_steps:
             for leg, name in ((0, "right"), (1, "left")):
                 te = tracking_errors(tr, leg, t0, tr.strides[0, 0])
-                c.print(f"{name} leg, stride 1: thigh RMS error {te.thigh_rms:.2e} L, "
-                        f"hip RMS error {te.hip_rms:.3f} rad")
+                c.print(f"{name} leg, stride 1: RMS error from the controller's references "
+                        f"(eqs E.29, E.32): thigh length {te.thigh_rms:.2e} L, hip angle "
+                        f"{te.hip_rms:.3f} rad")
         if out is not None:
             tr.save(out)  # the table, and its run record beside it (tslip.load reads both)
             c.print(f"wrote {out} and {out.with_suffix('.json')}")

@@ -211,7 +211,8 @@ def track_cmd(
                                               "from the file).")] = None,
     scale: Annotated[float | None, typer.Option("--scale", help="Image scale \\[px/m] (default: "
                                                 "measured from the disc spacing).")] = None,
-    ground: Annotated[float | None, typer.Option("--ground", help="Ground row \\[px].")] = None,
+    ground: Annotated[float | None, typer.Option("--ground", help="Ground row \\[px] (give "
+                                                 "--scale with it).")] = None,
     max_frames: Annotated[int | None, typer.Option(
         "--max-frames", help="Track only the first N frames (default: all).")] = None,
 ) -> None:
@@ -316,9 +317,13 @@ def experiment_cmd(
     out_dir: Annotated[Path, typer.Option(
         "--out-dir", "-o", help="Folder for tracks.csv, steps.csv and the fit's tables, "
         "figures and fit.json.")] = Path("experiment"),
-    fps: Annotated[float | None, typer.Option("--fps", help="Frame rate \\[Hz].")] = None,
-    scale: Annotated[float | None, typer.Option("--scale", help="\\[px/m]")] = None,
-    ground: Annotated[float | None, typer.Option("--ground", help="Ground row \\[px].")] = None,
+    fps: Annotated[float | None, typer.Option("--fps", help="Frame rate \\[Hz] (default: "
+                                              "from the file).")] = None,
+    scale: Annotated[float | None, typer.Option("--scale", help="Image scale \\[px/m] (default: "
+                                                "measured from the disc spacing; give "
+                                                "--ground with it).")] = None,
+    ground: Annotated[float | None, typer.Option("--ground", help="Ground row \\[px] (give "
+                                                 "--scale with it).")] = None,
 ) -> None:
     """Run track -> process -> fit and write everything into one folder."""
     with errors():

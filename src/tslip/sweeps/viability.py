@@ -63,16 +63,19 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import io
+import itertools
 import json
+import math
+import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .. import __version__
+from .. import __version__, _gridsize
 from .._checks import check_name, check_number
 from .._codehash import code_hash
 from .._io import atomic_write, git_hash, write_json
@@ -90,7 +93,7 @@ from ..model.parameters import Params, preset
 from ..simulation.options import IntegratorOptions
 from . import _pool
 from ._lock import folder_lock
-from ._schedule import Task, choose_workers, run_tasks
+from ._schedule import STARTUP_SECONDS, Task, choose_workers, run_tasks
 from .run import StudyInterrupted, _cached_names
 from .spec import Axis, read_spec
 
@@ -100,7 +103,7 @@ __all__ = ["CHUNK_CELLS", "ViabilityInterrupted", "ViabilitySpec", "chunk_keys",
 Progress = Callable[[int, int], None]
 
 #: Cells (state points x actions) per task and cache file.
-CHUNK_CELLS = 2000
+CHUNK_CELLS = _gridsize.CHUNK_CELLS
 #: Estimated seconds per cell at tolerance 1e-12 (warm cache), for the worker count.
 CELL_SECONDS = 2e-5
 
@@ -151,6 +154,11 @@ class ViabilitySpec:
                                  f"got {names}")
             if len(names) == 1:
                 object.__setattr__(self, "action", self.action[0])
+        names = [a.param for a in self.states]
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise ValueError(f"[[state]] tables must name different apex variables, got "
+                             f"{twice[0]!r} {names.count(twice[0])} times")
         check_map_inputs(self.base, {a.param: a.values for a in self.states},
                          self.actions(), self.energy)
 
@@ -170,29 +178,48 @@ class ViabilitySpec:
 
     @property
     def n_cells(self) -> int:
-        return int(np.prod(self.shape))
+        return math.prod(self.shape)  # Python integers: no overflow however large the grid
 
     @property
     def n_actions(self) -> int:
         """Action grid points (the product over the actions)."""
-        return int(np.prod([len(a.values) for a in self.action_axes]))
+        return math.prod(len(a.values) for a in self.action_axes)
 
     @property
     def n_states(self) -> int:
-        return int(np.prod([len(a.values) for a in self.states]))
+        return math.prod(len(a.values) for a in self.states)
 
     def points(self, rows: slice | None = None) -> np.ndarray:
-        """State points of the grid, C order, shape (n, n_names): all, or the ``rows``."""
+        """State points of the grid, C order, shape (n, n_names): all, or the ``rows``
+        (a slice with step 1; only its points are made, not the grid's)."""
         shape = tuple(len(a.values) for a in self.states)
-        idx = np.unravel_index(np.arange(self.n_states)[rows or slice(None)], shape)
+        start, stop, _ = (rows or slice(None)).indices(self.n_states)
+        idx = np.unravel_index(np.arange(start, max(start, stop)), shape)
         return np.stack([np.asarray(a.values, dtype=float)[i]
                          for a, i in zip(self.states, idx)], axis=1)
 
-    def chunks(self) -> list[slice]:
-        """Slices of :meth:`points`, about :data:`CHUNK_CELLS` cells each."""
-        n = self.n_states
-        per = max(1, CHUNK_CELLS // self.n_actions)
-        return [slice(i, min(i + per, n)) for i in range(0, n, per)]
+    def chunks(self) -> Sequence[slice]:
+        """Slices of :meth:`points`, about :data:`CHUNK_CELLS` cells each, made on demand
+        (a sequence: ``len``, indexing and iteration, however many chunks the grid has)."""
+        return _Chunks(self.n_states, max(1, CHUNK_CELLS // self.n_actions))
+
+    def memory(self, stored: bool = True) -> int:
+        """Estimated bytes :func:`run_viability` holds in memory for this grid
+        (:func:`tslip._gridsize.run_bytes`; ``stored``: with an output folder)."""
+        return _gridsize.run_bytes(self._points(), self._action_points(), self.rule, stored,
+                                   CHUNK_CELLS)
+
+    def check_fits(self, stored: bool = True) -> None:
+        """Refuse (one-line ``ValueError``: cells, estimated bytes, available memory) a grid
+        whose run (:meth:`memory`) does not fit in the memory available, before any work."""
+        _gridsize.check_run_fits(self.name, self._points(), self._action_points(), self.rule,
+                                 stored, CHUNK_CELLS)
+
+    def _points(self) -> list[int]:
+        return [len(a.values) for a in self.states]
+
+    def _action_points(self) -> list[int]:
+        return [len(a.values) for a in self.action_axes]
 
     def to_dict(self) -> dict[str, Any]:
         return {"name": self.name, "description": self.description, "energy": self.energy,
@@ -245,6 +272,28 @@ class ViabilitySpec:
 
 
 _TIGHT = {"rtol": 1e-12, "atol": 1e-12, "method": "dop853"}
+#: Chunks handed to a Dask cluster ahead of its results (it takes at most
+#: :data:`tslip.sweeps._schedule.DASK_IN_FLIGHT` per worker thread of them at a time).
+_DASK_WINDOW = 1024
+
+
+class _Chunks(Sequence[slice]):
+    """The chunk slices of ``n`` state points, ``per`` a chunk, each made when asked for."""
+
+    def __init__(self, n: int, per: int) -> None:
+        self.n, self.per = n, per
+
+    def __len__(self) -> int:
+        return -(-self.n // self.per)
+
+    def __getitem__(self, i: Any) -> Any:
+        if isinstance(i, slice):
+            return [self[j] for j in range(len(self))[i]]
+        k = range(len(self))[i]  # IndexError out of range, negatives from the end
+        return slice(k * self.per, min((k + 1) * self.per, self.n))
+
+    def __iter__(self) -> Iterator[slice]:
+        return (slice(i, min(i + self.per, self.n)) for i in range(0, self.n, self.per))
 
 
 def _axis_dict(a: Axis) -> dict[str, Any]:
@@ -283,22 +332,31 @@ def _prefix(spec: ViabilitySpec) -> Any:
     return hashlib.sha256(json.dumps(payload, sort_keys=True, default=float).encode())
 
 
-def chunk_keys(spec: ViabilitySpec) -> list[str]:
-    """Cache key of each chunk of :meth:`ViabilitySpec.chunks`."""
+def _keys(spec: ViabilitySpec) -> Iterator[str]:
+    """Cache key of each chunk of :meth:`ViabilitySpec.chunks`, one at a time."""
     prefix = _prefix(spec)
-    out = []
     for sl in spec.chunks():
         h = prefix.copy()
         h.update(np.ascontiguousarray(spec.points(sl)).tobytes())
-        out.append(h.hexdigest()[:24])
-    return out
+        yield h.hexdigest()[:24]
+
+
+def chunk_keys(spec: ViabilitySpec) -> list[str]:
+    """Cache key of each chunk of :meth:`ViabilitySpec.chunks`."""
+    return list(_keys(spec))
 
 
 def saved_cells(spec: ViabilitySpec, out_dir: str | Path) -> int:
     """How many of the spec's cells ``out_dir/cache`` holds."""
-    names = _cached_names(Path(out_dir) / "cache")
-    return sum((sl.stop - sl.start) * spec.n_actions
-               for sl, k in zip(spec.chunks(), chunk_keys(spec)) if f"{k}.npz" in names)
+    names = {n for n in _cached_names(Path(out_dir) / "cache") if n.endswith(".npz")}
+    saved = found = 0
+    for sl, k in zip(spec.chunks(), _keys(spec)):
+        if found == len(names):  # every file matched: the rest of the grid is not saved
+            break
+        if f"{k}.npz" in names:
+            found += 1
+            saved += (sl.stop - sl.start) * spec.n_actions
+    return saved
 
 
 def _chunk_task(spec: ViabilitySpec, rows: slice, key: str, cache: str | None,
@@ -354,11 +412,15 @@ def run_viability(spec: ViabilitySpec, out_dir: str | Path | None = None, *,
 
     Raises
     ------
+    ValueError
+        If the run would not fit in memory (:meth:`ViabilitySpec.check_fits`),
+        before anything is allocated or written.
     StudyInterrupted
         On Ctrl-C ("N of M cells saved"); the finished chunks stay cached.
     """
     if workers is not None and workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
+    spec.check_fits(stored=out_dir is not None)
     try:
         if out_dir is None:
             return _run(spec, None, workers, progress, scheduler)
@@ -371,48 +433,70 @@ def run_viability(spec: ViabilitySpec, out_dir: str | Path | None = None, *,
 
 def _run(spec: ViabilitySpec, out: Path | None, n_workers: int | None,
          progress: Progress | None, scheduler: str | None = None) -> Viability:
+    """The run: the chunks' keys made and their cache read one at a time, as the tasks are
+    handed out (a window of them ahead of the workers), never all at once."""
     t0 = time.perf_counter()
     cache = out / "cache" if out is not None else None
     names = _cached_names(cache)
     n_a, total, d = spec.n_actions, spec.n_cells, len(spec.states)
-    slices, keys = spec.chunks(), chunk_keys(spec)
+    slices = spec.chunks()
+    keys: list[str] = []  # made by pending(), in the order of the chunks
     held: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # the map, without a store only
-    state = {"done": 0}
+    state = {"done": 0, "cached": 0}
 
     def tick(n: int) -> None:
         state["done"] += n
         if progress:
             progress(min(state["done"], total), total)
 
-    tasks = []
-    for i, (sl, key) in enumerate(zip(slices, keys)):
-        n = (sl.stop - sl.start) * n_a
-        if cache is not None and f"{key}.npz" in names and read_chunk(
-                cache / f"{key}.npz", sl.stop - sl.start, n_a, d) is not None:
-            state["done"] += n
-            continue
-        here = cache is not None and scheduler is None  # on Dask: cached here, on arrival
-        tasks.append(Task((spec.name, sl.start), _chunk_task,
-                          (spec, sl, key, str(cache) if here else None),
-                          cost=n * CELL_SECONDS, meta={"i": i, "key": key}))
-    n_cached = state["done"]
+    here = cache is not None and scheduler is None  # on Dask: cached here, on arrival
+
+    def pending() -> Iterator[Task]:
+        for i, (sl, key) in enumerate(zip(slices, _keys(spec))):
+            keys.append(key)
+            n = (sl.stop - sl.start) * n_a
+            if cache is not None and f"{key}.npz" in names and read_chunk(
+                    cache / f"{key}.npz", sl.stop - sl.start, n_a, d) is not None:
+                state["cached"] += n
+                tick(n)
+                continue
+            yield Task((spec.name, sl.start), _chunk_task,
+                       (spec, sl, key, str(cache) if here else None),
+                       cost=n * CELL_SECONDS, meta={"i": i, "key": key})
+
+    feed = pending()
+
+    def on_done(task: Task, result: tuple[np.ndarray, np.ndarray] | None) -> Iterator[Task]:
+        if result is not None:  # else in the store already
+            if cache is None:
+                held[task.meta["i"]] = result
+            else:
+                _write_chunk(cache / f"{task.meta['key']}.npz", *result)
+            if scheduler is not None:
+                tick(int(result[1].size))
+        return itertools.islice(feed, 1)  # the next chunk to compute, in place of this one
+
     if progress:
-        progress(n_cached, total)
-
-    def on_done(task: Task, result: tuple[np.ndarray, np.ndarray] | None) -> list[Task]:
-        if result is None:  # in the store already
-            return []
-        if cache is None:
-            held[task.meta["i"]] = result
-        else:
-            _write_chunk(cache / f"{task.meta['key']}.npz", *result)
-        if scheduler is not None:
-            tick(int(result[1].size))
-        return []
-
+        progress(0, total)
+    # the first tasks, as many as tell the worker count (choose_workers: every core only
+    # when each gets 4 start-ups of work); the others are made as these finish
+    enough = (os.cpu_count() or 1) * 4 * STARTUP_SECONDS
+    first: list[Task] = []
+    cost = 0.0
+    for task in feed:
+        first.append(task)
+        cost += task.cost
+        if cost >= enough:
+            break
+    more = cost >= enough  # else every chunk left is in ``first``
     workers = (1 if scheduler is not None else
-               choose_workers(sum(t.cost for t in tasks), n_workers, width=len(tasks)))
-    run_tasks(tasks, on_done, workers, tick=tick, scheduler=scheduler)
+               choose_workers(cost, n_workers, width=None if more else len(first)))
+    window = _DASK_WINDOW if scheduler is not None else 2 * (workers + 1)
+    first += itertools.islice(feed, max(0, window - len(first)))
+    run_tasks(first, on_done, workers, tick=tick, scheduler=scheduler)
+    if len(keys) != len(slices):  # pragma: no cover - every task's on_done pulls the next
+        raise RuntimeError(f"{len(slices) - len(keys)} chunks were never handed out")
+    n_cached = state["cached"]
     grid = tuple(np.asarray(a.values, dtype=float) for a in spec.states)
     anames = tuple(a.param for a in spec.action_axes)
     agrids = tuple(np.asarray(a.values, dtype=float) for a in spec.action_axes)
