@@ -148,6 +148,10 @@ def test_results_round_trip_bit_for_bit(tmp_path):
         assert again.map.next.tobytes() == smap.next.tobytes()
         assert np.array_equal(again.q, v.q) and np.array_equal(again.s, v.s)
     assert "viable" in repr(v) and len(repr(v)) < 200
+    from dataclasses import replace
+
+    for n, word in ((1, "1 sweep)"), (3, "3 sweeps)")):  # one sweep is not "1 sweeps"
+        assert repr(replace(v, sweeps=n)).endswith(word)
 
 
 @pytest.mark.parametrize(("kwargs", "match"), [

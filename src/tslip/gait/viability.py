@@ -98,7 +98,8 @@ class Viability(Result):
         return (f"Viability({_short(m.grid, m.names)} x "
                 f"{_short(m.action_grids, m.action_names)}, {self.rule}: "
                 f"{int(self.q.sum())} of {self.q.size} pairs and "
-                f"{int(self.s.sum())} of {self.s.size} states viable, {self.sweeps} sweeps)")
+                f"{int(self.s.sum())} of {self.s.size} states viable, "
+                f"{self.sweeps} sweep{'' if self.sweeps == 1 else 's'})")
 
     @property
     def viable_fraction(self) -> float:
