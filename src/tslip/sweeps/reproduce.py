@@ -505,7 +505,7 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
     if scheduler is None and workers != 1:  # likely parallel: the workers' imports start now
         _pool.prestart(preload)
         warm_in_background(("biped",))  # on the other core, while the fork server warms
-    with folder_locks(out / "studies" / name for name in specs):
+    with folder_locks((out / "studies" / name for name in specs), root=out):
         jobs = {name: StudyJob(spec, out / "studies" / name, writes=scheduler is None)
                 for name, spec in specs.items()}
 
