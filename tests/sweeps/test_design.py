@@ -239,7 +239,8 @@ def test_store_ignores_other_code_and_non_data_lines(tmp_path, caplog):
     assert list(rows) == [(3.0, 0.1)] and math.isnan(rows[(3.0, 0.1)]["stance_time"])
     # another code's line is silent; the NaN literal is a bad line, named
     (msg,) = [r.getMessage() for r in caplog.records]
-    assert msg.startswith(f"ignoring 1 bad line of {path} (line 2: not JSON)")
+    assert msg.startswith(f"ignoring 1 bad line of {path} (line 2: non-standard JSON "
+                          "constant NaN)")
 
 
 _BAD_LINES = {

@@ -39,7 +39,7 @@ def design_cmd(
     from ..sweeps._lock import folder_lock
     from ..sweeps._warmup import announce
     from ..sweeps.design_spec import DesignSpec
-    from ..sweeps.pareto import budget_note, design, require_pymoo
+    from ..sweeps.pareto import budget_note, check_folder, design, require_pymoo
 
     console = make_console()
     with errors(), interruptible():
@@ -53,7 +53,7 @@ def design_cmd(
             console.print(note, highlight=False)
         t0 = time.perf_counter()
         with folder_lock(out_dir):  # refused before the bar is drawn if another run writes it
-            pass
+            check_folder(out_dir)  # and a link where it would write
         with progress_bar("designs") as bar, announce(bar.console.print, ("simulation",)):
             task = bar.add_task(f"design {spec.name}", total=spec.generations * spec.population)
             res = design(spec, out_dir, workers=workers, scheduler=scheduler,

@@ -66,8 +66,8 @@ if TYPE_CHECKING:
     from ..gait.fixed_point import Gait
     from ..gait.robustness import Kind
 
-__all__ = ["DesignResult", "budget_note", "design", "evaluate", "pareto_mask", "require_pymoo",
-           "store_schema"]
+__all__ = ["DesignResult", "budget_note", "check_folder", "design", "evaluate", "pareto_mask",
+           "require_pymoo", "store_schema"]
 
 #: ``progress(done, total)``: evaluations finished (cached ones included) of the budget.
 Progress = Callable[[int, int], None]
@@ -338,6 +338,19 @@ def budget_note(spec: DesignSpec) -> str | None:
             f"raised to {spec.generations} generations ({used} evaluations)")
 
 
+def check_folder(out: Path) -> None:
+    """Refuse (:class:`tslip._safefile.UnsafePath`) an output folder whose
+    ``evaluations.jsonl`` or ``gaits/`` is a link, before any work (the CLI, before its bar)."""
+    try:
+        os.close(open_below(out, out / _STORE, os.O_RDONLY))
+    except FileNotFoundError:
+        pass
+    try:
+        folder(out, out / "gaits", create=False)
+    except FileNotFoundError:
+        pass
+
+
 def _nsga2(spec: DesignSpec) -> Any:
     require_pymoo()
     from pymoo.algorithms.moo.nsga2 import NSGA2
@@ -388,6 +401,7 @@ def design(
     out = None if out_dir is None else Path(out_dir)
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
+        check_folder(out)
     code = code_version()
     lo = np.array([v.lower for v in spec.variables])
     span = np.array([v.upper for v in spec.variables]) - lo
