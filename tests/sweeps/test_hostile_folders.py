@@ -110,3 +110,21 @@ def test_a_stale_lock_message_names_the_holder_not_the_file_bytes(tmp_path, capl
         pass
     (msg,) = [r.getMessage() for r in caplog.records]
     assert "taking over the stale lock" in msg and "SECRET" not in msg
+
+
+def test_both_appenders_refuse_a_link_made_after_the_folder_was_read(tmp_path, target):
+    """The study's and the design's appenders open the file themselves, without following."""
+    from tslip.sweeps import _store
+    from tslip.sweeps.pareto import _Store
+
+    out = tmp_path / "o"
+    (out / "cache").mkdir(parents=True)
+    (out / "cache" / "s.jsonl").symlink_to(target)
+    with pytest.raises(UnsafePath), _store.Writer(out / "cache" / "s.jsonl", root=out) as w:
+        w.add("k", {"v0": 1.0})
+    store = _Store(None, "code", None)  # read nothing
+    store.path = out / "evaluations.jsonl"
+    store.path.symlink_to(target)
+    with pytest.raises(UnsafePath):
+        store.add((1.0,), {"k": 1.0})
+    _untouched(target)
