@@ -158,7 +158,7 @@ def read_lines(
     repair: bool = False,
     constants: bool = False,
     skip: Callable[[Any], bool] | None = None,
-    what: str = "computed again",
+    what: tuple[str, str] = ("its entry is computed again", "their entries are computed again"),
 ) -> list[Any]:
     """The records of ``path`` (a file inside the output folder ``root``) that match
     ``schema``, in file order; empty without a file.
@@ -166,8 +166,8 @@ def read_lines(
     ``repair`` (only by the run that holds the folder's lock) also cuts a torn
     last line off the file, so that the next append starts a line of its own.
     ``skip(value)`` marks a decoded line as not this reader's (e.g. another code
-    version's): dropped without a warning. ``what`` ends the warning (what happens
-    to the entries of the bad lines). ``constants``: see :func:`decode_line`.
+    version's): dropped without a warning. ``what`` ends the warning, for one bad
+    line and for several (what happens to their entries). ``constants``: see :func:`decode_line`.
     """
     flags = os.O_RDWR if repair else os.O_RDONLY
     try:
@@ -198,7 +198,7 @@ def read_lines(
         named = "; ".join(f"line {n}: {why}" for n, why in bad[:_NAMED])
         more = f"; and {len(bad) - _NAMED} more" if len(bad) > _NAMED else ""
         log.warning("ignoring %d bad line%s of %s (%s%s); %s", len(bad),
-                    "s" if len(bad) > 1 else "", path, named, more, what)
+                    "s" if len(bad) > 1 else "", path, named, more, what[len(bad) > 1])
     return out
 
 

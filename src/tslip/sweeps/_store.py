@@ -89,7 +89,8 @@ def read(path: str | Path, *, repair: bool = False,
     """
     path = Path(path)
     out: dict[str, dict[str, Any]] = {}
+    what = ("its point is computed again", "their points are computed again")
     for item in read_lines(path.parent if root is None else root, path, SCHEMA, repair=repair,
-                           constants=True, what="their points are computed again"):
+                           constants=True, what=what):
         out.setdefault(item["key"], item["record"])
     return out

@@ -291,7 +291,8 @@ class _Store:
             return
         recs = read_lines(path.parent, path, store_schema(spec), repair=True,
                           skip=lambda rec: isinstance(rec, dict) and rec.get("code") != code,
-                          what="their candidates are evaluated again")
+                          what=("its candidate is evaluated again",
+                                "their candidates are evaluated again"))
         for rec in recs:
             row = {k: (math.nan if v is None else v) for k, v in rec["row"].items()}
             self.rows[tuple(float(v) for v in rec["x"])] = row
