@@ -128,3 +128,14 @@ def test_both_appenders_refuse_a_link_made_after_the_folder_was_read(tmp_path, t
     with pytest.raises(UnsafePath):
         store.add((1.0,), {"k": 1.0})
     _untouched(target)
+
+
+def test_a_report_figures_folder_that_is_a_link_is_refused_before_any_work(tmp_path, target):
+    from tslip.sweeps.reproduce import run_catalogue
+
+    out = tmp_path / "report"
+    out.mkdir()
+    (out / "figures").symlink_to(target.parent)
+    with pytest.raises(UnsafePath, match="figures: it is a symbolic link"):
+        run_catalogue(out, False, workers=1)
+    _untouched(target)
