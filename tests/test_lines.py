@@ -129,15 +129,45 @@ _json = st.recursive(st.none() | st.booleans() | st.integers() | st.floats() | s
                      | st.dictionaries(st.sampled_from(["code", "x", "row", "rec", "k", "f", "ok",
                                                         "z"]), kids, max_size=5),
                      max_leaves=12)
-_near = st.fixed_dictionaries({k: st.one_of(st.just(v), _json) for k, v in GOOD.items()})
-_lines = st.lists(st.one_of(st.binary(max_size=40),
+_scalar = st.one_of(st.none(), st.booleans(), st.integers(), st.floats(), st.text(max_size=3))
+_finite = st.integers() | st.floats(allow_nan=False, allow_infinity=False)
+_good_x = st.lists(_finite, min_size=2, max_size=2)
+_good_row = st.fixed_dictionaries({"k": _finite, "f": st.none() | _finite, "ok": st.booleans()})
+_good = st.fixed_dictionaries({"code": st.text(max_size=3), "x": _good_x, "row": _good_row,
+                               "rec": st.dictionaries(st.text(max_size=2), _scalar, max_size=3)})
+
+
+def _mutate(rec, how, where, value):
+    """One change of a good record: a field, an item of ``x``, a field of ``row`` or of
+    ``rec`` set to ``value``, a field dropped or one added (or none)."""
+    rec = json.loads(json.dumps(rec))
+    if how == "field":
+        rec[where] = value
+    elif how == "x":
+        rec["x"][len(where) % 2] = value
+    elif how in ("row", "rec"):
+        rec[how][where] = value
+    elif how == "drop":
+        rec.pop(where, None)
+    elif how == "add":
+        rec[where + "_"] = value
+    return rec
+
+
+# records near the schema: a good one, or one with a single change (often a wrong type)
+_near = st.builds(_mutate, _good,
+                  st.sampled_from(["none", "field", "x", "row", "rec", "drop", "add"]),
+                  st.sampled_from(["code", "x", "row", "rec", "k", "f", "ok"]),
+                  st.one_of(_scalar, st.lists(_scalar, max_size=2),
+                            st.dictionaries(st.text(max_size=2), _scalar, max_size=2), _json))
+_near_line = _near.map(lambda v: json.dumps(v).encode())
+_lines = st.lists(st.one_of(_near_line, _near_line, _near_line, st.binary(max_size=40),
                             _json.map(lambda v: json.dumps(v).encode()),
-                            _near.map(lambda v: json.dumps(v).encode()),
-                            _near.map(lambda v: json.dumps(v).encode()[:-3])),
-                  max_size=8)
+                            _near_line.map(lambda b: b[:-3])),
+                  min_size=1, max_size=12)
 
 
-@settings(max_examples=200, deadline=None,
+@settings(max_examples=300, deadline=None,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(lines=_lines, end=st.sampled_from([b"", b"\n"]))
 def test_fuzzed_lines_never_raise_and_only_schema_records_come_back(tmp_path, lines, end):
