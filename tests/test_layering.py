@@ -17,7 +17,8 @@ ALLOWED = {
     "biped": {"model", "simulation", "gait"},
     "plotting": {"model", "simulation", "gait", "sweeps", "experiment", "biped"},
 }
-TOP = {"_io", "_results", "_checks", "_gridsize", "_kernel_cache", "_nrt", "_codehash",
+TOP = {"_io", "_lines", "_safefile", "_results", "_checks", "_gridsize", "_kernel_cache",
+       "_nrt", "_codehash",
        "_renamed", "protocols", "__init__", "__main__", "_typing", "__version__"}
 
 

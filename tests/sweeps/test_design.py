@@ -16,12 +16,13 @@ import numpy as np
 import pytest
 
 import tslip
+from _extras import require
 from tslip.cli.main import app
 from tslip.sweeps import Axis, StudySpec, run_study
 from tslip.sweeps.design_spec import OBJECTIVES, DesignSpec, Variable
 from tslip.sweeps.pareto import _Store, evaluate, pareto_mask
 
-pytest.importorskip("pymoo")
+require("pymoo", "design")  # in CI (TSLIP_REQUIRE_EXTRAS=1) a missing pymoo fails
 
 BASE = tslip.preset("table2.1")
 
@@ -220,16 +221,79 @@ def test_a_dask_cluster_finds_the_identical_designs(tmp_path):
     assert dask.frame.equals(local.frame)
 
 
-def test_store_ignores_other_code_and_non_data_lines(tmp_path):
+def _row(spec, k, value):
+    return {"k": k, "r": 0.1, **dict.fromkeys(spec.objectives, value), "feasible": True,
+            "violation": 0.0, "reason": ""}
+
+
+def test_store_ignores_other_code_and_non_data_lines(tmp_path, caplog):
+    spec = _spec()
     path = tmp_path / "evaluations.jsonl"
-    path.write_text(json.dumps({"code": "old", "x": [1.0], "row": {"k": 1.0}}) + "\n"
-                    + '{"code": "new", "x": [2.0], "row": {"k": NaN}}\n'
-                    + json.dumps({"code": "new", "x": [3.0], "row": {"k": None}}) + "\n")
-    rows = _Store(path, "new").rows
-    assert list(rows) == [(3.0,)] and math.isnan(rows[(3.0,)]["k"])
+    path.write_text(json.dumps({"code": "old", "x": [1.0, 0.1], "row": {"k": 1.0}}) + "\n"
+                    + json.dumps({"code": "new", "x": [2.0, 0.1], "row": _row(spec, 2.0, 1.0)}
+                                 ).replace("1.0,", "NaN,", 1) + "\n"
+                    + json.dumps({"code": "new", "x": [3.0, 0.1], "row": _row(spec, 3.0, None)})
+                    + "\n")
+    with caplog.at_level("WARNING", logger="tslip"):
+        rows = _Store(path, "new", spec).rows
+    assert list(rows) == [(3.0, 0.1)] and math.isnan(rows[(3.0, 0.1)]["stance_time"])
+    # another code's line is silent; the NaN literal is a bad line, named
+    (msg,) = [r.getMessage() for r in caplog.records]
+    assert msg.startswith(f"ignoring 1 bad line of {path} (line 2: non-standard JSON "
+                          "constant NaN)")
 
 
-def test_without_pymoo_the_error_names_the_extra(monkeypatch):
+_BAD_LINES = {
+    "row a number": lambda rec: json.dumps({**rec, "row": 5}),
+    "x of a string": lambda rec: json.dumps({**rec, "x": ["a", rec["x"][1]]}),
+    "objective a string": lambda rec: json.dumps(
+        {**rec, "row": {**rec["row"], "stance_time": "fast"}}),
+    "nested too deep": lambda rec: "[" * 100_000 + "]" * 100_000,
+    "not UTF-8": lambda rec: json.dumps({**rec, "code": "\xff"}, ensure_ascii=False),
+}
+
+
+@pytest.mark.parametrize("fault", [*_BAD_LINES, "torn"])
+def test_a_bad_stored_line_warns_once_naming_it_and_is_evaluated_again(tmp_path, caplog, fault):
+    spec = _spec(budget=8, population=4)
+    whole = tslip.design(spec, tmp_path, workers=1)
+    path = tmp_path / "evaluations.jsonl"
+    lines = path.read_text(encoding="utf-8").splitlines()
+    if fault == "torn":
+        data = ("\n".join(lines[:-1]) + "\n" + lines[-1][:30]).encode()
+        where = len(lines)
+    else:
+        bad = _BAD_LINES[fault](json.loads(lines[2]))
+        data = "\n".join([*lines[:2], bad, *lines[3:]]).encode("utf-8") + b"\n"
+        if fault == "not UTF-8":
+            data = data.replace("\xff".encode(), b"\xff")
+        where = 3
+    path.write_bytes(data)
+    with caplog.at_level("WARNING", logger="tslip"):
+        again = tslip.design(spec, tmp_path, workers=1)
+    msgs = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert len(msgs) == 1 and str(path) in msgs[0] and f"line {where}:" in msgs[0], msgs
+    assert again.meta["computed"] == 1 and again.frame.equals(whole.frame)
+
+
+def test_a_maximised_objective_is_a_negated_cost(tmp_path):
+    """The step-down limit is a robustness margin: the larger, the better. Of two designs
+    equal in their multiplier, the one that survives 0.10 dominates the one that survives
+    only 0.05 (and not the other way round)."""
+    from tslip.sweeps.pareto import _frame
+
+    spec = _spec(objectives=("max_multiplier", "step_down"))
+    rows = [{**_row(spec, 20.0, 0.5), "step_down": 0.05, "generation": 0},
+            {**_row(spec, 21.0, 0.5), "step_down": 0.10, "generation": 0},
+            {**_row(spec, 22.0, 0.4), "step_down": 0.02, "generation": 0}]
+    assert _frame(spec, rows)["front"].tolist() == [False, True, True]
+    # and a minimised objective is not negated: the smaller multiplier wins at equal limits
+    rows[2]["step_down"] = 0.10
+    assert _frame(spec, rows)["front"].tolist() == [False, False, True]
+
+
+@pytest.fixture
+def no_pymoo(monkeypatch):
     import builtins
 
     real = builtins.__import__
@@ -240,8 +304,22 @@ def test_without_pymoo_the_error_names_the_extra(monkeypatch):
         return real(name, *a, **kw)
 
     monkeypatch.setattr(builtins, "__import__", no_pymoo)
+
+
+def test_without_pymoo_the_error_names_the_extra(no_pymoo):
     with pytest.raises(ValueError, match=r"pip install 'tslip\[design\]'"):
         tslip.design(_spec())
+
+
+def test_without_pymoo_the_cli_refuses_before_drawing_or_writing_anything(tmp_path, no_pymoo):
+    from typer.testing import CliRunner
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC_TOML)
+    res = CliRunner().invoke(app, ["design", str(spec), "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2, res.output
+    assert res.output.strip() == "error: tslip design needs pymoo: pip install 'tslip[design]'"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]  # no o/, no o/.lock
 
 
 # -- results and the CLI -------------------------------------------------------
@@ -266,20 +344,74 @@ def test_result_saves_loads_and_has_units(tmp_path):
     assert g.params.k == res.front["k"].iloc[0] and g.converged
 
 
+SPEC_TOML = ('objectives = ["max_multiplier", "stance_time"]\nbudget = 8\n'
+             'population = 4\n[[variable]]\nparam = "k"\nfrom = 15\nto = 25\n')
+
+
 def test_cli_runs_a_spec_and_refuses_a_bad_one(tmp_path):
     from typer.testing import CliRunner
 
     runner = CliRunner()
     spec = tmp_path / "s.toml"
-    spec.write_text('objectives = ["max_multiplier", "stance_time"]\nbudget = 8\n'
-                    'population = 4\n[[variable]]\nparam = "k"\nfrom = 15\nto = 25\n')
+    spec.write_text(SPEC_TOML)
     r = runner.invoke(app, ["design", str(spec), "--out", str(tmp_path / "o"), "--workers", "1"])
     assert r.exit_code == 0, r.output
     assert "on the Pareto front" in r.output and (tmp_path / "o" / "front.png").exists()
+    assert "raised" not in r.output  # 8 is two whole generations of 4
     spec.write_text(spec.read_text().replace("budget = 8", "budget = 0"))
     r = runner.invoke(app, ["design", str(spec), "--out", str(tmp_path / "p")])
     assert r.exit_code == 2
     assert r.output.strip().count("\n") == 0 and "budget" in r.output
+
+
+@pytest.mark.parametrize(("budget", "said"), [
+    (3, "budget 3 is below the population 4: raised to one generation (4 evaluations)"),
+    (5, "budget 5 is not a whole number of generations of 4: raised to 2 generations "
+        "(8 evaluations)")])
+def test_cli_says_when_the_budget_is_raised_to_whole_generations(tmp_path, budget, said):
+    from typer.testing import CliRunner
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC_TOML)
+    r = CliRunner().invoke(app, ["design", str(spec), "--out", str(tmp_path / "o"),
+                                 "--workers", "1", "--budget", str(budget)])
+    assert r.exit_code == 0, r.output
+    assert said in " ".join(r.output.split())
+    assert len(tslip.load(tmp_path / "o" / "designs.parquet").frame) == -(-budget // 4) * 4
+
+
+def test_links_in_the_output_folder_are_never_written_through(tmp_path):
+    """``evaluations.jsonl`` a link: refused, its target (torn last line and all) intact;
+    ``front.csv`` and ``front.png`` links are replaced by files of their own."""
+    from typer.testing import CliRunner
+
+    precious = b"# ~/.profile\nexport A=1\nno newline"
+    home = tmp_path / "home"
+    home.mkdir()
+    for name in ("profile", "csv", "png"):
+        (home / name).write_bytes(precious)
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC_TOML)
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "evaluations.jsonl").symlink_to(home / "profile")
+    r = CliRunner().invoke(app, ["design", str(spec), "--out", str(out), "--workers", "1"])
+    assert r.exit_code == 2, r.output
+    assert r.stderr.strip() == (f"error: refusing to write through {out / 'evaluations.jsonl'}: "
+                                "it is a symbolic link; remove it or choose another output "
+                                "folder")
+    (out / "evaluations.jsonl").unlink()
+    (out / "front.csv").symlink_to(home / "csv")
+    (out / "front.png").symlink_to(home / "png")
+    r = CliRunner().invoke(app, ["design", str(spec), "--out", str(out), "--workers", "1"])
+    assert r.exit_code == 0, r.output
+    assert not (out / "front.csv").is_symlink() and not (out / "front.png").is_symlink()
+    assert all((home / n).read_bytes() == precious for n in ("profile", "csv", "png"))
+    (out / "gaits").rename(tmp_path / "g")
+    (out / "gaits").symlink_to(home)
+    r = CliRunner().invoke(app, ["design", str(spec), "--out", str(out), "--workers", "1"])
+    assert r.exit_code == 2 and "gaits: it is a symbolic link" in r.stderr
+    assert sorted(p.name for p in home.iterdir()) == ["csv", "png", "profile"]
 
 
 def test_the_shipped_example_spec_is_valid():

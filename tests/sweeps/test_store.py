@@ -3,6 +3,7 @@
 import json
 
 import pandas as pd
+import pytest
 
 import tslip
 from tslip.sweeps import Axis, StudySpec, _store, run_study
@@ -77,3 +78,35 @@ def test_another_configuration_has_its_own_file(tmp_path, monkeypatch):
     assert study_file(spec, tmp_path) != before
     assert run_study(spec, tmp_path, workers=1).meta["computed"] == spec.n_points
     assert before.exists()  # the old configuration's records stay
+
+
+_BAD = {
+    "nested too deep": lambda rec: b"[" * 100_000 + b"]" * 100_000,
+    "record a number": lambda rec: json.dumps({**rec, "record": 5}).encode(),
+    "a value a list": lambda rec: json.dumps(
+        {**rec, "record": {**rec["record"], "v0": ["a"]}}).encode(),
+    "key a number": lambda rec: json.dumps({**rec, "key": 5}).encode(),
+    "not UTF-8": lambda rec: json.dumps({**rec, "key": "X" + rec["key"]}).encode().replace(
+        b'"X', b'"\xff'),
+}
+
+
+@pytest.mark.parametrize("fault", [*_BAD, "torn"])
+def test_a_bad_line_warns_once_naming_it_and_its_point_is_recomputed(tmp_path, caplog, fault):
+    spec = _spec()
+    full = run_study(spec, tmp_path / "full", workers=1)
+    run_study(spec, tmp_path / "bad", workers=1)
+    path = study_file(spec, tmp_path / "bad")
+    lines = _lines(path)[:-1]
+    if fault == "torn":
+        data, where = b"\n".join(lines[:-1]) + b"\n" + lines[-1][:30], len(lines)
+    else:
+        lines[1] = _BAD[fault](json.loads(lines[1]))
+        data, where = b"\n".join(lines) + b"\n", 2
+    path.write_bytes(data)
+    with caplog.at_level("WARNING", logger="tslip"):
+        again = run_study(spec, tmp_path / "bad", workers=1)
+    msgs = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert len(msgs) == 1 and str(path) in msgs[0] and f"line {where}:" in msgs[0], msgs
+    assert again.meta["computed"] == 1 and again.meta["cached"] == spec.n_points - 1
+    _exact(full.frame, again.frame)

@@ -35,27 +35,32 @@ def design_cmd(
     """
     import dataclasses
 
+    from .._io import atomic_write
     from ..sweeps._lock import folder_lock
     from ..sweeps._warmup import announce
     from ..sweeps.design_spec import DesignSpec
-    from ..sweeps.pareto import design
+    from ..sweeps.pareto import budget_note, check_folder, design, require_pymoo
 
     console = make_console()
     with errors(), interruptible():
+        require_pymoo()  # refused before anything is drawn or written
         spec = DesignSpec.from_toml(spec_path)
         if budget is not None:
             spec = dataclasses.replace(spec, budget=budget)
         out_dir = out if out is not None else Path("designs") / spec.name
         check_output(out_dir / "run.json", "--out")
+        if (note := budget_note(spec)) is not None:
+            console.print(note, highlight=False)
         t0 = time.perf_counter()
         with folder_lock(out_dir):  # refused before the bar is drawn if another run writes it
-            pass
+            check_folder(out_dir)  # and a link where it would write
         with progress_bar("designs") as bar, announce(bar.console.print, ("simulation",)):
             task = bar.add_task(f"design {spec.name}", total=spec.generations * spec.population)
             res = design(spec, out_dir, workers=workers, scheduler=scheduler,
                          progress=lambda done, total: bar.update(task, completed=done))
         fig = res.plot()
-        fig.savefig(out_dir / "front.png", dpi=120)
+        atomic_write(out_dir / "front.png",  # a link there is replaced, never written through
+                     lambda tmp: fig.savefig(tmp, dpi=120, format="png"))
     f = res.frame
     console.print(f"{spec.name}: {len(f)} designs ({res.meta['reused']} reused), "
                   f"{int(f['feasible'].sum())} feasible, {len(res.front)} on the Pareto front, "

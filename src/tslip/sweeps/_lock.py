@@ -6,7 +6,10 @@ process ends, however it ends, so a crashed or killed run never blocks the
 next one: its lock is stale, and the next run takes it over (and says so
 in one line for all the folders it locks, naming the old pid). A run that
 ends normally empties the file. The file is never deleted: deleting a
-locked file lets two later runs lock two different files.
+locked file lets two later runs lock two different files. It is opened without
+following a link (:func:`tslip._safefile.open_below`): a ``.lock`` (or a folder
+below ``root``) that is a link is refused with one line, its target untouched
+and unread.
 """
 
 from __future__ import annotations
@@ -14,11 +17,14 @@ from __future__ import annotations
 import json
 import logging
 import os
+import re
 import socket
 import time
 from collections.abc import Iterable, Iterator
 from contextlib import AbstractContextManager, ExitStack, contextmanager
 from pathlib import Path
+
+from .._safefile import open_below
 
 try:
     import fcntl
@@ -35,12 +41,27 @@ class FolderLocked(ValueError):
 
 
 def _holder(fd: int) -> dict:
+    """The holder the file records: its pid, host and start, each only if it is one
+    (a file of other text names no holder and is never echoed)."""
     os.lseek(fd, 0, os.SEEK_SET)
     text = os.read(fd, 4096).decode(errors="replace").strip()
+    if not text:
+        return {}
     try:
-        return json.loads(text) if text else {}
-    except ValueError:
-        return {"pid": "?", "host": "?", "started": text[:40]}
+        rec = json.loads(text)
+    except (ValueError, RecursionError):
+        rec = None
+    if not isinstance(rec, dict):
+        return {"pid": "?", "host": "?", "started": "?"}
+    pid, host, started = rec.get("pid"), rec.get("host"), rec.get("started")
+    return {"pid": pid if isinstance(pid, int) and not isinstance(pid, bool) else "?",
+            "host": host if isinstance(host, str) and _HOST.fullmatch(host) else "?",
+            "started": started if isinstance(started, str) and _TIME.fullmatch(started)
+            else "?"}
+
+
+_HOST = re.compile(r"[A-Za-z0-9_.:-]{1,255}")
+_TIME = re.compile(r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d")
 
 
 def _describe(h: dict) -> str:
@@ -49,6 +70,9 @@ def _describe(h: dict) -> str:
 
 def folder_lock(folder: str | Path, *, wait: bool = False) -> AbstractContextManager[None]:
     """Hold ``folder/.lock`` for the block.
+
+    ``folder`` may itself be a link (the user named it); ``.lock`` may not
+    (:class:`tslip._safefile.UnsafePath`, a ValueError).
 
     Raises
     ------
@@ -60,13 +84,18 @@ def folder_lock(folder: str | Path, *, wait: bool = False) -> AbstractContextMan
 
 
 @contextmanager
-def folder_locks(folders: Iterable[str | Path], *, wait: bool = False) -> Iterator[None]:
+def folder_locks(folders: Iterable[str | Path], *, wait: bool = False,
+                 root: str | Path | None = None) -> Iterator[None]:
     """Hold every folder's lock for the block (:func:`folder_lock`); one warning line
-    names the stale locks taken over (a killed run of many studies left one in each)."""
+    names the stale locks taken over (a killed run of many studies left one in each).
+
+    ``root``, the output folder the folders lie in (default: each folder itself):
+    no folder below it is followed if it is a link."""
     stale: list[tuple[Path, str]] = []
     with ExitStack() as stack:
         for folder in folders:
-            stack.enter_context(_lock(Path(folder), wait, stale))
+            stack.enter_context(_lock(Path(folder), wait, stale,
+                                      Path(folder) if root is None else Path(root)))
         if stale:
             holders = sorted({who for _, who in stale})
             where = (str(stale[0][0]) if len(stale) == 1 else
@@ -77,10 +106,9 @@ def folder_locks(folders: Iterable[str | Path], *, wait: bool = False) -> Iterat
 
 
 @contextmanager
-def _lock(folder: Path, wait: bool, stale: list[tuple[Path, str]]) -> Iterator[None]:
+def _lock(folder: Path, wait: bool, stale: list[tuple[Path, str]], root: Path) -> Iterator[None]:
     """Hold ``folder/.lock``; a stale holder is added to ``stale``."""
-    folder.mkdir(parents=True, exist_ok=True)
-    fd = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
+    fd = open_below(root, folder / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
     try:
         if fcntl is not None:
             try:

@@ -12,11 +12,15 @@ workers of a run append to the same file without mixing their lines, and a
 point is saved the moment it is final. A write killed midway leaves a torn
 last line (no newline at its end): readers ignore it, and the next run (which
 holds the folder's lock) cuts it off before appending, so that point is
-computed again. Lines are data only, read with a strict JSON decoder: a line
-that is not an object of a string ``key`` and a ``record`` of numbers,
-strings, booleans and nulls is ignored (its point computed again), never
-evaluated. Records of another configuration (the code, the base parameters,
-the resolution changed) sit in another file: they are never read by this
+computed again. Lines are data only, read by the package's one strict reader
+(:func:`tslip._lines.read_lines`, schema :data:`SCHEMA`): a line that is not an
+object of a string ``key`` and a ``record`` of numbers, strings, booleans and
+nulls (not UTF-8, not JSON, nested too deep, another shape) is ignored with one
+warning naming the file and its lines, and its point computed again; nothing
+in it is evaluated. The file and ``cache/`` are opened without following a
+link (:mod:`tslip._safefile`): a link there is refused, never written through.
+Records of another configuration (the code, the base parameters, the
+resolution changed) sit in another file: they are never read by this
 configuration and never deleted, so changing a study back reuses them.
 """
 
@@ -27,22 +31,28 @@ import os
 from pathlib import Path
 from typing import Any
 
-__all__ = ["SUFFIX", "Writer", "read"]
+from .._lines import SCALAR, STRING, MapOf, Schema, read_lines
+from .._safefile import open_below
+
+__all__ = ["SCHEMA", "SUFFIX", "Writer", "read"]
 
 SUFFIX = ".jsonl"
-_DECODER = json.JSONDecoder()  # strict: plain JSON values, no hooks
-_SCALARS = (str, int, float, bool, type(None))
+#: A line of the store: a point's key and its record of plain values.
+SCHEMA = Schema({"key": STRING, "record": MapOf(SCALAR)})
 
 
 class Writer:
     """Appends records to ``path``, each as one line in one write; a context manager.
 
-    The file (and its folder) is opened on the first record and closed on
-    exit. ``path`` None keeps nothing (a study run without a folder).
+    The file (and its folders below ``root``, the output folder; default the
+    file's own folder) is opened on the first record, never through a link, and
+    closed on exit. ``path`` None keeps nothing (a study run without a folder).
     """
 
-    def __init__(self, path: str | Path | None) -> None:
+    def __init__(self, path: str | Path | None, root: str | Path | None = None) -> None:
         self.path = None if path is None else Path(path)
+        self.root = Path(root) if root is not None else (
+            None if self.path is None else self.path.parent)
         self._fd: int | None = None
 
     def add(self, key: str, record: dict[str, Any]) -> None:
@@ -51,8 +61,9 @@ class Writer:
             return
         line = (json.dumps({"key": key, "record": record}) + "\n").encode()
         if self._fd is None:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o666)
+            assert self.root is not None
+            self._fd = open_below(self.root, self.path,
+                                  os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o666)
         view = memoryview(line)
         while view:
             view = view[os.write(self._fd, view):]
@@ -66,39 +77,20 @@ class Writer:
             self._fd = None
 
 
-def read(path: str | Path, *, repair: bool = False) -> dict[str, dict[str, Any]]:
+def read(path: str | Path, *, repair: bool = False,
+         root: str | Path | None = None) -> dict[str, dict[str, Any]]:
     """The records in ``path`` by point key (empty if there is no file).
 
-    A torn last line is ignored; with ``repair`` (only by the run that holds
-    the folder's lock) it is also cut off the file, so the next append starts
-    a line of its own.
+    ``root`` is the output folder (default: the file's folder); nothing below it
+    is followed if it is a link. Bad lines are ignored with one warning; a torn
+    last line is ignored, and with ``repair`` (only by the run that holds the
+    folder's lock) also cut off the file, so the next append starts a line of
+    its own.
     """
-    try:
-        data = Path(path).read_bytes()
-    except FileNotFoundError:
-        return {}
-    *lines, torn = data.split(b"\n")
-    if torn and repair:
-        with open(path, "r+b") as fh:
-            fh.truncate(len(data) - len(torn))
+    path = Path(path)
     out: dict[str, dict[str, Any]] = {}
-    for raw in lines:
-        item = _decode(raw)
-        if item is not None:
-            out.setdefault(item[0], item[1])
+    what = ("its point is computed again", "their points are computed again")
+    for item in read_lines(path.parent if root is None else root, path, SCHEMA, repair=repair,
+                           constants=True, what=what):
+        out.setdefault(item["key"], item["record"])
     return out
-
-
-def _decode(raw: bytes) -> tuple[str, dict[str, Any]] | None:
-    """``(key, record)`` of one line, or None if it is not such a line."""
-    try:
-        item = _DECODER.decode(raw.decode("utf-8"))
-    except ValueError:  # UnicodeDecodeError is a ValueError too
-        return None
-    if not (isinstance(item, dict) and item.keys() == {"key", "record"}):
-        return None
-    key, rec = item["key"], item["record"]
-    if not (isinstance(key, str) and isinstance(rec, dict)
-            and all(isinstance(v, _SCALARS) for v in rec.values())):
-        return None
-    return key, rec

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import time
 from collections.abc import Callable, Sequence
 from contextlib import ExitStack
@@ -48,8 +49,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._codehash import code_hash
-from .._io import git_hash, write_json
+from .._io import git_hash, write_json, write_table
+from .._lines import BOOL, NUMBER, NUMBER_OR_NULL, STRING, ListOf, Schema, read_lines
 from .._results import FrameTable, Result, with_units
+from .._safefile import folder, open_below
 from ..model.units import param_unit
 from ._lock import folder_lock
 from ._schedule import Task, choose_workers, run_tasks
@@ -63,7 +66,8 @@ if TYPE_CHECKING:
     from ..gait.fixed_point import Gait
     from ..gait.robustness import Kind
 
-__all__ = ["DesignResult", "design", "evaluate", "pareto_mask"]
+__all__ = ["DesignResult", "budget_note", "check_folder", "design", "evaluate", "pareto_mask",
+           "require_pymoo", "store_schema"]
 
 #: ``progress(done, total)``: evaluations finished (cached ones included) of the budget.
 Progress = Callable[[int, int], None]
@@ -258,32 +262,40 @@ class DesignResult(FrameTable, Result):
 # ---------------------------------------------------------------------------
 
 
+def store_schema(spec: DesignSpec) -> Schema:
+    """A line of ``evaluations.jsonl``: the code hash, the candidate's values and its row
+    (the variables, the objectives (``null`` where not finite), ``feasible``,
+    ``violation``, ``reason``)."""
+    row = {**dict.fromkeys(spec.names, NUMBER), **dict.fromkeys(spec.objectives, NUMBER_OR_NULL),
+           "feasible": BOOL, "violation": NUMBER, "reason": STRING}
+    return Schema({"code": STRING, "x": ListOf(NUMBER, len(spec.names)), "row": Schema(row)})
+
+
 class _Store:
     """Evaluations as JSON lines: ``{"code": ..., "x": [...], "row": {...}}``.
 
-    Plain data, read with a strict decoder (no NaN literals in the text:
-    non-finite numbers are written as ``null``); lines that do not parse and lines
-    of other code are ignored, and a torn last line (no newline: a killed write)
-    is cut off the file, so the next evaluation appends on a line of its own.
+    Plain data, read by the package's one strict reader
+    (:func:`tslip._lines.read_lines`, schema :func:`store_schema`; no NaN literals in
+    the text: non-finite numbers are written as ``null``). Lines of other code are
+    ignored; a bad line (another shape, a wrong type, not JSON or UTF-8, too deep) is
+    ignored with one warning naming the file and line, its candidate evaluated again;
+    a torn last line (no newline: a killed write) is cut off the file, so the next
+    evaluation appends on a line of its own. The file is opened without following a
+    link (:mod:`tslip._safefile`): a link is refused, never written through.
     """
 
-    def __init__(self, path: Path | None, code: str) -> None:
+    def __init__(self, path: Path | None, code: str, spec: DesignSpec) -> None:
         self.path, self.code = path, code
         self.rows: dict[tuple[float, ...], dict[str, Any]] = {}
-        if path is not None and path.exists():
-            text = path.read_text(encoding="utf-8")
-            if not text.endswith("\n"):  # a torn last write: drop it, appends start clean
-                text = text[:text.rfind("\n") + 1]
-                with path.open("r+b") as fh:
-                    fh.truncate(len(text.encode("utf-8")))
-            for line in text.splitlines():
-                try:
-                    rec = json.loads(line, parse_constant=_refuse)
-                except ValueError:
-                    continue
-                if isinstance(rec, dict) and rec.get("code") == code:
-                    row = {k: (math.nan if v is None else v) for k, v in rec["row"].items()}
-                    self.rows[tuple(float(v) for v in rec["x"])] = row
+        if path is None:
+            return
+        recs = read_lines(path.parent, path, store_schema(spec), repair=True,
+                          skip=lambda rec: isinstance(rec, dict) and rec.get("code") != code,
+                          what=("its candidate is evaluated again",
+                                "their candidates are evaluated again"))
+        for rec in recs:
+            row = {k: (math.nan if v is None else v) for k, v in rec["row"].items()}
+            self.rows[tuple(float(v) for v in rec["x"])] = row
 
     def add(self, x: tuple[float, ...], row: dict[str, Any]) -> None:
         self.rows[x] = row
@@ -292,12 +304,13 @@ class _Store:
         clean = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
                  for k, v in row.items()}
         line = json.dumps({"code": self.code, "x": list(x), "row": clean}, allow_nan=False)
-        with self.path.open("a", encoding="utf-8") as fh:
-            fh.write(line + "\n")
-
-
-def _refuse(name: str) -> None:
-    raise ValueError(f"non-standard JSON constant {name}")
+        fd = open_below(self.path.parent, self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT)
+        try:
+            view = memoryview((line + "\n").encode("utf-8"))
+            while view:  # one write a line
+                view = view[os.write(fd, view):]
+        finally:
+            os.close(fd)
 
 
 # ---------------------------------------------------------------------------
@@ -305,12 +318,45 @@ def _refuse(name: str) -> None:
 # ---------------------------------------------------------------------------
 
 
-def _nsga2(spec: DesignSpec) -> Any:
+def require_pymoo() -> None:
+    """Raise the one-line ``ValueError`` of a missing ``design`` extra (pymoo), if it is."""
     try:
-        from pymoo.algorithms.moo.nsga2 import NSGA2
-        from pymoo.core.problem import Problem
+        import pymoo.algorithms.moo.nsga2  # noqa: F401
+        import pymoo.core.problem  # noqa: F401
     except ImportError:
         raise ValueError("tslip design needs pymoo: pip install 'tslip[design]'") from None
+
+
+def budget_note(spec: DesignSpec) -> str | None:
+    """A line saying how the budget was raised to whole generations, or None if it was not."""
+    used = spec.generations * spec.population
+    if used == spec.budget:
+        return None
+    if spec.budget < spec.population:
+        return (f"budget {spec.budget} is below the population {spec.population}: raised to "
+                f"one generation ({used} evaluations)")
+    return (f"budget {spec.budget} is not a whole number of generations of {spec.population}: "
+            f"raised to {spec.generations} generations ({used} evaluations)")
+
+
+def check_folder(out: Path) -> None:
+    """Refuse (:class:`tslip._safefile.UnsafePath`) an output folder whose
+    ``evaluations.jsonl`` or ``gaits/`` is a link, before any work (the CLI, before its bar)."""
+    try:
+        os.close(open_below(out, out / _STORE, os.O_RDONLY))
+    except FileNotFoundError:
+        pass
+    try:
+        folder(out, out / "gaits", create=False)
+    except FileNotFoundError:
+        pass
+
+
+def _nsga2(spec: DesignSpec) -> Any:
+    require_pymoo()
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+    from pymoo.core.problem import Problem
+
     n = len(spec.variables)
     problem = Problem(n_var=n, n_obj=len(spec.objectives), n_ieq_constr=1,
                       xl=np.zeros(n), xu=np.ones(n))
@@ -356,6 +402,7 @@ def design(
     out = None if out_dir is None else Path(out_dir)
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
+        check_folder(out)
     code = code_version()
     lo = np.array([v.lower for v in spec.variables])
     span = np.array([v.upper for v in spec.variables]) - lo
@@ -406,7 +453,7 @@ def design(
     with ExitStack() as stack:
         if out is not None:
             stack.enter_context(folder_lock(out))  # one run writes a folder at a time
-        store = _Store(None if out is None else out / _STORE, code)
+        store = _Store(None if out is None else out / _STORE, code, spec)
         first = advance()
         if first:
             n = choose_workers(_COST * total, workers, width=len(first))
@@ -441,9 +488,8 @@ def _write(result: DesignResult, out: Path) -> None:
     """The tables (all designs, the front), the front's gaits and the run record."""
     result.save(out / "designs.parquet")
     front = result.front
-    front.to_csv(out / "front.csv", index=False)
-    gaits = out / "gaits"
-    gaits.mkdir(exist_ok=True)
+    write_table(front, out / "front.csv")  # atomic: a link there is replaced, not written
+    gaits = folder(out, out / "gaits")  # a link there is refused
     for i, (_, row) in enumerate(front.iterrows()):
         _front_gait(result.spec, row).save(gaits / f"front-{i:03d}.json")
     write_json(out / "run.json", {"spec": result.spec.to_dict(), **result.meta,

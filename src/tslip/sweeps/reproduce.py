@@ -42,6 +42,7 @@ from typing import Any, Protocol
 
 from .._codehash import code_hash
 from .._io import atomic_write
+from .._safefile import folder
 from ..gait import find_gait, floquet, robustness_report, stride_properties
 from ..gait.fixed_point import Gait, GaitProblem, newton_solve
 from ..gait.robustness import robustness
@@ -506,7 +507,8 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
     if scheduler is None and workers != 1:  # likely parallel: the workers' imports start now
         _pool.prestart(preload)
         warm_in_background(("biped",))  # on the other core, while the fork server warms
-    with folder_locks(out / "studies" / name for name in specs):
+    with folder_locks((out / "studies" / name for name in specs), root=out):
+        folder(out, out / "figures")  # the report's figures: a link there is refused
         jobs = {name: StudyJob(spec, out / "studies" / name, writes=scheduler is None)
                 for name, spec in specs.items()}
 

@@ -45,7 +45,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
-from .. import __version__
+from .. import __version__, _safefile
 from .._io import git_hash, write_json, write_table
 from .._results import FrameTable, Result, with_units
 from ..gait.continuation import get_param
@@ -136,12 +136,22 @@ def study_file(spec: StudySpec, out_dir: str | Path) -> Path:
     return Path(out_dir) / "cache" / name
 
 
+def _writer(cache: str | Path | None) -> _store.Writer:
+    """The appender of a study file (:func:`study_file`): nothing below the study
+    folder (``cache/``, the file) is followed if it is a link."""
+    return _store.Writer(cache, root=None if cache is None else Path(cache).parent.parent)
+
+
 def _cached_names(cache: Path | None) -> set[str]:
     """File names in the cache; removes temporary files of interrupted writes.
 
     (The viability runner's chunk files; a study's points are in :func:`study_file`.)
     """
-    if cache is None or not cache.is_dir():
+    if cache is None:
+        return set()
+    try:  # a link in its place is refused: never list or delete another folder's files
+        _safefile.folder(cache.parent, cache, create=False)
+    except FileNotFoundError:
         return set()
     names = set()
     for entry in os.scandir(cache):
@@ -154,7 +164,7 @@ def _cached_names(cache: Path | None) -> set[str]:
 
 def saved_points(spec: StudySpec, out_dir: str | Path) -> int:
     """How many of the study's points ``out_dir/cache`` holds."""
-    stored = _store.read(study_file(spec, out_dir))
+    stored = _store.read(study_file(spec, out_dir), root=out_dir)
     return sum(k in stored for _, _, keys in study_keys(spec) for k in keys)
 
 
@@ -169,7 +179,7 @@ def _solve_task(spec: StudySpec, assignment: dict[str, float], values: list[floa
                 tick: Callable[[int], None] | None = None) -> Solved:
     """Find one line's gaits; its points without a gait are cached as final (in workers)."""
     tick = tick or _pool.notify
-    with _store.Writer(cache) as writer:
+    with _writer(cache) as writer:
 
         def emit(i: int, rec: dict[str, Any]) -> None:
             _save(writer, keys[i], rec)
@@ -183,7 +193,7 @@ def _analyse_task(spec: StudySpec, items: list[Pending], keys: list[str], cache:
     """Analyse solved points, caching each record as it is final (in workers)."""
     tick = tick or _pool.notify
     out = []
-    with _store.Writer(cache) as writer:
+    with _writer(cache) as writer:
         for item, key in zip(items, keys):
             rec = analyse_point(spec, item)
             _save(writer, key, rec)
@@ -340,7 +350,8 @@ class StudyJob:
         self.progress = progress
         self.n_total = spec.n_points
         # this run holds the folder's lock: a line torn by a killed run is cut off
-        stored = _store.read(self.cache, repair=True) if self.cache is not None else {}
+        stored = (_store.read(self.cache, repair=True, root=out)
+                  if self.cache is not None and out is not None else {})
         self.records: list[list[dict[str, Any] | None]] = [
             [stored.get(k) for k in keys] for _, _, keys in self.plan]
         n_cached = sum(r is not None for line in self.records for r in line)
@@ -438,7 +449,7 @@ class StudyJob:
         if self.writes:
             return
         if self.cache is not None:
-            with _store.Writer(self.cache) as writer:
+            with _writer(self.cache) as writer:
                 for k, r in fresh:
                     _save(writer, k, r)
         self.tick(len(fresh))
