@@ -11,8 +11,10 @@ import tomllib
 
 import pandas as pd
 import pytest
+from typer.testing import CliRunner
 
 import tslip
+from tslip.cli.main import app
 from tslip.simulation.result import TRAJECTORY_COLUMNS
 
 from .conftest import START_TIMEOUT, free_port, get, stop
@@ -173,3 +175,18 @@ def test_another_host_warns_and_takes_websockets_only_from_that_host_and_port(tm
 
 def test_the_default_host_does_not_warn(server):
     assert "warning" not in server.text()
+
+
+def test_the_help_names_the_extra_to_install():
+    """rich reads ``[explore]`` as markup unless it is escaped, and printed ``tslip``."""
+    result = CliRunner().invoke(app, ["explore", "--help"], env={"COLUMNS": "120"})
+    assert result.exit_code == 0
+    assert 'pip install "tslip[explore]"' in result.output
+
+
+@pytest.mark.parametrize("name", ["http://box.lan", "box.lan/", "", "a b"])
+def test_a_bad_allow_host_is_one_line_and_exit_2(name):
+    result = CliRunner().invoke(app, ["explore", "--no-open", "--allow-host", name])
+    assert result.exit_code == 2
+    want = f"error: --allow-host must be a host name or name:port, got {name!r}"
+    assert result.output.strip() == want

@@ -16,7 +16,6 @@ from those origins (a page from another origin). ``/export/params.toml`` and
 from __future__ import annotations
 
 import asyncio
-import gc
 import ipaddress
 import logging
 import signal
@@ -128,7 +127,7 @@ class _Export(RequestHandler):
             self._fail(400, "; ".join(errors))
             return
         try:
-            solved = await asyncio.wrap_future(_EXPORTS.submit(compute.solve, state.params))
+            solved = await asyncio.wrap_future(_exports().submit(compute.solve, state.params))
         except Exception as exc:  # noqa: BLE001 - reported, logged, the server goes on
             log.exception("tslip explore: export failed")
             self._fail(500, f"{type(exc).__name__}: {exc}")
@@ -152,14 +151,16 @@ class _Export(RequestHandler):
         self.finish(f"error: {message}\n")
 
 
-def _exports_lane() -> Any:
-    from .workers import Lane
-
-    return Lane("tslip-exports")
-
-
 #: The export routes' gait searches (a daemon thread: a stopping server does not wait).
-_EXPORTS: Any = None
+_EXPORTS: list[Any] = []
+
+
+def _exports() -> Any:
+    if not _EXPORTS:
+        from .workers import Lane
+
+        _EXPORTS.append(Lane("tslip-exports"))
+    return _EXPORTS[0]
 
 
 def make_server(port: int, host: str = LOOPBACK, allow_hosts: Iterable[str] = ()) -> object:
@@ -174,9 +175,6 @@ def make_server(port: int, host: str = LOOPBACK, allow_hosts: Iterable[str] = ()
 
     from .app import make_document
 
-    global _EXPORTS
-    if _EXPORTS is None:
-        _EXPORTS = _exports_lane()
     hosts = allowed_hosts(host, port, allow_hosts)
     server = Server(
         {"/": Application(FunctionHandler(make_document))},
@@ -232,10 +230,6 @@ def serve(port: int = 5006, host: str = LOOPBACK, open_browser: bool = True,
     finally:
         _shut_down(server)
     echo("tslip explore: stopped")
-    # what is left lives until the process ends: without this the collector's last pass
-    # over numba's and Bokeh's objects at exit took 2-3 s (measured under load), and the
-    # server (with the resource tracker it started) outlived its "stopped" by that much
-    gc.freeze()
 
 
 def _shut_down(server: Any) -> None:
