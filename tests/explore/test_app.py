@@ -10,7 +10,7 @@ import pytest
 from bokeh.document import Document
 
 import tslip
-from tslip.explore import app, compute
+from tslip.explore import app, compute, workers
 from tslip.explore.state import parse_query
 
 
@@ -47,7 +47,7 @@ def held(monkeypatch):
         return solve(params)
 
     monkeypatch.setattr(compute, "solve", slow)
-    monkeypatch.setattr(app, "_limit_in_process", compute.limit)
+    monkeypatch.setattr(workers, "limit", compute.limit)
     return release
 
 
@@ -78,7 +78,7 @@ def test_a_newer_move_replaces_an_older_one(held):
 
 
 def test_an_exception_in_the_work_is_shown_and_the_page_goes_on(monkeypatch):
-    monkeypatch.setattr(app, "_limit_in_process", compute.limit)
+    monkeypatch.setattr(workers, "limit", compute.limit)
     solve = compute.solve
     calls = []
 
@@ -101,7 +101,7 @@ def test_the_limits_are_drawn_whatever_order_the_posted_callbacks_run_in(monkeyp
     """Callbacks posted before a page's session exists run in any order (Bokeh keeps them in
     a set): here all the work posted while nothing is drawn runs newest first, and the
     limits still end up shown, not hidden by their gait's "updating"."""
-    monkeypatch.setattr(app, "_limit_in_process", compute.limit)
+    monkeypatch.setattr(workers, "limit", compute.limit)
     page = Page({"preset": "table6.1"})
     deadline = time.monotonic() + 60
     while not page.calls and time.monotonic() < deadline:
@@ -110,4 +110,38 @@ def test_the_limits_are_drawn_whatever_order_the_posted_callbacks_run_in(monkeyp
     page.until(lambda: page.ex.limit_text.text.startswith("robustness limits (25"),
                timeout=30, newest_first=True)
     page.until(lambda: len(page.ex.frames_src.data["t"]) > 10)
+    page.ex.close()
+
+
+def test_a_negative_fraction_sent_by_the_page_is_refused_and_the_runner_kept(monkeypatch):
+    """A slider cannot go below 0; a crafted message can. Refused in plain words (no class
+    name), the runner's disturbance is not turned around; 0 is accepted."""
+    monkeypatch.setattr(workers, "limit", compute.limit)
+    page = Page({"preset": "table6.1", "disturbance": "step_down"})
+    page.until(lambda: "at the 2nd touch-down" in page.ex.strip_text.text)
+    runner = page.ex.strip_text.text
+    page.ex.fraction.value = -0.5
+    page.until(lambda: page.ex.error.text != "")
+    assert page.ex.error.text == "fraction [-] must be in [0, 2], got -0.5"
+    time.sleep(0.5)
+    page.until(lambda: not page.calls)
+    assert page.ex.strip_text.text == runner  # no run with the step turned into a step up
+    page.ex.fraction.value = 0.0
+    page.until(lambda: page.ex.strip_text.text != runner)
+    assert float(page.ex.strip_text.text.split()[2]) == 0.0  # "step_down of 0 at ..."
+    assert page.ex.error.text == ""
+    page.ex.close()
+
+
+def test_a_binding_retraction_stop_is_a_plain_message_and_one_log_line(caplog):
+    """alpha_stop = 1.0 rad binds at the Table 6.1 gait (Section 7.5): the search refuses
+    it, and the page says why in the error line, without the exception's class name."""
+    caplog.set_level("INFO", logger="tslip.explore")
+    page = Page({"preset": "table6.1", "alpha_stop": "1.0"})
+    page.until(lambda: page.ex.error.text != "")
+    assert page.ex.error.text.startswith("no gait: alpha_stop binds at the periodic gait")
+    assert "Error" not in page.ex.error.text
+    assert page.ex.status.text == page.ex.error.text and page.ex.mult_text.text == "no gait"
+    records = [r for r in caplog.records if "alpha_stop binds" in r.getMessage()]
+    assert len(records) == 1 and records[0].exc_info is None
     page.ex.close()

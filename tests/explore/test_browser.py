@@ -117,6 +117,30 @@ def check_the_runner_plays(page) -> None:
     frame = page.evaluate(f"() => {{ const d = ({_MODEL})('runner_frames').data;"
                           " return [d.hip_x[5], d.com_x[5], d.foot_x[5]]; }")
     assert page.evaluate(pose) == pytest.approx(frame, abs=0)
+    n = page.evaluate(f"() => ({_MODEL})('runner_frames').get_length()")
+    assert n > 60  # six strides at 30 frames a second, a quarter of real time
+    first, later = drawn_frame(page, 5), drawn_frame(page, n // 2)
+    for i, d in ((5, first), (n // 2, later)):
+        # one frame's polylines: the spring from hip to foot has 17 points (hip, the 2 x 7
+        # + 1 points of its seven coils, foot: tslip animate's drawing), the trunk axis and
+        # the force arrow two; the run's n frames would have n times as many
+        assert len(d["leg"]["x"]) == len(d["leg"]["y"]) == 2 * 7 + 3, i
+        assert len(d["axis"]["x"]) == len(d["grf"]["x"]) == 2, i
+        assert (d["leg"]["x"][0], d["leg"]["x"][-1]) == (d["hip_x"], d["foot_x"]), i
+        assert (d["leg"]["y"][0], d["leg"]["y"][-1]) == (d["hip_y"], d["foot_y"]), i
+    assert first["leg"] != later["leg"] and first["axis"] != later["axis"]
+
+
+def drawn_frame(page, i: int) -> dict:
+    """What the runner's plot draws at frame ``i`` (its data sources), and the frame's joints."""
+    set_value(page, "runner_frame", i)
+    return page.evaluate(f"""(i) => {{
+        const src = (name) => {{ const d = ({_MODEL})(name).data;
+                                 return {{x: Array.from(d.x), y: Array.from(d.y)}}; }};
+        const f = ({_MODEL})('runner_frames').data;
+        return {{leg: src('runner_leg'), axis: src('runner_axis'), grf: src('runner_grf'),
+                 hip_x: f.hip_x[i], hip_y: f.hip_y[i], foot_x: f.foot_x[i],
+                 foot_y: f.foot_y[i]}}; }}""", i)
 
 
 @pytest.mark.parametrize("bad", ["-1", "nan", "abc", "1e999"])

@@ -51,6 +51,25 @@ def test_a_step_down_lowers_the_ground_after_the_second_touchdown(table61):
 def test_magnitude_is_the_fraction_of_a_finite_limit():
     assert compute.magnitude(-0.12, 0.5) == pytest.approx(-0.06)
     assert compute.magnitude(-np.inf, 0.5) == 0.0
+    assert compute.magnitude(-0.12, 0.0) == 0.0
+
+
+def test_magnitude_refuses_a_negative_fraction_that_would_turn_the_disturbance_around():
+    with pytest.raises(ValueError, match="fraction"):
+        compute.magnitude(-0.12, -0.5)  # +0.06: a step up, not a step down
+    with pytest.raises(ValueError, match="fraction"):
+        compute.magnitude(-0.12, np.nan)
+
+
+def test_a_search_that_refuses_the_parameters_is_a_refused_solve_not_an_exception():
+    """alpha_stop = 1.0 rad binds at the Table 6.1 gait (alpha_TD about 1.22, Section 7.5)."""
+    p = dataclasses.replace(tslip.preset("table6.1"), alpha_stop=1.0)
+    with pytest.raises(ValueError, match="alpha_stop binds"):
+        tslip.find_gait(p)  # what the page and the exports meet
+    solved = compute.solve(p)
+    assert solved.refused and not solved.ok and solved.gait is None
+    assert solved.message.startswith("no gait: alpha_stop binds at the periodic gait")
+    assert not compute.solve(tslip.preset("table6.1")).refused
 
 
 def test_limits_stop_between_searches_when_asked(table61):

@@ -115,3 +115,20 @@ def test_floats_survive_the_query_exactly():
     back, _ = parse_query(dict(parse_qsl(ExploreState("table2.1", p).query())))
     assert back.params.v0 == math.pi
     assert isinstance(back.params, Params)
+
+
+@pytest.mark.parametrize(("value", "ok"), [
+    (math.nextafter(0.0, -1.0), False), (-0.05, False), (0.0, True), (0.05, True),
+    (2.0, True), (math.nextafter(2.0, 3.0), False)])
+def test_the_fraction_is_refused_on_each_side_of_0_to_2(value, ok):
+    """A negative fraction would turn the runner's disturbance the other way (the limit's
+    sign is its direction): refused from the URL and by the state itself."""
+    state, errors = parse_query({"preset": "table6.1", "fraction": repr(value)})
+    if ok:
+        assert errors == [] and state.fraction == value
+        assert ExploreState("table6.1", preset("table6.1"), "push", value).fraction == value
+    else:
+        assert len(errors) == 1 and errors[0].startswith("fraction [-] must be in [0, 2]")
+        assert state.fraction == 0.5  # the default kept
+        with pytest.raises(ValueError, match=r"fraction \[-\] must be in \[0, 2\]"):
+            ExploreState("table6.1", preset("table6.1"), "push", value)

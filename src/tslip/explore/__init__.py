@@ -9,13 +9,20 @@ state and URL query are data parsed with the validators of
 ``import tslip.explore`` loads neither Bokeh nor the kernels.
 """
 
+from collections.abc import Iterable
+
 from .state import CONTROLS, GAINS, ExploreState, parse_query
 
 __all__ = ["CONTROLS", "GAINS", "ExploreState", "parse_query", "serve"]
 
 
-def serve(port: int = 5006, host: str = "127.0.0.1", open_browser: bool = True) -> None:
-    """Serve the explorer at ``http://host:port/`` until Ctrl-C (:func:`.server.serve`)."""
+def serve(port: int = 5006, host: str = "127.0.0.1", open_browser: bool = True,
+          allow_hosts: Iterable[str] = ()) -> None:
+    """Serve the explorer at ``http://host:port/`` until Ctrl-C or SIGTERM (:func:`.server.serve`).
+
+    ``allow_hosts``: further names (``name`` or ``name:port``) it answers for; a
+    request naming any other host gets 403 (:func:`.server.allowed_hosts`).
+    """
     from .server import serve as _serve
 
-    _serve(port, host, open_browser)
+    _serve(port, host, open_browser, allow_hosts=allow_hosts)

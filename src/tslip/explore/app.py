@@ -5,7 +5,10 @@ thread) and the page draws it, its Floquet multipliers, then the robustness
 limits ("updating" meanwhile) and the runner after the chosen disturbance.
 A newer change makes the older work stop at its next step (a generation
 counter). Every callback is guarded: an exception is logged and shown in the
-page, and the server goes on.
+page, and the server goes on; a refused input (a ValueError: a value out of
+range, a retraction stop the gait search refuses) is shown as its message and
+logged in one line. The work runs in daemon threads and the limits in a worker
+process that dies with the server (:mod:`.workers`).
 """
 
 from __future__ import annotations
@@ -15,10 +18,8 @@ import html
 import logging
 import math
 import threading
+import weakref
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
-from multiprocessing import get_context
 from typing import Any
 
 import numpy as np
@@ -31,19 +32,21 @@ from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 
 from ..model.parameters import Params, preset
-from . import compute
+from . import compute, workers
 from .state import (
     CLOCKS,
     CONTROLS,
     DISTURBANCES,
+    FRACTION,
     GAINS,
     PRESETS,
     STOP,
     ExploreState,
+    check_fraction,
     control_for,
 )
 
-__all__ = ["make_document", "COMPILING", "kernels_cold"]
+__all__ = ["make_document", "COMPILING", "kernels_cold", "close_pages"]
 
 log = logging.getLogger("tslip.explore")
 
@@ -67,26 +70,14 @@ def kernels_cold() -> bool:
         return False
 
 
-#: The worker process of the robustness searches (made on first use). numba's kernels
-#: hold the GIL, so in a thread a search would stall the server's event loop (and the
-#: next gait's redraw) for its whole second; one process for all pages keeps them apart.
-_LIMIT_PROCESS: list[ProcessPoolExecutor] = []
-_LIMIT_LOCK = threading.Lock()
+#: The pages open in this process (:func:`close_pages`).
+_PAGES: weakref.WeakSet[Explorer] = weakref.WeakSet()
 
 
-def _limit_in_process(gait: Any, kind: str) -> float:
-    """:func:`compute.limit` in the worker process (a new one if the old one died)."""
-    with _LIMIT_LOCK:
-        if not _LIMIT_PROCESS:
-            _LIMIT_PROCESS.append(ProcessPoolExecutor(1, mp_context=get_context("spawn")))
-        pool = _LIMIT_PROCESS[0]
-    try:
-        return pool.submit(compute.limit, gait, kind).result()
-    except BrokenProcessPool:
-        with _LIMIT_LOCK:
-            if _LIMIT_PROCESS and _LIMIT_PROCESS[0] is pool:
-                _LIMIT_PROCESS.clear()
-        raise
+def close_pages() -> None:
+    """Stop every page's work (the server is stopping)."""
+    for page in list(_PAGES):
+        page.close()
 
 
 #: The retraction stop's choices: none (``alpha_stop = None``), or at the slider's angle.
@@ -110,9 +101,10 @@ class Explorer:
         self.doc = doc
         self.generation = 0
         self.lock = threading.Lock()
-        self.gait_pool = ThreadPoolExecutor(1, thread_name_prefix="tslip-gait")
-        self.limit_pool = ThreadPoolExecutor(1, thread_name_prefix="tslip-limits")
-        self.map_pool = ThreadPoolExecutor(1, thread_name_prefix="tslip-map")
+        self.gait_pool = workers.Lane("tslip-gait")
+        self.limit_pool = workers.Lane("tslip-limits")
+        self.map_pool = workers.Lane("tslip-map")
+        _PAGES.add(self)
         self.map_cancel = threading.Event()
         self.solved: compute.Solved | None = None
         self.limits: dict[str, float] | None = None
@@ -145,8 +137,8 @@ class Explorer:
             self.sliders[name] = self._slider(name, float(value))
         self.kind = Select(title="disturbance at the 2nd touch-down", value=state.disturbance,
                            options=_options(DISTURBANCES), name="disturbance")
-        self.fraction = Slider(title="magnitude [fraction of its limit]", start=0.0, end=2.0,
-                               step=0.05, value=state.fraction, name="fraction")
+        self.fraction = Slider(title="magnitude [fraction of its limit]", start=FRACTION[0],
+                               end=FRACTION[1], step=0.05, value=state.fraction, name="fraction")
         self.link = Div(text="", name="permalink")
         replace_url = CustomJS(args={"div": self.link}, code=_REPLACE_URL)
         self.link.js_on_change("text", replace_url)
@@ -211,8 +203,8 @@ class Explorer:
         self.path_src = ColumnDataSource({"x": [], "y": []})
         self.ground_src = ColumnDataSource({"x": [], "y": []}, name="runner_ground")
         self.leg_src = ColumnDataSource({"x": [], "y": []}, name="runner_leg")
-        self.axis_src = ColumnDataSource({"x": [], "y": []})
-        self.grf_src = ColumnDataSource({"x": [], "y": []})
+        self.axis_src = ColumnDataSource({"x": [], "y": []}, name="runner_axis")
+        self.grf_src = ColumnDataSource({"x": [], "y": []}, name="runner_grf")
         self.body_src = ColumnDataSource({"x": [], "y": [], "w": [], "h": [], "angle": []})
         self.joint_src = ColumnDataSource({"x": [], "y": [], "fill": []}, name="runner_pose")
         fig = figure(title="runner after the disturbance", width=860, height=260,
@@ -276,7 +268,7 @@ class Explorer:
             self.generation += 1
         self.map_cancel.set()
         for pool in (self.gait_pool, self.limit_pool, self.map_pool):
-            pool.shutdown(wait=False, cancel_futures=True)
+            pool.shutdown()
 
     # -- guards and threads --------------------------------------------------
     def _guard(self, fn: Callable[..., None]) -> Callable[..., None]:
@@ -285,26 +277,25 @@ class Explorer:
             try:
                 fn(*args)
             except Exception as exc:  # noqa: BLE001 - shown in the page, logged, server goes on
-                log.exception("tslip explore: %s", exc)
-                self.show_errors([f"{type(exc).__name__}: {exc}"])
+                self.show_errors([_report(exc)], logged=True)
         return run
 
     def _post(self, fn: Callable[..., None], *args: Any) -> None:
         """Run ``fn(*args)`` on the document's thread (guarded)."""
         self.doc.add_next_tick_callback(functools.partial(self._guard(fn), *args))
 
-    def _background(self, pool: ThreadPoolExecutor, fn: Callable[..., None], *args: Any) -> None:
+    def _background(self, pool: workers.Lane, fn: Callable[..., None], *args: Any) -> None:
         def run() -> None:
             try:
                 fn(*args)
-            except Exception as exc:  # noqa: BLE001
-                log.exception("tslip explore: %s", exc)
-                self._post(self.show_errors, [f"{type(exc).__name__}: {exc}"])
+            except Exception as exc:  # noqa: BLE001 - shown in the page, logged
+                self._post(self.show_errors, [_report(exc)], True)
         pool.submit(run)
 
-    def show_errors(self, errors: list[str]) -> None:
-        """Show ``errors`` in the page (and log them); an empty list clears the line."""
-        for e in errors:
+    def show_errors(self, errors: list[str], logged: bool = False) -> None:
+        """Show ``errors`` in the page (and log them, one line each, unless ``logged``);
+        an empty list clears the line."""
+        for e in errors if not logged else ():
             log.warning("tslip explore: %s", e)
         self.error.text = "<br>".join(html.escape(e) for e in errors)
 
@@ -375,6 +366,8 @@ class Explorer:
             self.request()
 
     def _on_fraction(self, attr: str, old: Any, new: Any) -> None:
+        check_fraction(float(new))  # a crafted message can send any number
+        self.show_errors([])
         self._update_link()
         if self.solved is not None and self.solved.gait is not None and self.limits:
             self._background(self.limit_pool, self._runner, self.generation, self.solved.gait,
@@ -424,14 +417,14 @@ class Explorer:
         self._post(self._draw_gait, gen, solved)
 
     def _limits(self, gen: int, gait: Any) -> None:
-        lim = compute.limits(gait, stop=lambda: self.stale(gen), run=_limit_in_process)
+        lim = compute.limits(gait, stop=lambda: self.stale(gen), run=workers.limit)
         if lim is None or self.stale(gen):
             return
         self._post(self._draw_limits, gen, lim)
         self._runner(gen, gait, lim)
 
     def _runner(self, gen: int, gait: Any, lim: dict[str, float]) -> None:
-        kind, frac = self.kind.value, float(self.fraction.value)
+        kind, frac = self.kind.value, check_fraction(float(self.fraction.value))
         mag = compute.magnitude(lim[kind], frac)
         traj = compute.disturbed_run(gait, kind, mag)
         frames, ground = compute.runner_frames(traj), compute.ground(traj)
@@ -442,6 +435,8 @@ class Explorer:
         if self.stale(gen):
             return
         self.solved, self.limits = solved, None
+        if solved.refused:  # the search refused the parameters: said in the error line
+            self.show_errors([solved.message])
         if not solved.ok:
             for src in (self.gait_src, self.mult_src, self.pose_src, self.frames_src,
                         self.path_src, self.ground_src):
@@ -577,6 +572,16 @@ class Explorer:
         self.request()
 
 
+def _report(exc: Exception) -> str:
+    """Log ``exc`` and return its text for the page: a refused input (a ValueError) as its
+    message in one log line; anything else with its class name, its traceback logged."""
+    if isinstance(exc, ValueError):
+        log.warning("tslip explore: %s", exc)
+        return str(exc)
+    log.error("tslip explore: %s", exc, exc_info=exc)
+    return f"{type(exc).__name__}: {exc}"
+
+
 def _options(names: Any) -> list[Any]:
     """A Select's options (Bokeh's stubs want a list of str or pairs)."""
     return list(names)
@@ -619,9 +624,11 @@ function show(i) {
     label.setv({text: ''}, quiet);
     return;
   }
-  const line = (col) => {  // row i of an (n, m) array
-    const a = d[col], m = a.length / n;
-    return Array.from(a.subarray(i * m, (i + 1) * m));
+  const line = (col) => {  // row i of an (n, m) array, copied element by element: on
+    // Bokeh's typed array class (3.9.2) subarray() returns the whole array, every frame
+    const a = d[col], m = a.length / n, out = new Array(m);
+    for (let j = 0; j < m; j++) out[j] = a[i * m + j];
+    return out;
   };
   leg.setv({data: {x: line('leg_x'), y: line('leg_y')}}, quiet);
   axis.setv({data: {x: line('axis_x'), y: line('axis_y')}}, quiet);

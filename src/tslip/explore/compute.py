@@ -23,6 +23,7 @@ from ..model.parameters import Params
 from ..simulation import Disturbance, Trajectory, simulate
 from ..sweeps import Axis, StudyResult, StudySpec, run_study
 from ..sweeps.point import Pending, analyse_point, gait_tol
+from .state import check_fraction
 
 __all__ = ["Solved", "solve", "limit", "limits", "disturbed_run", "stability_map", "MapCancelled",
            "params_toml", "trajectory_parquet", "FIELDS", "FRESH", "magnitude", "unit_circle",
@@ -40,6 +41,9 @@ class Solved:
     floquet: Floquet | None
     trajectory: Trajectory | None
     message: str
+    #: The gait search refused the parameters (a ValueError, e.g. a binding ``alpha_stop``):
+    #: ``message`` says why, and the page and the exports show it as a refused input.
+    refused: bool = False
 
     @property
     def ok(self) -> bool:
@@ -48,8 +52,15 @@ class Solved:
 
 
 def solve(params: Params, n_steps: int = 2) -> Solved:
-    """The periodic gait of ``params`` (Section 2.8), its multipliers and ``n_steps`` strides."""
-    gait = find_gait(params)
+    """The periodic gait of ``params`` (Section 2.8), its multipliers and ``n_steps`` strides.
+
+    A search that refuses ``params`` (a ValueError: a retraction stop that binds at
+    the periodic gait, Section 7.5) is a :class:`Solved` with ``refused`` set.
+    """
+    try:
+        gait = find_gait(params)
+    except ValueError as exc:
+        return Solved(None, None, None, f"no gait: {exc}", refused=True)
     if not gait.converged:
         return Solved(gait, None, None, f"no gait: {gait.message}")
     fl = floquet(gait)
@@ -133,7 +144,12 @@ def ground(traj: Trajectory) -> tuple[np.ndarray, np.ndarray]:
 
 
 def magnitude(limit: float, fraction: float) -> float:
-    """The disturbance ``fraction`` of a signed ``limit``; 0 for an infinite or missing one."""
+    """The disturbance ``fraction`` of a signed ``limit``; 0 for an infinite or missing one.
+
+    Raises ValueError for a ``fraction`` outside [0, 2] (:func:`.state.check_fraction`):
+    a negative one would turn the disturbance the other way.
+    """
+    check_fraction(fraction)
     return fraction * limit if math.isfinite(limit) else 0.0
 
 

@@ -26,8 +26,8 @@ from ..model.parameters import (
     presets,
 )
 
-__all__ = ["Control", "CONTROLS", "GAINS", "STOP", "DISTURBANCES", "ExploreState",
-           "parse_query", "control_for"]
+__all__ = ["Control", "CONTROLS", "GAINS", "STOP", "DISTURBANCES", "FRACTION", "ExploreState",
+           "check_fraction", "parse_query", "control_for"]
 
 #: The disturbance kinds of the runner strip (thesis Section 3.1.3).
 DISTURBANCES: tuple[str, ...] = ("step_down", "push", "pitch_rate")
@@ -130,6 +130,9 @@ class ExploreState:
     disturbance: str = "push"
     fraction: float = 0.5
 
+    def __post_init__(self) -> None:
+        check_fraction(self.fraction)
+
     def query(self) -> str:
         """The URL query of this state (only what differs from nothing: every control)."""
         p = self.params
@@ -144,6 +147,19 @@ class ExploreState:
         out["disturbance"] = self.disturbance
         out["fraction"] = repr(float(self.fraction))
         return urlencode(out)
+
+
+#: The disturbance's magnitude as a fraction of its limit: [0, 2] (a negative fraction
+#: would flip the disturbance's direction, the limit's sign being the direction searched).
+FRACTION = (0.0, 2.0)
+
+
+def check_fraction(value: float) -> float:
+    """``value`` if it is a fraction in :data:`FRACTION`, else a ValueError naming it."""
+    lo, hi = FRACTION
+    if not lo <= value <= hi:  # also refuses NaN
+        raise ValueError(f"fraction [-] must be in [{lo:g}, {hi:g}], got {value!r}")
+    return float(value)
 
 
 def _number(text: str, name: str) -> float:
@@ -206,10 +222,7 @@ def parse_query(args: Mapping[str, str]) -> tuple[ExploreState, list[str]]:
     fraction = 0.5
     if "fraction" in args:
         try:
-            value = _number(args["fraction"], "fraction")
-            if not 0.0 <= value <= 2.0:  # also refuses NaN
-                raise ValueError(f"fraction [-] must be in [0, 2], got {value!r}")
-            fraction = value
+            fraction = check_fraction(_number(args["fraction"], "fraction"))
         except ValueError as exc:
             errors.append(str(exc))
     known = {"preset", "controller", "retraction", "alpha_stop", "disturbance", "fraction",

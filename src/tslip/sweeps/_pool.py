@@ -44,8 +44,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-__all__ = ["WATCH_SECONDS", "check_main_guard", "notify", "prestart", "process_pool",
-           "progress_queue", "stop_workers"]
+__all__ = ["WATCH_SECONDS", "check_main_guard", "lasting_pool", "notify", "prestart",
+           "process_pool", "progress_queue", "stop_workers"]
 
 #: How often a worker checks that its parent is alive [s].
 WATCH_SECONDS = 0.5
@@ -256,6 +256,24 @@ def process_pool(workers: int, queue: Any = None,
     except BaseException:
         stop_workers(pool)
         raise
+
+
+def _init_lasting(parent: int) -> None:  # pragma: no cover - in workers
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _die_with_parent(parent)
+
+
+def lasting_pool(workers: int) -> cf.ProcessPoolExecutor:
+    """A pool of watched, SIGINT-deaf, spawned workers that lasts until it is shut down.
+
+    For a server (``tslip explore``) rather than one run's ``with`` block
+    (:func:`process_pool`). Its workers start in its first ``submit`` calls and
+    on Linux die with the thread that made those calls (``PR_SET_PDEATHSIG``
+    tracks a thread): submit first from a thread that lives as long as the
+    pool should. End it with :func:`stop_workers`.
+    """
+    return _Executor(max_workers=workers, mp_context=mp.get_context("spawn"),
+                     initializer=_init_lasting, initargs=(os.getpid(),))
 
 
 def progress_queue() -> Any:
