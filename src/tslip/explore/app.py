@@ -9,6 +9,8 @@ page, and the server goes on; a refused input (a ValueError: a value out of
 range, a retraction stop the gait search refuses) is shown as its message and
 logged in one line. The work runs in daemon threads and the limits in a worker
 process that dies with the server (:mod:`.workers`).
+
+Over 600 lines: one concept, the explorer's page: controls, updates and plots of one document.
 """
 
 from __future__ import annotations
