@@ -47,9 +47,12 @@ from ..model._pack import (
     P_CL,
     P_G,
     P_GLOBAL,
+    O_ATOL,
+    O_RTOL,
     P_J,
     P_L0,
     P_M,
+    P_NEXP,
     P_OMEGA,
     P_R,
     P_THRUST,
@@ -198,6 +201,55 @@ def _sens_step(P, method, z, h, K, ztmp, Jf):
         z[i] = ztmp[i]
 
 
+#: At most this many substeps of one recorded step in :func:`_sens_steps` (a Table 2.1
+#: lift-off at ``n = 1.2`` takes about NN at tolerance 1e-12).
+MAX_SUBSTEPS = 10000
+
+
+@njit(**_INLINE)
+def _sens_steps(P, O, method, z, h, K, ztmp, zold, Jf, rec_row):
+    """One recorded step ``h`` of ``(y, Phi)`` (in place), split where ``Phi`` needs it.
+
+    A linear leg (``n = 1``): :func:`_sens_step`, the derivative of the computed step.
+    A power-law leg (``n != 1``): ``dF_s/dl = -k n |x|^(n-1)`` is not smooth at the
+    spring's rest length ``x = 0`` (not Lipschitz for ``n < 2``), and the variational
+    equation, whose right-hand side carries it, loses one order of smoothness more than
+    the state there: the stride's steps, sized by the state's error alone, leave an
+    error of about ``tol^(n/(n+1))`` in ``Phi`` where a stance ends on the spring's zero
+    (:func:`._stance.liftoff_on_spring`; 1e-6 to 1e-5 at tolerance 1e-12). So the
+    recorded step is integrated with error control on ``(y, Phi)`` by the same pair and
+    tolerances (the whole step first, the same arithmetic as :func:`_sens_step` if that is
+    accepted), and ``y`` is then reset to the stride's recorded state ``rec_row[1:]``.
+    """
+    if P[P_NEXP] == 1.0:
+        _sens_step(P, method, z, h, K, ztmp, Jf)
+        return
+    ns = _rk.n_stages(method)
+    rtol, atol = O[O_RTOL], O[O_ATOL]
+    done = 0.0
+    hs = h
+    for _ in range(MAX_SUBSTEPS):
+        last = done + hs >= h
+        if last:
+            hs = h - done
+        for i in range(NAUG):
+            zold[i] = z[i]
+        _sens_step(P, method, z, hs, K, ztmp, Jf)
+        _aug_rhs(P, z, K[ns], Jf)  # the FSAL row of the error estimate
+        err = _rk.error_norm(method, NAUG, zold, z, hs, K, rtol, atol)
+        if err <= 1.0 or hs <= 1e-12 * h:
+            done += hs
+            if last:
+                break
+            hs *= _rk.step_factor(method, err, 5.0)
+        else:
+            for i in range(NAUG):
+                z[i] = zold[i]
+            hs *= _rk.step_factor(method, err, 1.0) if math.isfinite(err) else 0.1
+    for i in range(NSTATE):
+        z[i] = rec_row[1 + i]
+
+
 @njit(**_INLINE)
 def _switch_saltation(Pw, z):
     """The thrust's switch at ``(y, Phi) = z`` (event ``-ldot = 0``): ``Pw`` switches its
@@ -254,16 +306,20 @@ def _make_stride_jacobian(method: int) -> Callable:
         z = np.zeros(NAUG)
         for i in range(NSTATE):
             z[i] = y[i]
-            z[NSTATE + i * NSTATE + i] = 1.0
+            # Phi's column 0, the response to the touch-down leg length, stays 0: that
+            # length is l0 on the section (D0's row 0 is 0), and the stiffness |x|^(n-1)
+            # of a power-law leg is not smooth at touch-down (_sens_steps)
+            z[NSTATE + i * NSTATE + i] = 1.0 if i > 0 else 0.0
         K = np.empty((_rk.NK, NAUG))
         ztmp = np.empty(NAUG)
+        zold = np.empty(NAUG)
         Jf = np.empty((NSTATE, NSTATE))
         tsw = out[27]  # OUT_TSW: the thrust's switch, NaN if none
         Pw = P.copy() if P[P_THRUST] > 0.0 else P  # the stance's working parameters
         for k in range(1, nrec):
             h = rec[k, 0] - rec[k - 1, 0]
             if h > 0.0:
-                _sens_step(Pw, method, z, h, K, ztmp, Jf)
+                _sens_steps(Pw, O, method, z, h, K, ztmp, zold, Jf, rec[k])
             if rec[k, 0] == tsw and Pw[P_THRUST] > 0.0:
                 _switch_saltation(Pw, z)
         for i in range(NSTATE):
