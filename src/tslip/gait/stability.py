@@ -92,6 +92,8 @@ class Floquet(Result):
         of energy moves it to the neighbouring gait of its family).
     jacobian : ndarray, shape (5, 5) or (4, 4)
     method : str
+        The method used: ``"exact"`` or ``"fd"``, also when ``"exact"`` was asked for
+        and fell back (a leg spring exponent below 1, :func:`floquet`).
     trivial_kinds : tuple of str, length 5
         Why each multiplier is trivial: ``"energy"``, ``"pitch"`` (two, with
         the stability evaluated on the section without the pitch), or ``""``.
