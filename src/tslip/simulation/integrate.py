@@ -269,8 +269,11 @@ def step_jacobian(
     The stance sensitivity is the variational equation integrated by the same
     Dormand-Prince steps (internal differentiation), corrected at lift-off by
     the saltation (event-time) term; the closed-form flight is differentiated
-    analytically, including the touch-down time. See
-    :mod:`tslip.simulation._variational`. The Jacobian is NaN after a fall.
+    analytically, including the touch-down time. For a power-law leg
+    (``leg_exponent != 1``) the sensitivity is integrated with error control of its own
+    within each step, since the leg's stiffness ``|x|^(n-1)`` is not smooth where the
+    spring force vanishes. See :mod:`tslip.simulation._variational`. The Jacobian is NaN
+    after a fall.
 
     Raises
     ------
