@@ -19,6 +19,11 @@ from .._renamed import warn_renamed
 
 __all__ = ["LimitSearch", "limit_search"]
 
+#: The most grid points ``max_magnitude / h`` a search may scan: its calls are bounded
+#: (about ``MAX_GRID_POINTS / ladder`` for the scan), so a step far too fine for its range
+#: is refused rather than scanned for hours (1e7 points of a 0.1 ms stride: 17 minutes).
+MAX_GRID_POINTS = 10_000_000
+
 
 @dataclass(frozen=True, slots=True)
 class LimitSearch:
@@ -84,7 +89,8 @@ def limit_search(
         shrinks the bracket ``k + 1`` times.
     max_magnitude : float
         End of the grid (the last point is clipped to it); the scan costs up
-        to ``max_magnitude / h`` evaluations when nothing fails.
+        to ``max_magnitude / h`` evaluations when nothing fails, at most
+        :data:`MAX_GRID_POINTS`.
     start : float, optional
         The old name of ``h`` (the doubling ladder's first rung, as ``h`` is
         the grid's); give one of the two.
@@ -98,8 +104,9 @@ def limit_search(
     Raises
     ------
     ValueError
-        For no or a non-positive ``h``, non-positive ``tol``/``max_magnitude``,
-        ``ladder < 1``, ``k < 1``, or a predicate answer of the wrong shape.
+        For no or a non-positive ``h``, non-positive ``tol``/``max_magnitude``, a grid of
+        more than :data:`MAX_GRID_POINTS` points, ``ladder < 1``, ``k < 1``, or a
+        predicate answer of the wrong shape.
 
     Examples
     --------
@@ -115,6 +122,10 @@ def limit_search(
             raise ValueError(f"{name} must be in (0, inf), got {v!r}")
     if h > max_magnitude:
         raise ValueError(f"h ({h!r}) must not exceed max_magnitude ({max_magnitude!r})")
+    if max_magnitude / h > MAX_GRID_POINTS:
+        raise ValueError(f"h ({h!r}) must be at least max_magnitude / {MAX_GRID_POINTS:.0e} "
+                         f"({max_magnitude / MAX_GRID_POINTS:.3g}): a grid of "
+                         f"{max_magnitude / h:.3g} points would run for hours")
     for name, n in (("ladder", ladder), ("k", k)):
         if not isinstance(n, (int, np.integer)) or n < 1:
             raise ValueError(f"{name} must be an integer >= 1, got {n!r}")
