@@ -38,7 +38,8 @@ def reference_stance(p, td, l_rest=None):
     """Stance from the touch-down ``td`` (beta, phi, xd, yd, phid) by solve_ivp.
 
     Returns ``(t_lo, u_lo, l_min)``: lift-off time, CoM state ``(x, y, phi, xd, yd,
-    phid)`` (CoM at x = 0 at touch-down, ground at 0) and the leg's minimum length.
+    phid)`` (CoM at x = 0 at touch-down, ground at 0) and the leg's minimum length (at the
+    thrust's switch, or over 400 samples of the stance without thrust).
     Passive hip (no torque). With ``p.leg_thrust`` the rest length steps to
     ``l0 (1 + d)`` where ``ldot`` first crosses from < 0 to >= 0.
     """
@@ -75,10 +76,10 @@ def reference_stance(p, td, l_rest=None):
         return leg(u, p.l0)[1]  # ldot
     switch.terminal, switch.direction = True, 1
 
-    kw = dict(rtol=1e-11, atol=1e-12, method="DOP853")
+    kw = dict(rtol=1e-11, atol=1e-12, method="DOP853", dense_output=True)
     events = [liftoff(p.l0)] + ([switch] if p.leg_thrust > 0 else [])
     sol = solve_ivp(rhs(p.l0), (0.0, 5.0), u0, events=events, **kw)
-    l_min = math.nan
+    l_min = min(leg(sol.sol(t), p.l0)[0] for t in np.linspace(0, sol.t[-1], 400))
     if p.leg_thrust > 0:
         assert len(sol.t_events[1]) == 1, "no switch before lift-off"
         t_sw, u_sw = sol.t_events[1][0], sol.y_events[1][0]

@@ -3,11 +3,11 @@
 ``F_s = k l0 sgn(x) |x|^n`` and ``V = k l0^2 |x|^(n+1) / (n+1)`` with ``x = (l_rest -
 l) / l0`` (docs/model.md, "Leg spring and thrust"): at ``l0 = 1`` the factors ``l0`` and
 ``l0^2`` are invisible, and every other power-law test runs there. Here ``l0``, ``m`` and
-``g`` are away from 1, against references written in this file from those formulas and
-the thesis's mechanics: a Newton-Euler stance in Cartesian coordinates (a point-mass
-trunk with pitch inertia, the massless leg pushing along the foot-hip line, eqs 2.5-2.6)
-integrated by scipy's ``solve_ivp``, energy conservation with the power-law ``V``, and the
-one-dimensional bounce ``m l'' = F_s(l)``.
+``g`` are away from 1, against references written from those formulas and the thesis's
+mechanics: a Newton-Euler stance in Cartesian coordinates (``test_leg_exponent.py``'s,
+general in ``l0``: a point-mass trunk with pitch inertia, the massless leg pushing along
+the foot-hip line, eqs 2.5-2.6) integrated by scipy's ``solve_ivp``, energy conservation
+with the power-law ``V``, and the one-dimensional bounce ``m l'' = F_s(l)``.
 
 The compiled kernels (``simulation._stance``), the recorded run's force and energy columns
 (``simulation._record``), the readable model (``model.dynamics``) and the bounce time
@@ -18,7 +18,6 @@ drops its ``l0`` factor.
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 import pytest
@@ -30,17 +29,12 @@ from tslip.model import _pack as pk
 from tslip.model import dynamics as dyn
 from tslip.simulation import _kernels as kn
 
+from .test_leg_exponent import reference_stance
+from .test_leg_exponent import spring as power_law
+
 TIGHT = tslip.IntegratorOptions(rtol=1e-12, atol=1e-12, method="dop853")
 #: A touch-down (beta, phi, xd, yd, phid) of a fast run: the leg at Table 2.1's angle.
 STATE = np.array([1.05, 0.05, 4.0, -0.3, 0.2])
-
-
-def power_law(p, l, l_rest):
-    """``(F_s, V)`` of the power-law leg, written out from docs/model.md."""
-    x = (l_rest - l) / p.l0
-    n = p.leg_exponent
-    return (p.k * p.l0 * math.copysign(abs(x) ** n, x),
-            p.k * p.l0**2 * abs(x) ** (n + 1) / (n + 1))
 
 
 def scaled(n, *, l0=0.9, m=1.3, g=0.8, c_l=0.0, d=0.0, compression=0.15):
@@ -50,61 +44,6 @@ def scaled(n, *, l0=0.9, m=1.3, g=0.8, c_l=0.0, d=0.0, compression=0.15):
     k = 25.0 * m * g * compression ** (1 - n) / l0
     return dataclasses.replace(tslip.preset("table2.1"), l0=l0, m=m, g=g, J=0.1 * m,
                                k=k, c_l=c_l, leg_exponent=n, leg_thrust=d)
-
-
-def reference_stance(p, td):
-    """The stance from the touch-down ``td`` by solve_ivp (passive hip).
-
-    Returns ``(t_lo, u_lo, l_min)``: lift-off time, the CoM state ``(x, y, phi, xd, yd,
-    phid)`` (CoM at ``x = 0`` at touch-down, ground at 0) and the shortest leg. With
-    ``p.leg_thrust = d > 0`` the rest length steps from ``l0`` to ``l0 (1 + d)`` where
-    ``ldot`` first crosses zero upwards, and ``x`` stays scaled by ``l0``.
-    """
-    b, ph, xd, yd, phd = td
-    r = p.r
-    foot = np.array([-r * math.sin(ph) + p.l0 * math.cos(b), 0.0])
-    u0 = np.array([0.0, p.l0 * math.sin(b) - r * math.cos(ph), ph, xd, yd, phd])
-
-    def leg(u, lr):
-        hip = np.array([u[0] - r * math.sin(u[2]), u[1] + r * math.cos(u[2])])
-        hv = np.array([u[3] - r * math.cos(u[2]) * u[5], u[4] - r * math.sin(u[2]) * u[5]])
-        e = hip - foot
-        l = math.hypot(*e)
-        e /= l
-        ld = e @ hv
-        return l, ld, e, power_law(p, l, lr)[0] - p.c_l * ld
-
-    def rhs(lr):
-        def f(t, u):
-            _, _, e, fl = leg(u, lr)
-            arm = (-r * math.sin(u[2]), r * math.cos(u[2]))  # hip - CoM
-            torque = arm[0] * fl * e[1] - arm[1] * fl * e[0]
-            return [u[3], u[4], u[5], fl * e[0] / p.m, fl * e[1] / p.m - p.g, torque / p.J]
-        return f
-
-    def liftoff(lr):
-        def ev(t, u):
-            l, _, e, fl = leg(u, lr)
-            return lr - l if p.c_l == 0.0 else fl * e[1]  # the spring relaxed, or F_y = 0
-        ev.terminal, ev.direction = True, -1
-        return ev
-
-    def switch(t, u):
-        return leg(u, p.l0)[1]  # ldot
-    switch.terminal, switch.direction = True, 1
-
-    kw = dict(rtol=1e-11, atol=1e-12, method="DOP853", dense_output=True)
-    events = [liftoff(p.l0)] + ([switch] if p.leg_thrust > 0 else [])
-    sol = solve_ivp(rhs(p.l0), (0.0, 5.0), u0, events=events, **kw)
-    l_min = min(leg(sol.sol(t), p.l0)[0] for t in np.linspace(0, sol.t[-1], 400))
-    if p.leg_thrust > 0:
-        assert len(sol.t_events[1]) == 1, "no switch before lift-off"
-        t_sw, u_sw = sol.t_events[1][0], sol.y_events[1][0]
-        l_min = leg(u_sw, p.l0)[0]
-        lr = p.l0 * (1 + p.leg_thrust)
-        sol = solve_ivp(rhs(lr), (t_sw, 5.0), u_sw, events=[liftoff(lr)], **kw)
-    assert len(sol.t_events[0]) == 1, "no lift-off"
-    return sol.t_events[0][0], sol.y_events[0][0], l_min
 
 
 @pytest.mark.parametrize("n, c_l, d, l0", [
