@@ -5,7 +5,8 @@ is the loop; its named steps are here, in the order a step takes them:
 
 * :func:`rk_step`: one Runge-Kutta step (the stages, FSAL);
 * :func:`shrink_step` / :func:`grow_step`: error control, the next step size
-  after a rejected / an accepted step;
+  after a rejected / an accepted step; :func:`retry_step`: whether a step is
+  rejected, by its error or, for a stance's first step, by :func:`jumped_hump`;
 * :func:`crossed`: event detection, a sign change of an event function
   (thesis Section 2.3) over the accepted step; :func:`jumped_hump`: no first step
   of a stance jumps a whole hump of an event function that starts at its zero;
@@ -91,6 +92,19 @@ def shrink_step(method, h, err):
     if not math.isfinite(err):
         return h * 0.1
     return h * _rk.step_factor(method, err, 10.0)
+
+
+@njit(**_INLINE)
+def retry_step(P, method, y, h, K, err, first, gv_old, gv_new, ytmp, gv_tmp):
+    """The size to retry the step just taken with, or 0.0 if it is accepted: a step whose
+    error ``err`` is above 1 (or not finite) is retried shorter (:func:`shrink_step`), and
+    so is a stance's ``first`` step that jumped a whole hump of an event function that
+    started at its zero (:func:`jumped_hump`), ``HUMP_SHRINK`` times as long."""
+    if not err <= 1.0:
+        return shrink_step(method, h, err)
+    if first and jumped_hump(P, y, K[0], h, gv_old, gv_new, ytmp, gv_tmp):
+        return h * _rk.HUMP_SHRINK
+    return 0.0
 
 
 @njit(**_INLINE)

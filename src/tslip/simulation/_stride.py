@@ -90,10 +90,9 @@ from ._stepper import (
     first_event,
     grow_step,
     initial_step,
-    jumped_hump,
     record_grid,
+    retry_step,
     rk_step,
-    shrink_step,
 )
 
 #: numba's options for the ``prange`` batch kernels (compiled only when first used)
@@ -347,7 +346,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         (:func:`touchdown_fall`). Otherwise each pass of the loop takes one
         Runge-Kutta step and either rejects it (error control: a smaller step; or,
         for a first step, that it jumped a whole hump of an event function that
-        started at its zero, :func:`._stepper.jumped_hump`) or
+        started at its zero: :func:`._stepper.retry_step`) or
         accepts it, looks for the sign changes of the event functions over it
         (lift-off, eq. 2.8; falls, eqs 2.10-2.11), locates the earliest on the
         step's dense output, and then ends the stance with one exact step to that
@@ -377,7 +376,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         t = 0.0
         t_next_rec = rec_dt
         status, h = stance_begin(P, O, method, y, K, gv_old, ytmp)
-        first = True  # the stance's first step is still to be accepted (:func:`jumped_hump`)
+        first = True  # the stance's first step is still to be accepted (:func:`retry_step`)
         n_acc = 0
         n_rej = 0
         last_rejected = False
@@ -411,19 +410,14 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
             else:
                 # error control
                 err = _rk.error_norm(method, NSTATE, y, ynew, h, K, rtol, atol)
-                if not err <= 1.0:
-                    h = shrink_step(method, h, err)
+                h_retry = retry_step(P, method, y, h, K, err, first, gv_old, gv_new, ytmp,
+                                     gv_tmp)
+                if h_retry > 0.0:
+                    h = h_retry
                     n_rej += 1
                     last_rejected = True
                     continue
-                if first:
-                    if jumped_hump(P, y, K[0], h, gv_old, gv_new, ytmp, gv_tmp):
-                        # it jumped a whole hump of an event that started at its zero
-                        h *= _rk.HUMP_SHRINK
-                        n_rej += 1
-                        last_rejected = True
-                        continue
-                    first = False
+                first = False
                 n_acc += 1
                 # event detection, dense output, event location (and grid samples)
                 event = crossed(gv_old, gv_new)
