@@ -429,10 +429,12 @@ def root_update(st, c, fc, tol):
 # event is never seen (the stance is lost: a false fall) or is located at the
 # start. So the first accepted step of a phase that ends with an event function
 # at or below zero is checked: if that function left its zero upward at the
-# phase's start (:func:`jumped_hump`, from its values at ``y + ZERO_PROBE h f(y)``
-# that each model computes with its own event functions), the step jumped a
-# whole hump, and is retried HUMP_SHRINK times as long, until it ends inside the
-# hump, where the event is armed. An ordinary step computes nothing more.
+# phase's start (:func:`left_zero_upward`, from its values at ``y + ZERO_PROBE h
+# f(y)`` that each model computes with its own event functions), the step jumped
+# a whole hump (:func:`jumped_hump`), and is retried HUMP_SHRINK times as long,
+# until it ends inside the hump, where the event is armed. The TSLIP reads the
+# probe once at a stance's start, and only if an event starts at or below zero;
+# the biped only when a first step ends with a function at or below zero.
 # ---------------------------------------------------------------------------
 
 #: Where an event function is probed for how it leaves its start: this fraction of the
@@ -444,14 +446,21 @@ HUMP_SHRINK = 0.1
 
 
 @njit(**_INLINE)
+def left_zero_upward(g_start, g_probe):
+    """Whether an event function with value ``g_start`` at a phase's start and ``g_probe``
+    at the probe (``y + ZERO_PROBE h f(y)``) left its zero upward at the start, or within
+    the probe's length before it: ``g_probe > 0`` and ``g_start <= g_probe - g_start`` (the
+    linear extrapolation back from the probe reaches zero no earlier than one probe length
+    before the start)."""
+    return g_probe > 0.0 and 2.0 * g_start <= g_probe
+
+
+@njit(**_INLINE)
 def jumped_hump(g_start, g_end, g_probe):
-    """Whether a phase's first step jumped a whole hump of an event function with values
-    ``g_start``, ``g_end`` at the step's ends and ``g_probe`` at the probe
-    (``y + ZERO_PROBE h f(y)``): it ends at or below zero, and it left its zero upward at
-    the start, or within the probe's length before it (``g_probe > 0`` and
-    ``g_start <= g_probe - g_start``: the linear extrapolation back from the probe reaches
-    zero no earlier than one probe length before the start)."""
-    return g_end <= 0.0 and g_probe > 0.0 and 2.0 * g_start <= g_probe
+    """Whether a phase's first step, ending at ``g_end``, jumped a whole hump of an event
+    function that :func:`left_zero_upward` (``g_start``, ``g_probe``): it ends at or below
+    zero again."""
+    return g_end <= 0.0 and left_zero_upward(g_start, g_probe)
 
 
 # ---------------------------------------------------------------------------

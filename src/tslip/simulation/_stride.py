@@ -92,6 +92,7 @@ from ._stepper import (
     initial_step,
     record_grid,
     retry_step,
+    rising_from_zero,
     rk_step,
 )
 
@@ -346,7 +347,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         (:func:`touchdown_fall`). Otherwise each pass of the loop takes one
         Runge-Kutta step and either rejects it (error control: a smaller step; or,
         for a first step, that it jumped a whole hump of an event function that
-        started at its zero: :func:`._stepper.retry_step`) or
+        started at its zero: :func:`._stepper.rising_from_zero`) or
         accepts it, looks for the sign changes of the event functions over it
         (lift-off, eq. 2.8; falls, eqs 2.10-2.11), locates the earliest on the
         step's dense output, and then ends the stance with one exact step to that
@@ -376,7 +377,8 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         t = 0.0
         t_next_rec = rec_dt
         status, h = stance_begin(P, O, method, y, K, gv_old, ytmp)
-        first = True  # the stance's first step is still to be accepted (:func:`retry_step`)
+        # events that left their zero upward, until the first step is accepted (retry_step)
+        rising = rising_from_zero(P, y, K[0], h, gv_old, ytmp, gv_tmp)
         n_acc = 0
         n_rej = 0
         last_rejected = False
@@ -397,7 +399,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
                 if h > 0.0:
                     copy_state(y, ynew)
                 h = thrust_switch(P, O, method, y, K, gv_old, ytmp, fly, t, out)
-                first = True
+                rising = rising_from_zero(P, y, K[0], h, gv_old, ytmp, gv_tmp)
                 ev = -1
                 last_rejected = False
             elif ev >= 0:
@@ -410,14 +412,13 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
             else:
                 # error control
                 err = _rk.error_norm(method, NSTATE, y, ynew, h, K, rtol, atol)
-                h_retry = retry_step(P, method, y, h, K, err, first, gv_old, gv_new, ytmp,
-                                     gv_tmp)
+                h_retry = retry_step(method, h, err, rising, gv_new)
                 if h_retry > 0.0:
                     h = h_retry
                     n_rej += 1
                     last_rejected = True
                     continue
-                first = False
+                rising = 0
                 n_acc += 1
                 # event detection, dense output, event location (and grid samples)
                 event = crossed(gv_old, gv_new)
