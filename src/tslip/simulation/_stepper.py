@@ -102,7 +102,8 @@ def retry_step(method, h, err, rising, gv_new):
     (:func:`rising_from_zero`) at or below zero again: it jumped a whole hump of it, and is
     retried ``HUMP_SHRINK`` times as long. (The mask is an integer, not an array, so that
     the stride's loop pays one comparison a step for it: a call with the event arrays in
-    the loop cost a Table 6.1 stride 2.9 % more instructions, the mask 0.5 %.)"""
+    the loop cost a Table 6.1 stride 2.9 % more instructions, the mask 0.3 %: callgrind,
+    20000 strides against the revision before it.)"""
     if not err <= 1.0:
         return shrink_step(method, h, err)
     if rising != 0:
