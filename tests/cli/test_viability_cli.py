@@ -183,6 +183,11 @@ def test_scheduler_option_runs_on_a_dask_cluster(spec, tmp_path):
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
                       dashboard_address=None) as cluster:
         res = _run(spec, "--out", tmp_path / "d", "--scheduler", cluster.scheduler_address)
+        worker = next(iter(cluster.scheduler.workers))  # a Dask server, not a scheduler
+        refused = _run(spec, "--out", tmp_path / "w", "--scheduler", worker)
+    assert refused.exit_code == 2 and not (tmp_path / "w").exists(), refused.output
+    assert f"--scheduler {worker!r} is not a Dask scheduler's address (it answered as " \
+        "'Worker')" in refused.stderr, refused.output
     assert res.exit_code == 0, res.output
     assert "240/240" in res.stderr
     _same(Viability.load(one / "results.parquet"), Viability.load(tmp_path / "d" /

@@ -6,6 +6,7 @@ import os
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -105,15 +106,19 @@ values = [5.0]
 """
 
 
+DESIGN = Path(__file__).parents[2] / "examples" / "design.toml"
+
+
 def _commands(tmp_path):
     (tmp_path / "v.toml").write_text(TEN)
     (tmp_path / "s.toml").write_text(STUDY)
     return {"viability": ["viability", str(tmp_path / "v.toml")],
             "study": ["study", str(tmp_path / "s.toml")],
-            "reproduce": ["reproduce", "--quick"]}
+            "reproduce": ["reproduce", "--quick"],
+            "design": ["design", str(DESIGN)]}
 
 
-@pytest.mark.parametrize("command", ["viability", "study", "reproduce"])
+@pytest.mark.parametrize("command", ["viability", "study", "reproduce", "design"])
 @pytest.mark.parametrize("address, what", [
     ("", "--scheduler is empty"),
     ("  ", "--scheduler is empty"),

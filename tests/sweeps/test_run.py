@@ -144,3 +144,26 @@ def test_a_dask_cluster_gets_a_bounded_number_of_tasks_at_a_time(monkeypatch):
         _schedule.run_tasks(tasks, on_done, scheduler=cluster.scheduler_address)
     assert sorted(done) == [2 * i for i in range(30)]
     assert out["max"] == _schedule.DASK_IN_FLIGHT
+
+
+@pytest.mark.parametrize("address, what", [
+    ("foo", "--scheduler 'foo' is not a Dask scheduler's address (ValueError: missing port"),
+    ("http://127.0.0.1:1", "--scheduler 'http://127.0.0.1:1' is not a Dask scheduler's "
+                           "address (ValueError: unknown address scheme 'http'"),
+])
+def test_the_api_refuses_a_bad_scheduler_before_building_a_client(monkeypatch, address, what):
+    """run_tasks(scheduler=...) checks the address itself (not only the CLI), before a
+    ``Client`` is built: a Client whose constructor failed hung CI for 900 s when
+    collected."""
+    from dask.distributed import Client
+
+    from tslip.sweeps import _schedule
+
+    def no_client(*args, **kwargs):
+        raise AssertionError("a Client was built for a bad address")
+
+    monkeypatch.setattr(Client, "__init__", no_client)
+    with pytest.raises(ValueError) as err:
+        _schedule.run_tasks([_schedule.Task(("t", 0), _double, (0,))], lambda t, r: [],
+                            scheduler=address)
+    assert what in str(err.value) and "\n" not in str(err.value)

@@ -113,26 +113,9 @@ def check_scheduler(address: str | None, echo: Any, seconds: float | None = None
     """
     if address is None:
         return
-    seconds = SCHEDULER_SECONDS if seconds is None else seconds
-    if not address.strip():
-        raise ValueError("--scheduler is empty; give a Dask scheduler's address, e.g. "
-                         "tcp://127.0.0.1:8786")
-    try:
-        from dask.distributed import Client
-    except ImportError:
-        raise ValueError("--scheduler needs Dask: pip install 'tslip[dask]'") from None
-    echo(f"connecting to the Dask scheduler at {address} (giving up after {seconds:g} s)")
-    try:
-        with Client(address, timeout=seconds):
-            pass
-    except (OSError, TimeoutError) as exc:
-        why = " ".join(str(exc).split()) or type(exc).__name__
-        raise ValueError(f"--scheduler {address!r}: no Dask scheduler answered within "
-                         f"{seconds:g} s ({why})") from None
-    except Exception as exc:  # noqa: BLE001 - Dask's refusal of the address, whatever its type
-        why = " ".join(str(exc).split())[:200] or type(exc).__name__
-        raise ValueError(f"--scheduler {address!r} is not a Dask scheduler's address "
-                         f"({type(exc).__name__}: {why})") from None
+    from ..sweeps._schedule import check_scheduler as check
+
+    check(address, SCHEDULER_SECONDS if seconds is None else seconds, echo)
 
 
 def make_console(stderr: bool = False) -> Console:

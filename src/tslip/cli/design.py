@@ -9,7 +9,15 @@ from typing import Annotated
 import typer
 
 from .._checks import check_output
-from ._common import SchedulerOpt, WorkersOpt, errors, interruptible, make_console, progress_bar
+from ._common import (
+    SchedulerOpt,
+    WorkersOpt,
+    check_scheduler,
+    errors,
+    interruptible,
+    make_console,
+    progress_bar,
+)
 
 __all__ = ["commands", "design_cmd"]
 
@@ -49,6 +57,7 @@ def design_cmd(
             spec = dataclasses.replace(spec, budget=budget)
         out_dir = out if out is not None else Path("designs") / spec.name
         check_output(out_dir / "run.json", "--out")
+        check_scheduler(scheduler, console.print)  # before the folder is made
         if (note := budget_note(spec)) is not None:
             console.print(note, highlight=False)
         t0 = time.perf_counter()

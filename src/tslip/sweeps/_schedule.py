@@ -30,6 +30,7 @@ Ctrl-C: the pool's workers are stopped (not waited for) and the
 
 from __future__ import annotations
 
+import asyncio
 import concurrent.futures as cf
 import heapq
 import itertools
@@ -208,10 +209,9 @@ def _run_dask(address: str, ready: list[tuple[float, int, Task]],
     :data:`DASK_IN_FLIGHT` per worker thread at a time (the scheduler and the client hold
     every submitted task's arguments and result until it is collected: submitting a
     4500-chunk viability map at once took 4 GB here)."""
-    try:
-        from dask.distributed import Client, wait
-    except ImportError:
-        raise ValueError("--scheduler needs Dask: pip install 'tslip[dask]'") from None
+    check_scheduler(address)  # a Client that fails to connect can hang when collected
+    from dask.distributed import Client, wait
+
     with Client(address) as client:
         running: dict[Any, Task] = {}
         limit = DASK_IN_FLIGHT * max(1, sum(client.nthreads().values()))
@@ -225,6 +225,52 @@ def _run_dask(address: str, ready: list[tuple[float, int, Task]],
         except BaseException:
             client.cancel(list(running))
             raise
+
+
+def check_scheduler(address: str, seconds: float = 10.0,
+                    echo: Callable[[str], object] | None = None) -> None:
+    """Refuse a Dask scheduler ``address`` that is empty, malformed or does not answer
+    within ``seconds``, with one ``ValueError`` line naming ``--scheduler``.
+
+    ``echo`` (optional) announces the wait in one line. The check asks the server its
+    ``identity`` over one bare connection, closed before returning, and refuses a server
+    that is not a scheduler (e.g. a worker's address). It does not build a
+    ``distributed.Client``: a ``Client`` whose constructor fails (an address such as
+    ``foo``) closes itself when collected, and that close can wait forever on its event
+    loop's lock (it hung a CI run for 900 s).
+    """
+    if not address.strip():
+        raise ValueError("--scheduler is empty; give a Dask scheduler's address, e.g. "
+                         "tcp://127.0.0.1:8786")
+    try:
+        from distributed.comm import connect
+    except ImportError:
+        raise ValueError("--scheduler needs Dask: pip install 'tslip[dask]'") from None
+    if echo is not None:
+        echo(f"connecting to the Dask scheduler at {address} (giving up after {seconds:g} s)")
+
+    async def identity() -> object:
+        comm = await connect(address, timeout=seconds)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            answer = await asyncio.wait_for(comm.read(), seconds)
+        finally:
+            await comm.close()
+        return answer.get("type") if isinstance(answer, dict) else type(answer).__name__
+
+    try:
+        kind = asyncio.run(identity())
+    except (OSError, TimeoutError) as exc:
+        why = " ".join(str(exc).split()) or type(exc).__name__
+        raise ValueError(f"--scheduler {address!r}: no Dask scheduler answered within "
+                         f"{seconds:g} s ({why})") from None
+    except Exception as exc:  # noqa: BLE001 - Dask's refusal of the address, whatever its type
+        why = " ".join(str(exc).split())[:200] or type(exc).__name__
+        raise ValueError(f"--scheduler {address!r} is not a Dask scheduler's address "
+                         f"({type(exc).__name__}: {why})") from None
+    if kind != "Scheduler":
+        raise ValueError(f"--scheduler {address!r} is not a Dask scheduler's address "
+                         f"(it answered as {str(kind)[:40]!r})")
 
 
 def _drain(queue: Any, tick: Callable[[int], None] | None) -> None:
