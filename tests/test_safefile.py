@@ -95,3 +95,42 @@ def test_a_missing_file_without_create_is_file_not_found_and_creates_nothing(tmp
     with pytest.raises(FileNotFoundError):
         open_below(tmp_path, tmp_path / "cache" / "f", os.O_RDONLY)
     assert not (tmp_path / "cache").exists()
+
+
+@pytest.mark.parametrize("write", ["figure", "text"])
+def test_a_figure_or_text_written_where_a_link_is_replaces_the_link(tmp_path, write):
+    """save_figure and write_text (every CLI figure and the biped's multipliers.csv):
+    a link at the path is replaced by a fresh file, its target keeps its bytes."""
+    import matplotlib.pyplot as plt
+
+    from tslip._io import save_figure, write_text
+
+    target = tmp_path / "home" / ".profile"
+    target.parent.mkdir()
+    target.write_bytes(b"precious")
+    path = tmp_path / "out" / ("fig.png" if write == "figure" else "multipliers.csv")
+    path.parent.mkdir()
+    path.symlink_to(target)
+    if write == "figure":
+        fig = plt.figure()
+        save_figure(fig, path, dpi=20)
+        plt.close(fig)
+        assert path.read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
+    else:
+        write_text(path, "index,abs\n0,0.5\n")
+        assert path.read_text() == "index,abs\n0,0.5\n"
+    assert not path.is_symlink() and target.read_bytes() == b"precious"
+    assert sorted(os.listdir(path.parent)) == [path.name]  # no temporary file left
+
+
+def test_the_commands_write_files_only_through_the_atomic_writers():
+    """No command writes a figure or a text file directly (that follows a link at the
+    path): every write in ``tslip/cli`` goes through :mod:`tslip._io`."""
+    from pathlib import Path
+
+    import tslip.cli
+
+    direct = [f"{p.name}:{i}" for p in sorted(Path(tslip.cli.__file__).parent.glob("*.py"))
+              for i, line in enumerate(p.read_text().splitlines(), 1)
+              if ".savefig(" in line or ".write_text(" in line or ".write_bytes(" in line]
+    assert not direct, direct

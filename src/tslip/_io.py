@@ -11,7 +11,8 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-__all__ = ["atomic_write", "git_hash", "read_toml", "write_json", "write_mp4", "write_table"]
+__all__ = ["atomic_write", "git_hash", "read_toml", "save_figure", "write_json", "write_mp4",
+           "write_table", "write_text"]
 
 
 def atomic_write(path: str | Path, write: Callable[[str], object]) -> Path:
@@ -40,6 +41,19 @@ def atomic_write(path: str | Path, write: Callable[[str], object]) -> Path:
         if tmp and os.path.exists(tmp):
             os.unlink(tmp)
     return path
+
+
+def save_figure(fig: Any, path: str | Path, **kwargs: Any) -> Path:
+    """Save a matplotlib figure atomically, in the format its suffix names (``.png``,
+    ``.pdf``, ``.svg``): a link at ``path`` is replaced, never written through."""
+    fmt = Path(path).suffix.lstrip(".").lower() or "png"
+    return atomic_write(path, lambda tmp: fig.savefig(tmp, format=fmt, **kwargs))
+
+
+def write_text(path: str | Path, text: str) -> Path:
+    """Write ``text`` (UTF-8) atomically: a link at ``path`` is replaced, never written
+    through."""
+    return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
 def _json_default(o: Any) -> Any:

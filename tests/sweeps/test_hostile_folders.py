@@ -101,6 +101,31 @@ def test_the_cli_refuses_in_one_line_with_exit_2(tmp_path, target):
     _untouched(target)
 
 
+@pytest.mark.parametrize("link", ["cache", "file"])
+def test_the_cli_refuses_a_cache_link_before_its_bar_is_drawn(tmp_path, target, link):
+    """A link at ``cache/`` or at the study file is refused before any work: no progress
+    bar, no compile announcement, one line, exit 2 (it was refused only once the bar ran)."""
+    spec = tmp_path / "s.toml"
+    spec.write_text('name = "s"\npreset = "table2.1"\n[[axis]]\nparam = "v0"\nvalues = [4.0]\n')
+    out = tmp_path / "o"
+    path = study_file(StudySpec.from_toml(spec), out)
+    path.parent.parent.mkdir()
+    if link == "cache":
+        path.parent.symlink_to(target.parent, target_is_directory=True)
+        where = path.parent
+    else:
+        path.parent.mkdir()
+        path.symlink_to(target)
+        where = path
+    res = CliRunner().invoke(app, ["study", str(spec), "--out", str(out), "--workers", "1"])
+    assert res.exit_code == 2, res.output
+    assert res.stdout == "", res.stdout  # nothing drawn or announced before the refusal
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: refusing to write through "
+                                                   f"{where}"), lines
+    _untouched(target)
+
+
 def test_a_stale_lock_message_names_the_holder_not_the_file_bytes(tmp_path, caplog):
     """A plain ``.lock`` of another program's text: the take-over line does not print it."""
     out = tmp_path / "study"

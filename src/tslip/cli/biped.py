@@ -245,7 +245,7 @@ def report_cmd(
     """Write Figures E.2-E.4, the multiplier and metacentric tables (and robustness limits)."""
     import pandas as pd
 
-    from .._io import write_table
+    from .._io import save_figure, write_table, write_text
     from ..biped import BipedState, simulate
     from ..biped.gait import floquet, to_section
     from ..biped.metacentre import metacentric_table, metacentric_test
@@ -259,10 +259,10 @@ def report_cmd(
         tr = simulate(p, y, strides, t0=t0)
         c = make_console()
         c.print(f"strides until fall: {tr.n_steps} ({tr.status.reason})")
-        plot_tracking(tr).savefig(out_dir / "fig_e2_tracking.png", dpi=120)
-        plot_foot_path(tr).savefig(out_dir / "fig_e3_foot_path.png", dpi=120)
+        save_figure(plot_tracking(tr), out_dir / "fig_e2_tracking.png", dpi=120)
+        save_figure(plot_foot_path(tr), out_dir / "fig_e3_foot_path.png", dpi=120)
         meta = metacentric_test(p, BipedState.from_array(y), t0)
-        plot_metacentric(meta).savefig(out_dir / "fig_e4_metacentric.png", dpi=120)
+        save_figure(plot_metacentric(meta), out_dir / "fig_e4_metacentric.png", dpi=120)
         table = pd.DataFrame(metacentric_table(meta))
         write_table(table, out_dir / "metacentric.csv")
         c.print("metacentric test (right stance, legs fixed in the world): " + "; ".join(
@@ -273,7 +273,7 @@ def report_cmd(
         rows = ["index,real,imag,abs"] + [
             f"{i},{m.real:.6g},{m.imag:.6g},{abs(m):.6g}" for i, m in enumerate(fr.multipliers)
         ]
-        (out_dir / "multipliers.csv").write_text("\n".join(rows) + "\n")
+        write_text(out_dir / "multipliers.csv", "\n".join(rows) + "\n")
         c.print(f"largest multiplier {fr.max_nontrivial:.3f} "
                 f"(periodicity residual {fr.residual:.2e})")
         if robustness:

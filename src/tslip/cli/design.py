@@ -43,7 +43,7 @@ def design_cmd(
     """
     import dataclasses
 
-    from .._io import atomic_write
+    from .._io import save_figure
     from ..sweeps._lock import folder_lock
     from ..sweeps._warmup import announce
     from ..sweeps.design_spec import DesignSpec
@@ -67,9 +67,7 @@ def design_cmd(
             task = bar.add_task(f"design {spec.name}", total=spec.generations * spec.population)
             res = design(spec, out_dir, workers=workers, scheduler=scheduler,
                          progress=lambda done, total: bar.update(task, completed=done))
-        fig = res.plot()
-        atomic_write(out_dir / "front.png",  # a link there is replaced, never written through
-                     lambda tmp: fig.savefig(tmp, dpi=120, format="png"))
+        save_figure(res.plot(), out_dir / "front.png", dpi=120)  # a link there is replaced
     f = res.frame
     console.print(f"{spec.name}: {len(f)} designs ({res.meta['reused']} reused), "
                   f"{int(f['feasible'].sum())} feasible, {len(res.front)} on the Pareto front, "

@@ -17,7 +17,7 @@ import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from .._checks import check_number, check_output
-from .._io import atomic_write, write_json, write_table
+from .._io import save_figure, write_json, write_table
 from ._common import DATA_SUFFIXES, PresetOpt, SetOpt, build_params, errors, fail, make_console
 
 if TYPE_CHECKING:  # imported by the commands that read tables (a fast --help)
@@ -283,12 +283,9 @@ def _fit(steps_path: Path, out_dir: Path, frames: Any = None) -> Any:
                                        "flight_time": res.flight_time, "converged":
                                        res.converged, "message": res.message,
                                        "n_steps": avg.n_steps, "n_evals": res.n_evals})
-    fig = plot_step_average(avg, res)
-    atomic_write(out_dir / "figure6_1.png", lambda tmp: fig.savefig(tmp, format="png", dpi=90))
+    save_figure(plot_step_average(avg, res), out_dir / "figure6_1.png", dpi=90)
     if frames is not None:
-        fig2 = plot_foot_trajectory(frames)
-        atomic_write(out_dir / "figureD_2.png",
-                     lambda tmp: fig2.savefig(tmp, format="png", dpi=90))
+        save_figure(plot_foot_trajectory(frames), out_dir / "figureD_2.png", dpi=90)
     c = make_console()
     c.print(res.message)
     c.print("fitted: " + ", ".join(f"{k} = {v:.4f}" for k, v in res.values.items()))

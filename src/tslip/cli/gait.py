@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import functools
 import json
 import math
 import time
@@ -15,7 +14,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from .._checks import check_fits, check_number, check_output
-from .._io import atomic_write
+from .._io import save_figure
 from ._common import (
     DATA_SUFFIXES,
     ParamsOpt,
@@ -173,7 +172,7 @@ def gait_cmd(
                 "friction.png": plot_friction(friction_ratio(gait.params, gait.state)),
             }
             for name, fig in figs.items():
-                atomic_write(plot / name, functools.partial(fig.savefig, format="png"))
+                save_figure(fig, plot / name)
                 if not as_json:
                     make_console().print(f"wrote {plot / name} ({file_size(plot / name)})")
 
@@ -237,6 +236,5 @@ def continue_cmd(
         if plot is not None:
             from ..plotting import plot_branch
 
-            fig = plot_branch(branch)
-            atomic_write(plot, lambda tmp: fig.savefig(tmp, format=plot.suffix.lstrip(".")))
+            save_figure(plot_branch(branch), plot)
             console.print(f"wrote {plot} ({file_size(plot)})")

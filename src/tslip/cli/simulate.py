@@ -217,11 +217,10 @@ def _write_animation(traj: Trajectory, out: Path, fps: float, speed: float, dpi:
 
 
 def _save_plot(traj: Trajectory, path: Path) -> Path:
+    from .._io import save_figure
     from ..plotting.trajectories import plot_trajectory
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    plot_trajectory(traj).savefig(path, dpi=110)
-    return path
+    return save_figure(plot_trajectory(traj), path, dpi=110)
 
 
 # -- commands ------------------------------------------------------------------------

@@ -66,9 +66,10 @@ def study_cmd(
         check_output(out_dir / "run.json", "--out")  # before any work, naming the user's path
         check_scheduler(scheduler, console.print)  # before the folder is made
         from ..sweeps._lock import folder_lock
+        from ..sweeps.run import check_study_folder
 
         with folder_lock(out_dir, wait=wait):  # refused (or waited for) before the bar is drawn
-            pass
+            check_study_folder(spec, out_dir)  # and a link where its points are saved
         t0 = time.perf_counter()
         with progress_bar("pt") as bar, announce(bar.console.print, ("simulation",)):
             task = bar.add_task(f"study {spec.name}", total=spec.n_points)

@@ -106,8 +106,9 @@ def viability_cmd(
                       f"sweep{'s' if res.sweeps != 1 else ''}")
         console.print(f"wrote {out_dir / 'results.parquet'} (with results.json) and run.json")
         if plot:
-            fig = res.plot().figure
-            fig.savefig(out_dir / "viability.png", dpi=120)
+            from .._io import save_figure
+
+            save_figure(res.plot().figure, out_dir / "viability.png", dpi=120)
             console.print(f"wrote {out_dir / 'viability.png'}")
 
 

@@ -136,6 +136,18 @@ def study_file(spec: StudySpec, out_dir: str | Path) -> Path:
     return Path(out_dir) / "cache" / name
 
 
+def check_study_folder(spec: StudySpec, out_dir: str | Path) -> None:
+    """Refuse (:class:`tslip._safefile.UnsafePath`, one line) a study folder whose
+    ``cache/`` or study file (:func:`study_file`) is a link, before any work: the CLI
+    calls it before its progress bar is drawn (the writer refuses it again when it
+    opens the file)."""
+    path = study_file(spec, out_dir)
+    try:
+        os.close(_safefile.open_below(out_dir, path, os.O_RDONLY))
+    except FileNotFoundError:
+        pass
+
+
 def _writer(cache: str | Path | None) -> _store.Writer:
     """The appender of a study file (:func:`study_file`): nothing below the study
     folder (``cache/``, the file) is followed if it is a link."""
