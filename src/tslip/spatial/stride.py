@@ -231,6 +231,10 @@ def step_jacobian(params: SpatialParams, x: np.ndarray, side: int = 1,
     angle ``phi = psi + s gamma``), the stance (the variational equations of
     :mod:`._kernels` with the lift-off event's correction ``(I - f grad(g)^T /
     grad(g).f) Phi``, ``g = l0 - |q|``), and the rise ``y' = q_y + vy^2 / (2 g)``.
+    (The leg force vanishes at lift-off, so the stance field there is the flight's and
+    the rise maps the correction's direction ``f`` to 0: the apex does not depend on
+    when the lift-off happens along its parabola. The correction is kept for the
+    lift-off state itself.)
 
     Raises
     ------
