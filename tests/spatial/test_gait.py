@@ -83,3 +83,13 @@ def test_planar_limit_multiplier_is_the_planar_apex_maps_squared():
         slope = (b.y[2] - b.y[0]) / (2 * d)
         (lam,) = floquet(g, "exact", TIGHT).nontrivial
         assert abs(lam.real - slope**2) < 1e-6 * max(1.0, slope**2) and lam.imag == 0.0
+
+
+def test_fixed_speed_finds_the_gait_of_that_forward_speed(gaits):
+    """A gait found at fixed energy is found again at fixed forward apex speed (its vx)."""
+    p, found = gaits["fixed"]
+    g = found[0]
+    again = symmetric_gaits(p, speed=g.apex.vx, options=TIGHT)
+    best = min(again, key=lambda h: abs(h.apex.y - g.apex.y))
+    np.testing.assert_allclose(best.apex.section(), g.apex.section(), atol=1e-9)
+    assert abs(best.energy - g.energy) < 1e-9
