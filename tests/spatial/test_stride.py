@@ -180,3 +180,24 @@ def test_bad_parameters_are_refused_in_one_line():
         assert "\n" not in str(e.value)
     with pytest.raises(ValueError, match="SpatialApex.side"):
         SpatialApex(1.0, 1.0, side=0)
+
+
+def test_pure_python_kernel_agrees_with_the_compiled_one():
+    """The stance loop runs with NUMBA_DISABLE_JIT=1 (CONTRIBUTING's rule) to the same numbers."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    code = ("import json, tslip\nfrom tslip.spatial import SpatialApex, SpatialParams, apex_step\n"
+            "p = SpatialParams(k=31.0, beta0=1.12, gamma0=0.09, k_lat=0.4, m=0.9, l0=1.3, g=1.2)\n"
+            "o = tslip.IntegratorOptions(rtol=1e-10, atol=1e-10, method='dop853')\n"
+            "s = apex_step(p, SpatialApex(1.34, 1.7, 0.13), o)\n"
+            "print(json.dumps(s.apex.as_array().tolist()))\n")
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                         check=True).stdout
+    p = SpatialParams(k=31.0, beta0=1.12, gamma0=0.09, k_lat=0.4, **ODD)
+    s = apex_step(p, SpatialApex(1.34, 1.7, 0.13),
+                  tslip.IntegratorOptions(rtol=1e-10, atol=1e-10, method="dop853"))
+    np.testing.assert_allclose(json.loads(out), s.apex.as_array(), rtol=0, atol=1e-13)
