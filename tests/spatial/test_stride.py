@@ -201,3 +201,14 @@ def test_pure_python_kernel_agrees_with_the_compiled_one():
     s = apex_step(p, SpatialApex(1.34, 1.7, 0.13),
                   tslip.IntegratorOptions(rtol=1e-10, atol=1e-10, method="dop853"))
     np.testing.assert_allclose(json.loads(out), s.apex.as_array(), rtol=0, atol=1e-13)
+
+
+def test_presets_and_a_bad_name():
+    from tslip.spatial import preset, presets
+
+    assert presets() == ["slip3d", "slip3d-feedback"]
+    p = preset("slip3d")
+    assert (p.k, p.beta0, p.gamma0, p.k_lat, p.heading) == (25.0, 1.19, 0.05, 0.0, "fixed")
+    assert preset("slip3d-feedback").k_lat == 1.5
+    with pytest.raises(ValueError, match="preset must be one of"):
+        preset("slip4d")

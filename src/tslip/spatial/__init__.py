@@ -9,7 +9,7 @@
 from __future__ import annotations
 
 from .gait import Multipliers, SymmetricGait, floquet, symmetric_gaits
-from .parameters import HEADINGS, SpatialParams
+from .parameters import HEADINGS, SpatialParams, preset, presets
 from .stride import (
     SECTION_NAMES,
     SpatialApex,
@@ -23,6 +23,7 @@ from .stride import (
     step_jacobian,
 )
 
-__all__ = ["HEADINGS", "SpatialParams", "SECTION_NAMES", "SpatialApex", "SpatialStatus",
-           "SpatialStep", "apex_step", "apex_steps", "energy", "mirror", "section_map",
-           "step_jacobian", "Multipliers", "SymmetricGait", "floquet", "symmetric_gaits"]
+__all__ = ["HEADINGS", "SpatialParams", "preset", "presets", "SECTION_NAMES", "SpatialApex",
+           "SpatialStatus", "SpatialStep", "apex_step", "apex_steps", "energy", "mirror",
+           "section_map", "step_jacobian", "Multipliers", "SymmetricGait", "floquet",
+           "symmetric_gaits"]

@@ -192,7 +192,8 @@ def symmetric_gaits(params: SpatialParams, *, energy: float | None = None,
     """
     p = params
     if (energy is None) == (speed is None):
-        raise ValueError("give one of energy or speed")
+        raise ValueError(f"symmetric_gaits needs exactly one of energy [MgL] or speed "
+                         f"[g^1/2 L^1/2], got energy={energy!r}, speed={speed!r}")
     if energy is not None:
         energy = float(check_number(energy, "energy", unit="MgL", lower=0.0, lower_open=True))
         y_top = energy / (p.m * p.g)

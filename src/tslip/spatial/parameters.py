@@ -38,7 +38,7 @@ import numpy as np
 from .._checks import check_fields
 from ._kernels import NP, P_G, P_K, P_L0, P_M
 
-__all__ = ["SpatialParams", "HEADINGS", "Heading"]
+__all__ = ["SpatialParams", "HEADINGS", "Heading", "preset", "presets"]
 
 Heading = Literal["fixed", "velocity"]
 #: The allowed values of :attr:`SpatialParams.heading`.
@@ -94,3 +94,32 @@ class SpatialParams:
     def touchdown_height(self) -> float:
         """Height of the mass at touch-down, ``l0 sin(beta0)`` [L]."""
         return self.l0 * math.sin(self.beta0)
+
+
+_PRESETS: dict[str, tuple[str, dict[str, object]]] = {
+    "slip3d": ("3-D spring-mass runner: the planar slip preset's k 25 and beta0 1.19, leg "
+               "azimuth gamma0 0.05 outward, no feedback, fixed heading",
+               dict(k=25.0, beta0=1.19, gamma0=0.05)),
+    "slip3d-feedback": ("slip3d with the lateral feedback k_lat 1.5 (stabilises its fast "
+                        "symmetric gait at energy 2.2: docs/analyses/spatial.md)",
+                        dict(k=25.0, beta0=1.19, gamma0=0.05, k_lat=1.5)),
+}
+
+
+def presets() -> list[str]:
+    """Names accepted by :func:`preset`."""
+    return list(_PRESETS)
+
+
+def preset(name: str) -> SpatialParams:
+    """Named 3-D parameter set (``slip3d``, ``slip3d-feedback``).
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not one of :func:`presets`.
+    """
+    key = name.strip().lower() if isinstance(name, str) else name
+    if key not in _PRESETS:
+        raise ValueError(f"preset must be one of {presets()}, got {name!r}")
+    return SpatialParams(**_PRESETS[key][1])  # type: ignore[arg-type]

@@ -91,15 +91,15 @@ class SpatialApex:
         object.__setattr__(self, "side", int(self.side))
 
     @classmethod
-    def from_energy(cls, params: SpatialParams, y: float, energy_: float, vz: float = 0.0,
+    def from_energy(cls, params: SpatialParams, y: float, energy: float, vz: float = 0.0,
                     side: int = 1) -> SpatialApex:
-        """The apex at height ``y`` and lateral speed ``vz`` with total energy ``energy_``
+        """The apex at height ``y`` and lateral speed ``vz`` with total energy ``energy``
         [MgL]: ``m (vx^2 + vz^2)/2 + m g y``, solved for ``vx > 0``."""
-        kin = 2.0 * (energy_ - params.m * params.g * y) / params.m - vz * vz
+        kin = 2.0 * (energy - params.m * params.g * y) / params.m - vz * vz
         if not kin > 0.0:
-            raise ValueError(f"energy must exceed m g y + m vz^2/2 = "
-                             f"{params.m * (params.g * y + 0.5 * vz * vz):.6g} MgL at this "
-                             f"apex, got {energy_!r}")
+            raise ValueError(f"energy [MgL] must exceed m g y + m vz^2/2 = "
+                             f"{params.m * (params.g * y + 0.5 * vz * vz):.6g} at this "
+                             f"apex, got {energy!r}")
         return cls(y, math.sqrt(kin), vz, side=side)
 
     def section(self) -> np.ndarray:
@@ -196,7 +196,7 @@ def apex_step(params: SpatialParams, apex: SpatialApex,
     Tu = lo[4] / p.g
     nxt = SpatialApex(lo[1] + 0.5 * lo[4] * Tu, lo[3], lo[5], lo[0] + lo[3] * Tu,
                       lo[2] + lo[5] * Tu, -apex.side)
-    return SpatialStep(nxt, st, foot, td, lo, ts, T + ts + Tu, gamma)
+    return SpatialStep(nxt, st, foot, td, lo, ts, float(T + ts + Tu), gamma)
 
 
 def apex_steps(params: SpatialParams, apex: SpatialApex, n: int,
