@@ -23,10 +23,12 @@ import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.optimize import root
 
+from .._io import atomic_write
 from ..simulation.options import IntegratorOptions
 from .gait import SymmetricGait, _residual, _vx, floquet, symmetric_gaits
 from .parameters import SpatialParams
@@ -192,9 +194,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     rows = survey(grid)
     scans = {i: feedback_scan(r) for i, r in enumerate(rows) if r.heading == "fixed"}
     text = report(rows, scans, K_LATS, grid)
-    if a.out:
-        with open(a.out, "w", encoding="utf-8") as fh:
-            fh.write(text)
+    if a.out:  # replaced atomically: a link at that name is replaced, never written through
+        atomic_write(a.out, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
     else:
         print(text)
     return 0
