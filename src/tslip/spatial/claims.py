@@ -103,7 +103,7 @@ def _continue(p: SpatialParams, x: np.ndarray, energy: float,
 
 def feedback_scan(row: GaitRow, k_lats: Sequence[float] = K_LATS,
                   options: IntegratorOptions | None = None) -> np.ndarray:
-    """Largest non-trivial |multiplier| of the gait of ``row`` continued in ``k_lat``
+    """Largest non-trivial multiplier modulus of the gait of ``row`` continued in ``k_lat``
     (``heading="fixed"``), one per gain; NaN where the continuation lost it."""
     base = row.gait.params
     out = np.full(len(k_lats), np.nan)
