@@ -33,7 +33,8 @@ ODD = dict(m=0.9, l0=1.3, g=1.2)
 # with the vectors h and n, scipy's solve_ivp with its own event location
 # ---------------------------------------------------------------------------
 
-def _reference_step(p: SpatialParams, a: SpatialApex) -> tuple[str, np.ndarray | None]:
+def _reference_step(p: SpatialParams, a: SpatialApex, max_step: float = np.inf
+                    ) -> tuple[str, np.ndarray | None]:
     y_td = p.l0 * math.sin(p.beta0)
     if a.y <= y_td:
         return "apex low", None
@@ -66,7 +67,7 @@ def _reference_step(p: SpatialParams, a: SpatialApex) -> tuple[str, np.ndarray |
     ground.terminal, ground.direction = True, -1.0
 
     sol = solve_ivp(f, (0, 50), np.concatenate([c, v]), method="DOP853", rtol=1e-12,
-                    atol=1e-12, events=(liftoff, ground))
+                    atol=1e-12, events=(liftoff, ground), max_step=max_step)
     if sol.t_events[1].size:
         return "fall", sol.y_events[1][0]
     u = sol.y_events[0][0]
@@ -212,3 +213,30 @@ def test_presets_and_a_bad_name():
     assert preset("slip3d-feedback").k_lat == 1.5
     with pytest.raises(ValueError, match="preset must be one of"):
         preset("slip4d")
+
+
+@pytest.mark.parametrize("side", [1, -1])
+def test_a_stance_shorter_than_the_first_step_is_not_jumped(side):
+    """A touch-down barely compressing the leg at high speed (the foot almost sideways): a
+    stance of ~2e-4 under a forced first step of 0.3. Without the core's hump check the
+    first step ends with the leg beyond rest length again, no lift-off is seen, and the
+    stance goes on with the spring in tension."""
+    p = SpatialParams(k=25.0, beta0=1.19, gamma0=1.4, **ODD)
+    drop = 0.05
+    T = math.sqrt(2 * drop / p.g)
+    cb, phi, vx = math.cos(p.beta0), p.gamma0, 2.0
+    vz0 = -(cb * math.cos(phi) * vx + math.sin(p.beta0) * p.g * T) / (cb * math.sin(phi))
+    a = SpatialApex(p.touchdown_height + drop, vx, vz0 + 1e-3, side=1)  # (c - p).v < 0
+    if side == -1:
+        a = mirror(a)
+    kind, ref = _reference_step(p, a, max_step=1e-5)  # scipy, too, jumps it otherwise
+    assert kind == "no apex"
+    # the stance's length from the leg's length l(t): 2 |l'(0)| / l''(0) for a short hump
+    v2 = vx**2 + (p.g * T) ** 2 + a.vz**2
+    ld = -cb * math.sin(phi) * 1e-3  # (q.v)/l0 with the placement above, q.v = -l0 cb sin(phi) dvz
+    ldd = (v2 - ld**2) / p.l0 - p.g * math.sin(p.beta0)
+    for h0 in (0.0, 0.3):
+        s = apex_step(p, a, tslip.IntegratorOptions(rtol=1e-12, atol=1e-12, h0=h0))
+        assert s.status == SpatialStatus.NO_APEX
+        assert abs(s.stance_time / (2 * abs(ld) / ldd) - 1) < 0.01
+        np.testing.assert_allclose(s.liftoff, ref, rtol=0, atol=1e-9)
