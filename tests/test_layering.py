@@ -15,6 +15,7 @@ ALLOWED = {
     "sweeps": {"model", "simulation", "gait", "biped"},
     "experiment": {"model", "simulation", "gait", "biped"},
     "biped": {"model", "simulation", "gait"},
+    "spatial": {"model", "simulation"},
     "plotting": {"model", "simulation", "gait", "sweeps", "experiment", "biped"},
 }
 TOP = {"_io", "_lines", "_safefile", "_results", "_checks", "_gridsize", "_kernel_cache",

@@ -72,7 +72,7 @@ _SUBPACKAGE = {
 
 #: Subpackages, imported on first attribute access too (``tslip.gait.analyse``).
 _SUBPACKAGES = ("biped", "cli", "experiment", "gait", "model", "plotting", "protocols",
-               "simulation", "sweeps")
+               "simulation", "spatial", "sweeps")
 
 __all__ = [
     "__version__",

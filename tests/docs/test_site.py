@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 EXAMPLES = sorted((ROOT / "examples").glob("plot_*.py"))
 ANALYSES = ("gait", "stability", "slip", "robustness", "impulse", "stride", "studies", "experiment",
-            "biped")
+            "biped", "spatial")
 
 
 @pytest.fixture(scope="module")
@@ -51,7 +51,7 @@ def test_every_page_is_built(site: Path) -> None:
     pages = ["index", "getting-started", "model", "conventions", "reproducing", "speed",
              "changelog", "_generated/cli", "api/index", "gallery/index",
              *(f"analyses/{a}" for a in ANALYSES),
-             *(f"api/{m}" for m in ("model", "simulation", "gait", "sweeps", "biped",
+             *(f"api/{m}" for m in ("model", "simulation", "gait", "sweeps", "biped", "spatial",
                                     "experiment", "plotting", "protocols")),
              *(f"gallery/{e.stem}" for e in EXAMPLES)]
     missing = [p for p in pages if not (site / f"{p}.html").is_file()]

@@ -2,7 +2,8 @@
 
 Each subcommand module (:mod:`~tslip.cli.simulate`, :mod:`~tslip.cli.experiment`,
 :mod:`~tslip.cli.gait`, :mod:`~tslip.cli.studies`, :mod:`~tslip.cli.design`,
-:mod:`~tslip.cli.viability`, :mod:`~tslip.cli.explore`, :mod:`~tslip.cli.biped`)
+:mod:`~tslip.cli.viability`, :mod:`~tslip.cli.explore`, :mod:`~tslip.cli.biped`,
+:mod:`~tslip.cli.spatial`)
 defines its commands and imports its shared options and error handling from
 :mod:`tslip.cli._common`; this module only puts them together, adds
 ``--version`` and is the console script's entry point. Invalid input prints
@@ -15,7 +16,7 @@ from typing import Annotated
 import typer
 
 from .. import __version__
-from . import biped, design, experiment, explore, gait, simulate, studies, viability
+from . import biped, design, experiment, explore, gait, simulate, spatial, studies, viability
 from ._common import run
 
 __all__ = ["app", "main"]
@@ -32,6 +33,7 @@ app = typer.Typer(
 for _module in (simulate, experiment, gait, studies, design, viability, explore):
     app.registered_commands.extend(_module.commands.registered_commands)
 app.add_typer(biped.biped_app, name="biped")
+app.add_typer(spatial.spatial_app, name="spatial")
 
 
 def _print_version(value: bool) -> None:
