@@ -167,3 +167,20 @@ def test_the_api_refuses_a_bad_scheduler_before_building_a_client(monkeypatch, a
         _schedule.run_tasks([_schedule.Task(("t", 0), _double, (0,))], lambda t, r: [],
                             scheduler=address)
     assert what in str(err.value) and "\n" not in str(err.value)
+
+
+def test_the_scheduler_check_works_inside_a_running_event_loop():
+    """The check runs its connection on a loop of its own: called where a loop already
+    runs (a notebook, or a test that left one running) it still judges the address,
+    instead of failing with asyncio's "cannot be called from a running event loop"."""
+    import asyncio
+
+    from tslip.sweeps._schedule import check_scheduler
+
+    async def main():
+        with pytest.raises(ValueError) as err:
+            check_scheduler("foo", 0.5)
+        return str(err.value)
+
+    assert asyncio.run(main()).startswith(
+        "--scheduler 'foo' is not a Dask scheduler's address (ValueError: missing port")

@@ -36,6 +36,7 @@ import heapq
 import itertools
 import os
 import queue as queue_mod
+import threading
 import time
 from collections.abc import Callable, Hashable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
@@ -259,7 +260,7 @@ def check_scheduler(address: str, seconds: float = 10.0,
         return answer.get("type") if isinstance(answer, dict) else type(answer).__name__
 
     try:
-        kind = asyncio.run(identity())
+        kind = _in_own_loop(identity, 2 * seconds + 5)
     except (OSError, TimeoutError) as exc:
         why = " ".join(str(exc).split()) or type(exc).__name__
         raise ValueError(f"--scheduler {address!r}: no Dask scheduler answered within "
@@ -271,6 +272,28 @@ def check_scheduler(address: str, seconds: float = 10.0,
     if kind != "Scheduler":
         raise ValueError(f"--scheduler {address!r} is not a Dask scheduler's address "
                          f"(it answered as {str(kind)[:40]!r})")
+
+
+def _in_own_loop(coroutine: Callable[[], Any], seconds: float) -> Any:
+    """``coroutine()`` run to its end on a fresh event loop in a thread of its own (this
+    thread may already run a loop, where ``asyncio.run`` refuses); its result or its
+    exception, or ``TimeoutError`` after ``seconds``."""
+    box: dict[str, Any] = {}
+
+    def run() -> None:
+        try:
+            box["result"] = asyncio.run(coroutine())
+        except BaseException as exc:  # noqa: BLE001 - handed to the caller
+            box["error"] = exc
+
+    thread = threading.Thread(target=run, name="tslip-scheduler-check", daemon=True)
+    thread.start()
+    thread.join(seconds)
+    if thread.is_alive():
+        raise TimeoutError(f"no answer within {seconds:g} s")
+    if "error" in box:
+        raise box["error"]
+    return box["result"]
 
 
 def _drain(queue: Any, tick: Callable[[int], None] | None) -> None:
