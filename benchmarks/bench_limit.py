@@ -20,12 +20,27 @@ Definitions:
   :func:`tslip.run_batch` call of ``--steps`` strides of the gait (one row,
   nothing recorded) divided by ``--steps``.
 * **RHS-bound limit** = ``t_rhs x N_RHS``. ``t_rhs`` is the median time of one
-  compiled stance right-hand side (``_stance.rhs``) over the stride's own stance
-  states (the states at the integrator's steps, ``tslip.step(...).stance``), called
-  in a compiled loop. :data:`N_RHS` = 146 is frozen: the right-hand sides
-  (accepted and rejected steps, 6 per dopri5 step, plus the initial-step
-  estimate; no dense-output stages) that the kernel of revision 3b38fb1 spends
-  on this stride. Today's count is printed beside it (counted exactly by
+  stance right-hand side as the stride kernel runs it: ``_stance.rhs_inline``, the
+  code every stage of ``rk_step`` copies in (numba's ``inline="always"``), inlined
+  into one compiled loop with the kernels' compile flags (``_rk._JIT``: numpy's error
+  model) over the stride's own stance states (the states at the integrator's steps,
+  ``tslip.step(...).stance``), each copied into a whole state array as a stage's
+  arithmetic writes its ``ytmp``; all six derivatives are summed, so none is dropped
+  as unused. Issue 41 found the figure moved with the harness alone: a separately
+  compiled ``_stance.rhs`` (issue 25's harness) pays a call the kernel does not (the
+  same kernel read 1.35 to 1.73); Python's error model (zero-division checks) made
+  the inlined right-hand side 144 ns against 77; and writing into a row of a stage
+  matrix (a view, 146-161 ns) or reading a row of ``Y`` in place (150 ns) cost more
+  than the kernel's own stage loop spends on a right-hand side and its stage
+  arithmetic together (about 72 ns: ``rk_step`` replayed, the breakdown line's
+  ``steps``), against 53-63 ns from and into whole arrays (2026-12-06, load 7-9).
+  The states are independent, so the processor may overlap consecutive right-hand
+  sides, which a step's stages (each from the last) cannot: ``t_rhs`` is a
+  throughput, a floor for the kernel's. On a checkout without ``rhs_inline``,
+  ``_stance.rhs`` (which LLVM inlined into the stages there). :data:`N_RHS` = 146
+  is frozen: the right-hand sides (accepted and rejected steps, 6 per dopri5 step,
+  plus the initial-step estimate; no dense-output stages) that the kernel of
+  revision 3b38fb1 spends on this stride. Today's count is printed beside it (counted exactly by
   ``_rhs_count.py``: the stride as plain Python in a subprocess, every call of
   ``rhs`` counted), so a kernel taking fewer steps shows as a gain.
 * **unrecorded strides**: the same ``--steps`` strides through the compiled
@@ -40,10 +55,13 @@ Definitions:
   columns once.
 * **step_map**: one :func:`tslip.step_map` call from the gait's section (a
   loop of ``--maps`` calls, divided by ``--maps``), against one stride kernel.
-* **study point / its compiled work**: the wall time of one serial continuation
-  point of ``run_study`` over the summed time of the compiled kernel calls it
-  makes (wrapped and timed), both from ``benchmarks/_study_limit.py``'s
-  ``measure(rounds) -> (point seconds, kernel seconds)``; ``n/a`` if that
+* **study point / its compiled work**: the time of one serial continuation point
+  of ``run_study`` over the time of the compiled kernel calls it makes (stride
+  maps, exact Jacobians, ``alpha_r`` columns), recorded with their arguments in an
+  untimed round and replayed from one compiled loop per kernel, so that no Python
+  dispatch counts as compiled work; both CPU time (``--wall``: wall), from
+  ``benchmarks/_study_limit.py``'s ``measure(rounds, clock) -> (point seconds,
+  kernel seconds)``, its own ``--rounds`` rounds after the others; ``n/a`` if that
   module is missing.
 """
 
@@ -72,15 +90,28 @@ from tslip.simulation._stepper import rk_step
 #: revision 3b38fb1 (frozen: the limit does not move when the kernel takes fewer steps).
 N_RHS = 146
 
-@njit(cache=False)
+#: The stance right-hand side as the stages of ``rk_step`` run it: inlined into them
+#: (``_stance.rhs`` on checkouts before ``rhs_inline``, which LLVM inlined by itself).
+_RHS = getattr(_stance, "rhs_inline", _stance.rhs)
+#: The loops that time the kernels' own code compile with the kernels' flags (numpy's
+#: error model: no zero-division checks), uncached.
+_KJIT = dict(getattr(_rk, "_JIT", {"error_model": "numpy"}), cache=False)
+
+
+@njit(**_KJIT)
 def _rhs_loop(P, Y, reps):  # noqa: N803
-    """``reps`` passes of ``rhs`` over the rows of ``Y``; the sum keeps the calls alive."""
+    """``reps`` passes over the rows of ``Y`` of the right-hand side as a stage of ``rk_step``
+    calls it: inlined, from a whole state array (its ``ytmp``; here the row copied in) into
+    a whole output array. The sum of every derivative keeps all of each call alive."""
     dy = np.empty(6)
+    y = np.empty(6)
     acc = 0.0
     for _ in range(reps):
         for i in range(Y.shape[0]):
-            _stance.rhs(P, Y[i], dy)
-            acc += dy[3]
+            for j in range(6):
+                y[j] = Y[i, j]
+            _RHS(P, y, dy)
+            acc += dy[0] + dy[1] + dy[2] + dy[3] + dy[4] + dy[5]
     return acc
 
 
@@ -115,7 +146,7 @@ def _make_steps_loop(with_events: bool):  # noqa: ANN202 - a compiled function
     control, events or step-size choice. ``with_events``: ``rk_step`` takes the event
     values' array (its last stage computes them; checkouts before that take no such array)."""
 
-    @njit(cache=False)
+    @njit(**_KJIT)
     def _steps_loop(P, y0, hs, reps):  # noqa: N803
         ns = _rk.n_stages(_DOPRI5)
         K = np.empty((_rk.NK, 6))
@@ -142,7 +173,15 @@ def _make_steps_loop(with_events: bool):  # noqa: ANN202 - a compiled function
 _steps_loop = _make_steps_loop(len(inspect.signature(rk_step.py_func).parameters) == 8)
 
 
-@njit(cache=False)
+def _stance_kernel():  # noqa: ANN202 - a compiled function
+    """The compiled dopri5 stance kernel ``(P, O, y0, tx, th, rec, rec_dt, out) -> status``
+    that :func:`_stance_loop` calls (the one place that knows how the kernels are held:
+    one per method in a tuple, or one for all)."""
+    kernels = kn.STANCE_REC
+    return kernels[pk.M_DOPRI5] if isinstance(kernels, tuple) else kernels
+
+
+@njit(**_KJIT)
 def _stance_loop(stance, P, O, y0, reps):  # noqa: N803
     """``reps`` stances from ``y0`` through the stance kernel ``stance``, nothing recorded."""
     rec = np.empty((0, pk.NREC))
@@ -181,7 +220,7 @@ def main() -> None:
     rec = np.empty((4096, pk.NREC))
     kn.integrate_stance(P, O, y0, yout, rec, 0.0, stats)
     hs = np.diff(rec[: int(stats[3]), pk.REC_T])
-    stance = kn.STANCE_REC[pk.M_DOPRI5]
+    stance = _stance_kernel()
 
     data = tslip.simulate(p, s, a.steps, dt=a.dt).data
     beta = np.ascontiguousarray(data[:, pk.TR_BETA])
@@ -212,7 +251,7 @@ def main() -> None:
     except ImportError:
         pass
     else:
-        study = measure(a.rounds)
+        study = measure(a.rounds, "wall" if a.wall else "cpu")
     load1 = os.getloadavg()[0]
 
     what = "wall" if a.wall else "CPU"
@@ -240,7 +279,7 @@ def main() -> None:
           f"strides: {floor / t['strides']:.2f}")
     if study is not None:
         print(f"study point {study[0] * 1e3:.3f} ms, its compiled kernel calls "
-              f"{study[1] * 1e3:.3f} ms")
+              f"{study[1] * 1e3:.3f} ms (replayed in compiled loops; {what} time)")
     print(f"stride kernel / RHS-bound limit: {stride / (t_rhs * N_RHS):.2f}")
     print(f"simulate / unrecorded strides: {t['simulate'] / t['strides']:.2f}")
     print(f"simulate + to_dataframe / unrecorded strides: "

@@ -61,6 +61,23 @@ def test_trip_on_step_up(gait):
     assert low.ok and low.state.h == pytest.approx(0.5 * fy[i])
 
 
+@pytest.mark.parametrize("frac", [0.3, 0.6, 0.9])
+def test_riser_just_below_the_descending_foot_is_stepped_onto(gait, frac):
+    """A riser whose top the foot clears at its edge, by 2 % of its height there, is landed
+    on, never tripped over: the touch-down search may not step across the edge (a safe step
+    sized against the lower ground would carry the foot below the riser's top beyond it).
+    The foot's path is the closed-form flight (eq. 2.7) sampled by ``simulate``."""
+    tr = tslip.simulate(gait.params, gait.state, 1, dt=1e-4)
+    flight = tr["stance"] == 0
+    fx, fy = tr["foot_x"][flight], tr["foot_y"][flight]
+    top = int(np.argmax(fy))
+    i = top + int(frac * (len(fy) - 1 - top))  # on the way down
+    assert np.all(np.diff(fx) > 0)  # the foot moves forward: it passes the edge once
+    dh = 0.98 * fy[i]
+    r = tslip.step(gait.params, gait.state, terrain=tslip.Terrain.step(x=fx[i], dh=dh))
+    assert r.ok and r.state.h == pytest.approx(dh)
+
+
 @pytest.mark.parametrize(
     ("opts", "status"),
     [(tslip.IntegratorOptions(max_steps=3), Status.MAX_STEPS),

@@ -177,6 +177,55 @@ def _safe_dt(f, fd, K):
     return (fd + math.sqrt(fd * fd + 2.0 * K * f)) / K
 
 
+@njit(**_INLINE)
+def _foot_bounds(P, lo, bd):
+    """``(Kf, vx)`` for a leg turning at ``bd``: the bound on the foot height's second
+    derivative and on the foot's horizontal speed in flight (``phid = lo[5]``)."""
+    g = P[P_G]
+    r = abs(P[P_R])
+    l0 = P[P_L0]
+    phid = lo[5]
+    Kf = g + r * phid * phid + l0 * bd * bd + 1e-300
+    vx = abs(lo[2]) + r * abs(phid) + l0 * abs(bd) + 1e-300
+    return Kf, vx
+
+
+@njit(**_INLINE)
+def _leg_rate_bound(P, phid, ta):
+    """The swing leg's rate ``beta'`` in flight, or a bound on its size that holds on both
+    sides of the apex when the retraction clock starts there (``ta > 0``): before it the
+    held leg turns with the trunk (local reset) or not at all (global)."""
+    bd = P[P_OMEGA] if P[P_GLOBAL] != 0.0 else P[P_OMEGA] - phid
+    if ta > 0.0:
+        bd = max(abs(bd), abs(0.0 if P[P_GLOBAL] != 0.0 else phid))
+    return bd
+
+
+@njit(**_INLINE)
+def _breakpoint_dt(tx, k, foot_x, vx, dt):
+    """``dt`` cut so that a foot moving at most ``vx`` sideways does not cross a terrain
+    breakpoint of segment ``k`` unnoticed (at least 1e-12)."""
+    if tx.shape[0] > 0:
+        dist = math.inf
+        if k > 0:
+            dist = foot_x - tx[k - 1]
+        if k < tx.shape[0]:
+            dist = min(dist, tx[k] - foot_x)
+        dt = min(dt, max(dist / vx, 1e-12))
+    return dt
+
+
+@njit(**_INLINE)
+def _clock_dt(t, ta, ts, dt):
+    """``dt`` cut at the apex ``ta`` (the foot's rate jumps there) or, after it, at the
+    retraction stop ``ts`` (Section 7.5): no step crosses either."""
+    if t < ta:
+        dt = min(dt, ta - t)
+    elif ts < math.inf:
+        dt = min(dt, ts - t)
+    return dt
+
+
 @njit(**_JIT)
 def find_touchdown(P, O, lo, tx, th, res):
     """First touch-down after lift-off, by certified safe steps.
@@ -195,18 +244,12 @@ def find_touchdown(P, O, lo, tx, th, res):
 
     ``res`` receives ``(t_td, ground_h, clearance_at_reset)``.
     """
-    g = P[P_G]
     r = abs(P[P_R])
-    l0 = P[P_L0]
     phid = lo[5]
-    bd = P[P_OMEGA] if P[P_GLOBAL] != 0.0 else P[P_OMEGA] - phid
     ta = retraction_start(P, lo[3])
-    if ta > 0.0:  # before the apex the held leg turns with the trunk (local) or not at all
-        bd = max(abs(bd), abs(0.0 if P[P_GLOBAL] != 0.0 else phid))
     ts = stop_time(P, ta)
-    Kf = g + r * phid * phid + l0 * bd * bd + 1e-300
-    Kh = g + r * phid * phid + 1e-300
-    vx = abs(lo[2]) + r * abs(phid) + l0 * abs(bd) + 1e-300
+    Kf, vx = _foot_bounds(P, lo, _leg_rate_bound(P, phid, ta))
+    Kh = P[P_G] + r * phid * phid + 1e-300
     t_max = O[O_TMAX_FLIGHT]
     tol = 1e-13
     t = 0.0
@@ -218,9 +261,7 @@ def find_touchdown(P, O, lo, tx, th, res):
     for _ in range(100000):
         if t >= ts:  # stopped from here on: the leg turns with the trunk (local) or not at all
             ts = math.inf
-            bd = 0.0 if P[P_GLOBAL] != 0.0 else phid
-            Kf = g + r * phid * phid + l0 * bd * bd + 1e-300
-            vx = abs(lo[2]) + r * abs(phid) + l0 * abs(bd) + 1e-300
+            Kf, vx = _foot_bounds(P, lo, 0.0 if P[P_GLOBAL] != 0.0 else phid)
         if t > t_max:
             res[0] = t
             return ST_ERR_FLIGHT_TIMEOUT
@@ -246,19 +287,7 @@ def find_touchdown(P, O, lo, tx, th, res):
             dt = _safe_dt(max(-f, 1e-300), -foot_yd, Kf)
             dt = max(dt, 1e-12)
         dt = min(dt, _safe_dt(hh, hip_yd, Kh))
-        # do not step across a terrain breakpoint unnoticed
-        if tx.shape[0] > 0:
-            dist = math.inf
-            if k > 0:
-                dist = foot_x - tx[k - 1]
-            if k < tx.shape[0]:
-                dist = min(dist, tx[k] - foot_x)
-            dt = min(dt, max(dist / vx, 1e-12))
-        if t < ta:  # stop at the apex: the foot's rate jumps there
-            dt = min(dt, ta - t)
-        elif ts < math.inf:  # and at the retraction stop (Section 7.5)
-            dt = min(dt, ts - t)
-        t += dt
+        t += _clock_dt(t, ta, ts, _breakpoint_dt(tx, k, foot_x, vx, dt))
         foot_y, foot_yd, hip_y, hip_yd, foot_x = _flight_heights(P, lo, t, ta)
         knew = _segment(tx, foot_x)
         if knew != k:
