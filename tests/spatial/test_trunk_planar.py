@@ -70,3 +70,29 @@ def test_a_planar_fall_is_the_same_fall():
     r3 = trunk_step(tp, from_planar(tp, td), options=OPT)
     assert not r2.ok
     assert r3.status == TrunkStatus[r2.status.name]
+
+
+@pytest.mark.parametrize("change", [
+    {"retraction": "apex"},
+    {"leg_exponent": 1.5},  # passive, undamped: lift-off located on the spring
+    {"leg_exponent": 0.8, "controller": ConstantTorque(tau_c=0.2, c_h=0.05)},
+    {"leg_thrust": 0.1, "c_l": 0.3},
+    {"alpha_stop": 0.95, "leg_reset": "global"},
+])
+def test_the_planar_leg_law_and_retraction_options_carry_over(change):
+    p = dataclasses.replace(_planar(Passive(), "local"), **change)
+    tp = TrunkParams.from_planar(p)
+    td = tslip.TouchdownState(beta=1.0, phi=0.04, xd=2.0, yd=-0.3, phid=-0.2, x=0.3)
+    state = from_planar(tp, td, side=-1)
+    for _ in range(2):
+        r2 = tslip.step(p, td, options=OPT)
+        r3 = trunk_step(tp, state, options=OPT)
+        # the same outcome at the same instant: a fall too (the hip reaching the ground)
+        assert r3.status.name == r2.status.name
+        assert abs(r3.stance_time - r2.stance_time) < 1e-9
+        assert abs(r3.flight_time - r2.flight_time) < 1e-9
+        if not r2.ok:
+            break
+        np.testing.assert_allclose(to_planar(tp, r3.state).as_array(), r2.state.as_array(),
+                                   rtol=0, atol=1e-9)
+        td, state = r2.state, r3.state
