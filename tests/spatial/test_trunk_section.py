@@ -93,3 +93,32 @@ def test_symmetric_gait_lands_on_its_mirror_and_has_the_trivial_multipliers():
 def test_bad_section_vector_is_refused():
     with pytest.raises(ValueError, match="section vector"):
         from_section(TP, X[:9])
+
+
+@pytest.mark.parametrize("change", [{"k_splay": 0.5}, {"k_trail": 0.8},
+                                    {"k_splay": -0.7, "k_trail": -1.2}])
+def test_roll_couplings_keep_the_mirror_and_the_round_trip(change):
+    tp = dataclasses.replace(TP, **change)
+    for side in (1, -1):
+        s = from_section(tp, X, side)
+        np.testing.assert_allclose(section(tp, s), X, atol=1e-13)
+    right, st_r = one_step_map(tp, X, side=1, options=OPT)
+    left, st_l = one_step_map(tp, MIRROR * X, side=-1, options=OPT)
+    assert st_r == st_l == TrunkStatus.OK
+    np.testing.assert_allclose(left, MIRROR * right, rtol=0, atol=1e-9)
+    base, _ = one_step_map(TP, X, side=1, options=OPT)
+    assert np.max(np.abs(right - base)) > 1e-3  # the coupling acts
+
+
+def test_roll_couplings_place_the_leg_as_documented():
+    # leaning right (roll > 0): the right leg splays further out, the trail turns it right
+    from tslip.spatial.trunk_section import _attitude, _placement
+    R = _attitude(0.0, 0.0, 0.1)
+    base = _placement(TP, 1, 1.0, R)
+    out = _placement(dataclasses.replace(TP, k_splay=1.0), 1, 1.0, R)
+    np.testing.assert_allclose(out, [np.cos(1.0), -np.sin(1.0) * np.cos(0.18),
+                                     np.sin(1.0) * np.sin(0.18)], atol=1e-15)
+    left = _placement(dataclasses.replace(TP, k_splay=1.0), -1, 1.0, R)
+    assert abs(left[2]) < abs(base[2])  # the left leg, leaning away from it: less splay
+    turned = _placement(dataclasses.replace(TP, k_trail=1.0), 1, 1.0, R)
+    assert turned[2] > base[2] and abs(np.linalg.norm(turned) - 1.0) < 1e-15

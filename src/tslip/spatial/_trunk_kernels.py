@@ -62,7 +62,7 @@ from ..simulation._rk import _INLINE, _JIT
 
 #: Parameter vector layout (:meth:`tslip.spatial.trunk_parameters.TrunkParams.packed`)
 (P_M, P_J, P_JROLL, P_JYAW, P_R, P_K, P_L0, P_G, P_CL, P_NEXP, P_THRUST, P_OMEGA, P_ALPHA,
- P_SPLAY, P_GLOBAL, P_STOP, P_C0) = range(17)
+ P_SPLAY, P_GLOBAL, P_STOP, P_KSPLAY, P_KTRAIL, P_C0) = range(19)
 #: Per-phase slots: side, foot (x, y, z), current rest length, thrust pending (1/0),
 #: retraction clock start after lift-off
 P_SIDE = P_C0 + 4
@@ -245,15 +245,33 @@ def swing_angle(P, t):
 @njit(**_INLINE)
 def leg_direction(P, R, t, d):
     """The flight leg's direction in the trunk frame, ``d = (cos a, -sin a cos(splay),
-    s sin a sin(splay))``, with the hip angle ``a`` (the global reset adds the pitch)."""
+    s sin a sin(splay))``, with the hip angle ``a`` (the global reset adds the pitch).
+
+    The roll couplings (0 in the base model; ``rho`` the roll of the yaw-pitch-roll
+    sequence, ``atan2(-R_12, R_11)``, > 0 leaning right): the splay is ``splay +
+    k_splay s rho`` (outward when leaning towards the leg), and ``d`` is then turned
+    about ``y_b`` by ``-k_trail rho`` (to the right when leaning right, a trail).
+    """
     a = swing_angle(P, t)
     if P[P_GLOBAL] != 0.0:
         ct = math.sqrt(R[0, 0] * R[0, 0] + R[2, 0] * R[2, 0])
         a += math.atan2(R[1, 0], ct)
+    s = P[P_SIDE]
     sp = P[P_SPLAY]
+    ks, kt = P[P_KSPLAY], P[P_KTRAIL]
+    rho = 0.0
+    if ks != 0.0 or kt != 0.0:
+        rho = math.atan2(-R[1, 2], R[1, 1])
+        sp += ks * s * rho
     d[0] = math.cos(a)
     d[1] = -math.sin(a) * math.cos(sp)
-    d[2] = P[P_SIDE] * math.sin(a) * math.sin(sp)
+    d[2] = s * math.sin(a) * math.sin(sp)
+    if kt != 0.0:
+        psi = -kt * rho
+        c, z = math.cos(psi), math.sin(psi)
+        d0, d2 = d[0], d[2]
+        d[0] = c * d0 + z * d2
+        d[2] = -z * d0 + c * d2
 
 
 @njit(**_JIT)

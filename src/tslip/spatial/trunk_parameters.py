@@ -15,7 +15,10 @@ sagittal plane (``leg_reset="local"``, the base model) or its pitch in the
 world (``"global"``, the pitch of a yaw-pitch-roll sequence; for the planar
 limit); ``controller`` is one of the four planar hip controllers, acting about
 ``z_b``. ``splay`` turns the flight leg outward about ``x_b`` (towards
-``+z_b`` for the right leg).
+``+z_b`` for the right leg). ``k_splay`` and ``k_trail`` (0: the base model)
+couple the placement to the trunk's roll ``rho`` (the roll of the yaw-pitch-roll
+sequence, > 0 leaning right): splay ``splay + k_splay s rho``, and the leg turned
+about ``y_b`` by ``-k_trail rho`` (a trail: to the right when leaning right).
 """
 
 from __future__ import annotations
@@ -63,6 +66,9 @@ class TrunkParams:
                            0.0, 0.5, False, False)
     splay: float = _f(0.0, "rad", "leg abduction about the trunk's forward axis (+: outward)",
                       -math.pi / 2, math.pi / 2)
+    k_splay: float = _f(0.0, "-", "splay per roll angle at placement (+: outward leaning "
+                        "towards the leg)")
+    k_trail: float = _f(0.0, "-", "placement yaw per roll angle (+: to the right leaning right)")
     controller: Controller = field(default_factory=Passive)
     leg_reset: LegReset = "local"
     retraction: Retraction = "liftoff"
@@ -103,6 +109,7 @@ class TrunkParams:
         P[kn.P_OMEGA], P[kn.P_ALPHA], P[kn.P_SPLAY] = self.omega_r, self.alpha_r, self.splay
         P[kn.P_GLOBAL] = 1.0 if self.leg_reset == "global" else 0.0
         P[kn.P_STOP] = 0.0 if self.alpha_stop is None else self.alpha_stop
+        P[kn.P_KSPLAY], P[kn.P_KTRAIL] = self.k_splay, self.k_trail
         P[kn.P_C0:kn.P_C0 + 4] = self.controller.torque_coefficients()
         P[kn.P_SIDE] = float(side)
         P[kn.P_LREST] = self.l0

@@ -30,6 +30,7 @@ import math
 import numpy as np
 
 from ..simulation.options import IntegratorOptions
+from . import _trunk_kernels as kn
 from .trunk import TrunkStatus, TrunkTouchdown, rotation, trunk_step
 from .trunk_parameters import TrunkParams
 
@@ -77,6 +78,16 @@ def _quaternion(R: np.ndarray) -> np.ndarray:
     return qa if qa[0] >= 0.0 else -qa
 
 
+def _placement(params: TrunkParams, side: int, a: float, R: np.ndarray) -> np.ndarray:
+    """The leg direction in the trunk frame at hip angle ``a`` (with the roll couplings):
+    the kernel's :func:`~tslip.spatial._trunk_kernels.leg_direction` itself."""
+    P = params.packed(side)
+    P[kn.P_ALPHA], P[kn.P_OMEGA], P[kn.P_GLOBAL], P[kn.P_STOP] = a, 0.0, 0.0, 0.0
+    d = np.empty(3)
+    kn.leg_direction(P, np.ascontiguousarray(R), 0.0, d)
+    return d
+
+
 def from_section(params: TrunkParams, x: np.ndarray, side: int = 1) -> TrunkTouchdown:
     """The touch-down of section vector ``x`` (module docstring), CoM above ``x = z = 0``."""
     x = np.asarray(x, dtype=float)
@@ -84,8 +95,7 @@ def from_section(params: TrunkParams, x: np.ndarray, side: int = 1) -> TrunkTouc
         raise ValueError(f"section vector must have shape (10,), got {x.shape}")
     a, yaw, pitch, roll = x[0:4]
     R = _attitude(yaw, pitch, roll)
-    sp = params.splay
-    d = np.array([math.cos(a), -math.sin(a) * math.cos(sp), side * math.sin(a) * math.sin(sp)])
+    d = _placement(params, side, a, R)
     off = params.r * R[:, 1] + params.l0 * (R @ d)
     c = np.array([0.0, -off[1], 0.0])
     foot = c + off
@@ -99,10 +109,14 @@ def section(params: TrunkParams, state: TrunkTouchdown) -> np.ndarray:
     y = state.y
     R = rotation(y)
     u = R.T @ (state.foot - y[0:3] - params.r * R[:, 1])
+    roll = math.atan2(-R[1, 2], R[1, 1])
+    if params.k_trail != 0.0:  # undo the trail's turn about y_b (kernel's leg_direction)
+        psi = -params.k_trail * roll
+        c, z = math.cos(psi), math.sin(psi)
+        u = np.array([c * u[0] - z * u[2], u[1], z * u[0] + c * u[2]])
     a = math.atan2(math.hypot(u[1], u[2]), u[0])
     yaw = math.atan2(-R[2, 0], R[0, 0])
     pitch = math.atan2(R[1, 0], math.hypot(R[0, 0], R[2, 0]))
-    roll = math.atan2(-R[1, 2], R[1, 1])
     return np.array([a, yaw, pitch, roll, *y[3:6], *y[10:13]])
 
 
