@@ -140,8 +140,16 @@ def _heading(R: np.ndarray) -> np.ndarray:
     return h / math.hypot(h[0], h[2])
 
 
+_DEFAULT_O = IntegratorOptions().packed()
+
+
 def _options(options: IntegratorOptions | None) -> np.ndarray:
-    return (options or IntegratorOptions()).packed()
+    return _DEFAULT_O if options is None else options.packed()
+
+
+def _crossed(side: int, foot: np.ndarray, c: np.ndarray, h: np.ndarray) -> bool:
+    """The foot on the far side of the mid-plane: ``s (p - c) . n < 0``, ``n = h x e_y``."""
+    return side * (-(foot[0] - c[0]) * h[2] + (foot[2] - c[2]) * h[0]) < 0.0
 
 
 def touchdown_fall(params: TrunkParams, state: TrunkTouchdown) -> TrunkStatus:
@@ -149,8 +157,7 @@ def touchdown_fall(params: TrunkParams, state: TrunkTouchdown) -> TrunkStatus:
     y, p = state.y, state.foot
     R = rotation(y)
     h = _heading(R)
-    n = np.cross(h, [0.0, 1.0, 0.0])
-    if state.side * float(np.dot(p - y[0:3], n)) < 0.0:
+    if _crossed(state.side, p, y, h):
         return TrunkStatus.FALL_CROSSED_LEG
     if y[1] + params.r * R[1, 1] <= 0.0:
         return TrunkStatus.FALL_HIP_GROUND
@@ -239,8 +246,7 @@ def trunk_step(params: TrunkParams, state: TrunkTouchdown, *,
     foot = y[0:3] + params.r * R[:, 1] + params.l0 * (R @ d)
     foot[1] = 0.0  # on the ground: the event located it there to the root's tolerance
     td = TrunkTouchdown(y, foot, side)
-    h = _heading(R)
-    if side * float(np.dot(foot - y[0:3], np.cross(h, [0.0, 1.0, 0.0]))) < 0.0:
+    if _crossed(side, foot, y, _heading(R)):
         return TrunkStep(TrunkStatus.FALL_CROSSED_LEG, td, ts, tf, ylo, nsteps)
     return TrunkStep(TrunkStatus.OK, td, ts, tf, ylo, nsteps)
 
