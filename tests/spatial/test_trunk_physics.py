@@ -13,6 +13,7 @@ Parameters are away from 1 (m, l0, g) so that a missing factor shows.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -22,7 +23,7 @@ from scipy.interpolate import CubicHermiteSpline
 from scipy.spatial.transform import Rotation
 
 import tslip
-from tslip.model.controllers import ConstantTorque, Passive
+from tslip.model.controllers import ConstantTorque, GlobalPD, Passive
 from tslip.spatial import _trunk_kernels as kn
 from tslip.spatial.trunk import TrunkStatus, TrunkTouchdown, trunk_energy, trunk_stance, trunk_step
 from tslip.spatial.trunk_parameters import TrunkParams
@@ -64,7 +65,7 @@ def _split(s):
 
 def _ref_stance_rhs(tp, foot):
     Jb = np.diag([tp.J_roll, tp.J_yaw, tp.J])
-    a0, _, a2, a3 = tp.controller.torque_coefficients()  # a local controller: a2 == a3
+    a0, a1, a2, a3 = tp.controller.torque_coefficients()
 
     def forces(s):
         c, v, R, w = _split(s)
@@ -79,7 +80,8 @@ def _ref_stance_rhs(tp, foot):
         ub = R.T @ u
         ubd = R.T @ ((-hipd - u * ld) / l) - R.T @ np.cross(w, u)
         alphad = (ub[0] * -ubd[1] - (-ub[1]) * ubd[0]) / (ub[0] ** 2 + ub[1] ** 2)
-        tau = a0 + a2 * alphad
+        theta, thetad = _pitch_and_rate(R, R.T @ w)
+        tau = a0 + a1 * theta + a2 * (alphad - thetad) + a3 * thetad
         tvec = tau * R[:, 2]
         tperp = tvec - (tvec @ u) * u
         F = -Fl * u + np.cross(tperp, u) / l
@@ -100,6 +102,24 @@ def _ref_stance_rhs(tp, foot):
     return f, fy
 
 
+def _hip_angle(tp, t, R):
+    """The flight hip angle: eq. 2.17's swing, plus the pitch under the global reset."""
+    a = tp.alpha_r + tp.omega_r * t
+    if tp.leg_reset == "global":
+        a += Rotation.from_matrix(R).as_euler("YZX")[1]
+    return a
+
+
+def _pitch_and_rate(R, wb):
+    """Pitch of R = R_y(yaw) R_z(pitch) R_x(roll) and its rate, from the Euler-angle
+    kinematics w_b = Rx^T Rz^T (0, yawd, 0) + Rx^T (0, 0, pitchd) + (rolld, 0, 0)."""
+    _, th, ph = Rotation.from_matrix(R).as_euler("YZX")
+    Rz = Rotation.from_euler("Z", th).as_matrix()
+    Rx = Rotation.from_euler("X", ph).as_matrix()
+    A = np.column_stack([Rx.T @ Rz.T @ EY, Rx.T @ [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+    return th, np.linalg.solve(A, wb)[1]
+
+
 def _ref_flight(tp, side):
     Jb = np.diag([tp.J_roll, tp.J_yaw, tp.J])
 
@@ -111,7 +131,7 @@ def _ref_flight(tp, side):
 
     def foot_y(t, s):
         c, _, R, _ = _split(s)
-        return (c + tp.r * R[:, 1] + tp.l0 * _leg(tp, side, tp.alpha_r + tp.omega_r * t, R))[1]
+        return (c + tp.r * R[:, 1] + tp.l0 * _leg(tp, side, _hip_angle(tp, t, R), R))[1]
 
     foot_y.terminal, foot_y.direction = True, -1
     return f, foot_y
@@ -129,8 +149,10 @@ def _from_world(s):
     return np.concatenate([c, v, q, R.T @ w])
 
 
-def test_stride_agrees_with_an_independent_newton_euler_model():
-    tp = TORQUED
+@pytest.mark.parametrize("tp", [TORQUED, dataclasses.replace(
+    TORQUED, leg_reset="global", alpha_r=0.8, controller=GlobalPD(Kp=2.0, Kd=0.3, phi_ref=0.1))],
+    ids=["local-torque", "global-pd"])
+def test_stride_agrees_with_an_independent_newton_euler_model(tp):
     td = _touchdown(tp)
     r = trunk_step(tp, td, options=OPT)
     assert r.ok, r.status
@@ -151,7 +173,7 @@ def test_stride_agrees_with_an_independent_newton_euler_model():
     assert abs(r.flight_time - tf) < 1e-9
     np.testing.assert_allclose(_to_world(r.state.y), std, rtol=0, atol=1e-8)
     c, _, R, _ = _split(std)
-    foot = c + tp.r * R[:, 1] + tp.l0 * _leg(tp, -td.side, tp.alpha_r + tp.omega_r * tf, R)
+    foot = c + tp.r * R[:, 1] + tp.l0 * _leg(tp, -td.side, _hip_angle(tp, tf, R), R)
     np.testing.assert_allclose(r.state.foot, foot, rtol=0, atol=1e-8)
     assert r.state.side == -td.side
 
