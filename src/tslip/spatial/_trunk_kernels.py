@@ -46,6 +46,11 @@ to <= 0 (docs/conventions.md):
 * flight: 0 the foot height ``H_y + l0 (R d)_y`` (eq. 2.9 in 3-D; ``d`` the leg
   direction in the trunk frame, :func:`leg_direction`), 1 hip height (no
   touch-down before the hip reaches the ground).
+
+Known limit: the flight's events are checked at the ends of each accepted step, so
+a foot that rises above the ground and comes back below within one step (a
+grazing hump shorter than a step) is not seen; the planar flight's certified
+safe steps (:func:`tslip.simulation._flight.find_touchdown`) have no 3-D twin yet.
 """
 
 from __future__ import annotations
