@@ -1,0 +1,294 @@
+"""The TSLIP in three dimensions: touch-down -> stance -> lift-off -> flight -> touch-down.
+
+Issue 43, Part 2. The model (:class:`~tslip.spatial.trunk_parameters.TrunkParams`;
+equations in :mod:`tslip.spatial._trunk_kernels`): a rigid trunk of mass ``m``
+and principal inertias ``(J_roll, J_yaw, J)`` about its axes ``(x_b, y_b, z_b)``
+(forward, along the trunk to the hip, right), the hip on the trunk axis at
+``H = c + r y_b`` (the planar model's, eq. A.3), massless spring legs from the
+hip to a point foot with the planar leg law (eq. 2.1, its exponent and thrust).
+
+* Touch-down state (:class:`TrunkTouchdown`): the 13 numbers ``y = (c, v, q,
+  w_b)`` (CoM, its velocity, the unit quaternion trunk -> world, the body
+  angular velocity), the foot ``p`` on the ground and the ``side`` of the leg
+  that has landed (``+1`` right, ``-1`` left). A touch-down fails (a fall at the
+  touch-down instant, in this order) when the foot is on the far side of the
+  body's mid-plane from its leg, ``s (p - c) . n < 0`` with ``n = h x e_y`` and
+  ``h`` the trunk's horizontal heading (:attr:`TrunkStatus.FALL_CROSSED_LEG`);
+  when the hip is at or below the ground; when the body moves backward,
+  ``v . h < 0``; or when the leg lengthens (docs/conventions.md, "Events").
+* Stance: the foot fixed; lift-off at the first downward zero of the vertical
+  foot force (eq. 2.8; the planar rule for a power-law leg). The hip torque of
+  the planar controller acts about ``z_b``; the trunk receives its component
+  across the leg (a point foot takes no torque about the leg).
+* Flight: ballistic CoM, torque-free trunk (Euler's equations on the same
+  Runge-Kutta core). The other leg (``side = -s``) is placed locally: its
+  direction in the trunk frame is ``d = (cos a, -sin a cos(splay), s sin a
+  sin(splay))`` with the planar hip angle ``a(t)`` (eq. 2.17 with the planar
+  retraction clock and stop; under ``leg_reset="global"`` ``a`` is the leg's
+  pitch plus the trunk's pitch ``asin(x_b . e_y)``, the yaw-pitch-roll pitch).
+  Touch-down is the first downward zero of the foot height ``H_y + l0 (R d)_y``
+  (eq. 2.9 in 3-D); the hip reaching the ground first is a fall.
+
+The planar limit (``splay = 0``, no roll, yaw or lateral motion) is the planar
+:func:`tslip.step` in every planar variable (:func:`from_planar`,
+:func:`to_planar`; tests/spatial/test_trunk_planar.py).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model._pack import O_TMAX_FLIGHT, O_TMAX_STANCE
+from ..model.state import TouchdownState
+from ..simulation.options import IntegratorOptions
+from . import _trunk_kernels as kn
+from .trunk_parameters import TrunkParams
+
+__all__ = ["TrunkStatus", "TrunkTouchdown", "TrunkStep", "trunk_step", "trunk_stance",
+           "from_planar", "to_planar", "trunk_energy", "STATE_NAMES"]
+
+#: Names of the 13 state components (:mod:`tslip.spatial._trunk_kernels`).
+STATE_NAMES: tuple[str, ...] = ("x", "y", "z", "vx", "vy", "vz", "qw", "qx", "qy", "qz",
+                                "w_roll", "w_yaw", "w_pitch")
+
+
+class TrunkStatus(enum.IntEnum):
+    """Outcome of a 3-D TSLIP stride (module docstring)."""
+
+    OK = kn.ST_OK
+    FALL_BACKWARD = kn.ST_FALL_BACKWARD
+    FALL_HIP_GROUND = kn.ST_FALL_HIP_GROUND
+    FALL_NO_TOUCHDOWN = kn.ST_FALL_NO_TOUCHDOWN
+    FALL_LENGTHENING = kn.ST_FALL_LENGTHENING
+    FALL_CROSSED_LEG = kn.ST_FALL_CROSSED_LEG
+    STEP_UNDERFLOW = kn.ST_ERR_STEP_UNDERFLOW
+    MAX_STEPS = kn.ST_ERR_MAX_STEPS
+    TIMEOUT = kn.ST_ERR_TIMEOUT
+    NONFINITE = kn.ST_ERR_NONFINITE
+
+    @property
+    def is_fall(self) -> bool:
+        return 0 < self.value < 10
+
+    @property
+    def is_error(self) -> bool:
+        return self.value >= 10
+
+
+@dataclass(frozen=True)
+class TrunkTouchdown:
+    """The state at a touch-down: ``y`` (13, :data:`STATE_NAMES`), the foot ``p`` (3, on
+    the ground) and the ``side`` of the leg that has landed (+1 right, -1 left)."""
+
+    y: np.ndarray
+    foot: np.ndarray
+    side: int = 1
+
+    def __post_init__(self) -> None:
+        y = np.array(self.y, dtype=float).reshape(-1)
+        foot = np.array(self.foot, dtype=float).reshape(-1)
+        if y.shape != (kn.NSTATE,) or not np.all(np.isfinite(y)):
+            raise ValueError(f"TrunkTouchdown.y must be 13 finite numbers, got shape {y.shape}")
+        if foot.shape != (3,) or not np.all(np.isfinite(foot)):
+            raise ValueError(f"TrunkTouchdown.foot must be 3 finite numbers, got {foot}")
+        if self.side not in (1, -1):
+            raise ValueError(f"TrunkTouchdown.side must be 1 (right) or -1 (left), "
+                             f"got {self.side!r}")
+        nq = float(np.linalg.norm(y[6:10]))
+        if nq == 0.0:
+            raise ValueError("TrunkTouchdown.y: the quaternion y[6:10] must not be 0")
+        y[6:10] /= nq
+        object.__setattr__(self, "y", y)
+        object.__setattr__(self, "foot", foot)
+
+    @property
+    def R(self) -> np.ndarray:
+        """The trunk's rotation matrix (columns ``x_b, y_b, z_b`` in the world)."""
+        return rotation(self.y)
+
+
+@dataclass(frozen=True)
+class TrunkStep:
+    """One stride: the next touch-down (``None`` after a fall or error), the durations,
+    the lift-off state (13; NaN if none) and the integrator's accepted steps."""
+
+    status: TrunkStatus
+    state: TrunkTouchdown | None
+    stance_time: float
+    flight_time: float
+    liftoff: np.ndarray
+    n_steps: int
+
+    @property
+    def ok(self) -> bool:
+        return self.status == TrunkStatus.OK
+
+
+def rotation(y: np.ndarray) -> np.ndarray:
+    """``R`` of the (renormalised) quaternion ``y[6:10]``."""
+    R = np.empty((3, 3))
+    kn.rotation(np.asarray(y, dtype=float), R)
+    return R
+
+
+def _heading(R: np.ndarray) -> np.ndarray:
+    h = np.array([R[0, 0], 0.0, R[2, 0]])
+    return h / math.hypot(h[0], h[2])
+
+
+_DEFAULT_O = IntegratorOptions().packed()
+
+
+def _options(options: IntegratorOptions | None) -> np.ndarray:
+    return _DEFAULT_O if options is None else options.packed()
+
+
+def _crossed(side: int, foot: np.ndarray, c: np.ndarray, h: np.ndarray) -> bool:
+    """The foot on the far side of the mid-plane: ``s (p - c) . n < 0``, ``n = h x e_y``."""
+    return side * (-(foot[0] - c[0]) * h[2] + (foot[2] - c[2]) * h[0]) < 0.0
+
+
+def touchdown_fall(params: TrunkParams, state: TrunkTouchdown) -> TrunkStatus:
+    """The fall a stance starts in (module docstring), else ``OK``."""
+    y, p = state.y, state.foot
+    R = rotation(y)
+    h = _heading(R)
+    if _crossed(state.side, p, y, h):
+        return TrunkStatus.FALL_CROSSED_LEG
+    if y[1] + params.r * R[1, 1] <= 0.0:
+        return TrunkStatus.FALL_HIP_GROUND
+    if float(np.dot(y[3:6], h)) < 0.0:
+        return TrunkStatus.FALL_BACKWARD
+    P = _stance_params(params, state)
+    o = np.empty(16)
+    kn.stance_terms(P, y, np.empty((3, 3)), o)
+    if o[10] > 0.0:
+        return TrunkStatus.FALL_LENGTHENING
+    return TrunkStatus.OK
+
+
+def _stance_params(params: TrunkParams, state: TrunkTouchdown) -> np.ndarray:
+    P = params.packed(state.side)
+    P[kn.P_FOOT:kn.P_FOOT + 3] = state.foot
+    return P
+
+
+def trunk_stance(params: TrunkParams, state: TrunkTouchdown, *,
+                 options: IntegratorOptions | None = None, rows: int = 0,
+                 ) -> tuple[TrunkStatus, float, np.ndarray, np.ndarray, int]:
+    """The stance from ``state``: ``(status, duration, end state, records, steps)``.
+
+    ``records`` holds ``(t, y)`` at the start and at each accepted step, up to
+    ``rows`` rows (a leg thrust's switch restarts the step sequence, so its
+    rows continue in time). The touch-down's own falls are not checked here
+    (:func:`trunk_step` does).
+    """
+    O = _options(options)
+    P = _stance_params(params, state)
+    y = state.y.copy()
+    out = np.empty(kn.NOUT)
+    t = 0.0
+    nsteps = 0
+    recs = []
+    while True:
+        rec = np.empty((rows, 1 + kn.NSTATE))
+        status = kn.run_phase(P, O, kn.STANCE, y, O[O_TMAX_STANCE] - t, out, rec)
+        nrec = int(out[kn.OUT_NREC])
+        rec = rec[:nrec]
+        rec[:, 0] += t
+        recs.append(rec)
+        rows = max(rows - nrec, 0)
+        t += out[kn.OUT_T]
+        nsteps += int(out[kn.OUT_NSTEP])
+        y = out[kn.OUT_Y:kn.OUT_Y + kn.NSTATE].copy()
+        if status != kn.ST_SWITCH:
+            break
+        P[kn.P_LREST] = params.l0 * (1.0 + params.leg_thrust)
+        P[kn.P_PENDING] = 0.0
+    y[6:10] /= np.linalg.norm(y[6:10])
+    return TrunkStatus(status), t, y, np.concatenate(recs), nsteps
+
+
+def trunk_step(params: TrunkParams, state: TrunkTouchdown, *,
+               options: IntegratorOptions | None = None) -> TrunkStep:
+    """One stride from the touch-down ``state`` to the other leg's touch-down."""
+    if not isinstance(params, TrunkParams):
+        raise TypeError(f"params must be TrunkParams, got {type(params).__name__}")
+    nan = np.full(kn.NSTATE, np.nan)
+    fall = touchdown_fall(params, state)
+    if fall != TrunkStatus.OK:
+        return TrunkStep(fall, None, 0.0, 0.0, nan, 0)
+    status, ts, ylo, _, nsteps = trunk_stance(params, state, options=options)
+    if status != TrunkStatus.OK:
+        return TrunkStep(status, None, ts, 0.0, nan, nsteps)
+    if float(np.dot(ylo[3:6], _heading(rotation(ylo)))) < 0.0:
+        return TrunkStep(TrunkStatus.FALL_BACKWARD, None, ts, 0.0, ylo, nsteps)
+    side = -state.side
+    O = _options(options)
+    P = params.packed(side)
+    vy = ylo[4]
+    P[kn.P_TA] = vy / params.g if (params.retraction == "apex" and vy > 0.0) else 0.0
+    out = np.empty(kn.NOUT)
+    fst = kn.run_phase(P, O, kn.FLIGHT, ylo, O[O_TMAX_FLIGHT], out, np.empty((0, 1 + kn.NSTATE)))
+    tf = float(out[kn.OUT_T])
+    nsteps += int(out[kn.OUT_NSTEP])
+    if fst != kn.ST_OK:
+        return TrunkStep(TrunkStatus(fst), None, ts, tf, ylo, nsteps)
+    y = out[kn.OUT_Y:kn.OUT_Y + kn.NSTATE].copy()
+    y[6:10] /= np.linalg.norm(y[6:10])
+    R = rotation(y)
+    d = np.empty(3)
+    kn.leg_direction(P, R, tf, d)
+    foot = y[0:3] + params.r * R[:, 1] + params.l0 * (R @ d)
+    foot[1] = 0.0  # on the ground: the event located it there to the root's tolerance
+    td = TrunkTouchdown(y, foot, side)
+    if _crossed(side, foot, y, _heading(R)):
+        return TrunkStep(TrunkStatus.FALL_CROSSED_LEG, td, ts, tf, ylo, nsteps)
+    return TrunkStep(TrunkStatus.OK, td, ts, tf, ylo, nsteps)
+
+
+def from_planar(params: TrunkParams, td: TouchdownState, side: int = 1) -> TrunkTouchdown:
+    """The 3-D touch-down of a planar one (flat ground at height 0 only): the CoM and
+    foot of eq. A.3 in the x-y plane, the trunk pitched by ``phi`` about z."""
+    if td.h != 0.0:
+        raise ValueError(f"from_planar: the 3-D model runs on flat ground at 0, got h={td.h}")
+    b, ph = td.beta, td.phi
+    c = [td.x, params.l0 * math.sin(b) - params.r * math.cos(ph), 0.0]
+    foot = [td.x - params.r * math.sin(ph) + params.l0 * math.cos(b), 0.0, 0.0]
+    y = np.array([*c, td.xd, td.yd, 0.0, math.cos(ph / 2), 0.0, 0.0, math.sin(ph / 2),
+                  0.0, 0.0, td.phid])
+    return TrunkTouchdown(y, np.array(foot), side)
+
+
+def to_planar(params: TrunkParams, state: TrunkTouchdown) -> TouchdownState:
+    """The planar variables of a 3-D touch-down: the leg's angle ``beta`` from +x down to
+    the leg, the trunk's pitch ``phi`` (yaw-pitch-roll), ``xd, yd``, the rate about ``z_b``
+    and ``x`` (docs/conventions.md)."""
+    y = state.y
+    R = rotation(y)
+    e = state.foot - (y[0:3] + params.r * R[:, 1])
+    beta = math.atan2(-e[1], e[0])
+    phi = math.atan2(R[1, 0], math.hypot(R[0, 0], R[2, 0]))
+    return TouchdownState(beta, phi, float(y[3]), float(y[4]), float(y[12]), float(y[0]), 0.0)
+
+
+def trunk_energy(params: TrunkParams, y: np.ndarray, foot: np.ndarray | None = None,
+                 l_rest: float | None = None) -> float:
+    """Kinetic + gravity energy, plus the leg spring's with the foot at ``foot`` [MgL]."""
+    y = np.asarray(y, dtype=float)
+    w = y[10:13]
+    Jd = np.array([params.J_roll, params.J_yaw, params.J])
+    E = 0.5 * params.m * float(y[3:6] @ y[3:6]) + 0.5 * float(w @ (Jd * w))
+    E += params.m * params.g * float(y[1])
+    if foot is not None:
+        R = rotation(y)
+        l = float(np.linalg.norm(np.asarray(foot) - y[0:3] - params.r * R[:, 1]))
+        lr = params.l0 if l_rest is None else l_rest
+        n = params.leg_exponent
+        x = abs(lr - l) / params.l0
+        E += params.k * params.l0**2 * x ** (n + 1) / (n + 1)
+    return E
