@@ -9,8 +9,8 @@ run does) and returns the median over the rounds of
   the points), and
 * the seconds per point spent inside the compiled stride kernels it calls,
   measured by wrapping every such call with a timer (the same clock): the stride map
-  (``tslip.simulation._kernels.SECTION_MAP``, what ``_packed.stride_map`` calls; on
-  checkouts before it, ``STRIDE``)
+  (``tslip.simulation._kernels.section_map``, what ``_packed.stride_map`` calls; on
+  checkouts before it, the per-method tuple ``SECTION_MAP``, before that ``STRIDE``)
   and the stride with its exact Jacobian
   (``tslip.simulation._variational.stride_jacobian``). The timer's own
   overhead (two ``perf_counter`` calls) falls inside the kernel time.
@@ -75,10 +75,12 @@ def measure(rounds: int, clock: str = "wall") -> tuple[float, float]:
     whole, call = CLOCKS[clock]
     spec = study(STUDY, quick=True).with_resolution([GRID, GRID])
     acc = [0.0]
-    # the map's kernel: its own since SECTION_MAP (it calls STRIDE inside), STRIDE before
-    maps = "SECTION_MAP" if hasattr(kn, "SECTION_MAP") else "STRIDE"
+    # the map's kernel: one for both methods (section_map), before it a tuple by method
+    # (SECTION_MAP, calling STRIDE inside; STRIDE before that)
+    maps = next(n for n in ("section_map", "SECTION_MAP", "STRIDE") if hasattr(kn, n))
     saved = getattr(kn, maps), va.stride_jacobian
-    setattr(kn, maps, tuple(_timed(f, acc, call) for f in saved[0]))
+    setattr(kn, maps, _timed(saved[0], acc, call) if maps == "section_map"
+            else tuple(_timed(f, acc, call) for f in saved[0]))
     va.stride_jacobian = _timed(saved[1], acc, call)  # type: ignore[assignment]
     try:
         _one_round(spec, acc, whole)  # loads the kernels

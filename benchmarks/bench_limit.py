@@ -181,7 +181,7 @@ def main() -> None:
     rec = np.empty((4096, pk.NREC))
     kn.integrate_stance(P, O, y0, yout, rec, 0.0, stats)
     hs = np.diff(rec[: int(stats[3]), pk.REC_T])
-    stance = kn.STANCE_REC[pk.M_DOPRI5]
+    stance = kn.stance_rec
 
     data = tslip.simulate(p, s, a.steps, dt=a.dt).data
     beta = np.ascontiguousarray(data[:, pk.TR_BETA])
