@@ -1,6 +1,6 @@
 """The stance integrator's steps: the :mod:`._rk` stage loop with the stance ``rhs``, events.
 
-Private (see :mod:`._kernels`). The stride kernel (:func:`._stride._make_stride`)
+Private (see :mod:`._kernels`). The stride kernel (:func:`._stride.stride`)
 is the loop; its named steps are here, in the order a step takes them:
 
 * :func:`rk_step`: one Runge-Kutta step (the stages, FSAL);
