@@ -12,10 +12,12 @@ using both: a first ``step_map``, ``step_jacobian`` and ``simulate`` with each p
 42 s of CPU from an empty cache, not 63 s (one pair alone, 36 s before: 15 % more, the
 branches on the pair now compiled in; a loaded machine, two runs side by side). The
 cost at run time: a Table 6.1 dopri5 stride executes 111,100 instructions, not 102,400
-(+8.6 %, callgrind, ``NUMBA_CPU_NAME=generic``), though :func:`._stepper.stage_input`
-keeps the stage sums in registers; what remains is the tableau read at run time (loads
-and zero tests of its coefficients, loops of run-time length) in the stages, the error
-norm and the dense output.
+(+8.6 %; dop853 98,400, not 94,600, +4.0 %; callgrind, ``NUMBA_CPU_NAME=generic``),
+though :func:`._stepper.stage_input` keeps the stage sums in registers; what remains is
+the tableau read at run time (loads and zero tests of its coefficients, loops of
+run-time length) in the error norm, the dense output and the step control: a copy of
+the stage loop per pair inside the one kernel (the pair a constant in each) ran no
+fewer instructions (112,300).
 
 Only what a call uses compiles: a first :func:`tslip.step_map` compiles
 :func:`section_map`, the stride kernel and the functions it calls
