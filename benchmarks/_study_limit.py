@@ -8,8 +8,8 @@ a first run does) and returns the median over the rounds of
   as the lock, ``run.json`` and ``results.parquet``, spread over the points), and
 * the seconds per point of its compiled work: the compiled kernel calls the study
   makes, replayed inside compiled code. One extra round, untimed, records every
-  call of the stride map (``tslip.simulation._kernels.SECTION_MAP``, what
-  ``_packed.stride_map`` calls; ``STRIDE`` on checkouts before it), of the stride
+  call of the stride map (``tslip.simulation._kernels.section_map``, what
+  ``_packed.stride_map`` calls; ``SECTION_MAP`` or ``STRIDE`` on checkouts before it), of the stride
   with its exact Jacobian (``tslip.simulation._variational.stride_jacobian``;
   calls the Jacobian cache of ``_packed`` answers make none) and of the touch-down's
   derivative in ``alpha_r`` (``_kernels.alpha_r_column``), with copies of their
@@ -159,8 +159,9 @@ def _record(spec: Any) -> list[Call]:
     from tslip.simulation import _kernels as kn
     from tslip.simulation import _variational as va
 
-    # the map's kernel: its own since SECTION_MAP (it calls STRIDE inside), STRIDE before
-    maps = "SECTION_MAP" if hasattr(kn, "SECTION_MAP") else "STRIDE"
+    # the map's kernel: one for both methods (section_map); before it a tuple by method
+    # (SECTION_MAP, calling STRIDE inside; STRIDE before that)
+    maps = next(n for n in ("section_map", "SECTION_MAP", "STRIDE") if hasattr(kn, n))
     hooked = [(kn, maps), (va, "stride_jacobian"), (kn, "alpha_r_column")]
     saved = [getattr(mod, name) for mod, name in hooked]
     calls: list[list[Call]] = [[] for _ in hooked]

@@ -260,15 +260,14 @@ def floors(gait: tslip.Gait) -> dict[str, Callable[[], object]]:
     """
     from tslip.gait.fixed_point import TIGHT
     from tslip.simulation import _variational as va
-    from tslip.simulation._stride import RUN_ROW
+    from tslip.simulation._stride import run_row
 
     P, O = pk.pack_params(gait.params), TIGHT.packed()  # noqa: E741 - the kernels' names
-    m = int(O[pk.O_METHOD])
     q = gait.state.section()
     td, tx, th = _packed.touchdown(q), np.empty(0), np.array([0.0])
     J, out = np.empty((5, 5)), np.empty(pk.NOUT)
     rows = [_packed.touchdown(q + d) for d in np.vstack([np.eye(5), -np.eye(5)]) * 1e-5]
-    jac, stride = va.STRIDE_JACOBIAN[m], kn.STRIDE[m]
+    jac, stride = va.stride_jacobian, kn.stride
     no_rec = np.empty((0, pk.NREC))
 
     calls: list[tuple] = []
@@ -286,7 +285,7 @@ def floors(gait: tslip.Gait) -> dict[str, Callable[[], object]]:
 
     def runs() -> None:
         for P_, O_, td_, n, tx_, th_ in calls:
-            RUN_ROW[int(O_[pk.O_METHOD])](P_, O_, td_, n, tx_, th_, np.empty((n + 1, pk.NTD)))
+            run_row(P_, O_, td_, n, tx_, th_, np.empty((n + 1, pk.NTD)))
 
     return {
         "multipliers, exact, cold (floquet)": lambda: jac(P, O, td, tx, th, J, out),

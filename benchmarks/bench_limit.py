@@ -177,7 +177,7 @@ def _stance_kernel():  # noqa: ANN202 - a compiled function
     """The compiled dopri5 stance kernel ``(P, O, y0, tx, th, rec, rec_dt, out) -> status``
     that :func:`_stance_loop` calls (the one place that knows how the kernels are held:
     one per method in a tuple, or one for all)."""
-    kernels = kn.STANCE_REC
+    kernels = kn.stance_rec if hasattr(kn, "stance_rec") else kn.STANCE_REC
     return kernels[pk.M_DOPRI5] if isinstance(kernels, tuple) else kernels
 
 

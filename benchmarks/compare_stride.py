@@ -30,7 +30,7 @@ import sys, time
 import numpy as np
 import tslip
 from tslip.model import _pack as pk
-from tslip.simulation._stride import STRIDE
+from tslip.simulation import _stride
 g = tslip.find_gait(tslip.preset("table6.1"))
 P = pk.pack_params(g.params)
 O = tslip.IntegratorOptions().packed()
@@ -38,7 +38,8 @@ td = np.array(list(g.state.as_array()[:5]) + [0.0, 0.0])
 tx, th = tslip.Terrain.flat(0.0).arrays()
 rec = np.empty((0, pk.NREC))
 out = np.empty(pk.NOUT)
-kernel = STRIDE[int(O[pk.O_METHOD])]
+# one kernel for both pairs (the pair read from O); a tuple by method code before
+kernel = _stride.STRIDE[int(O[pk.O_METHOD])] if hasattr(_stride, "STRIDE") else _stride.stride
 assert kernel(P, O, td, tx, th, rec, 0.0, out) == 0
 print("ready", flush=True)
 for line in sys.stdin:

@@ -67,7 +67,7 @@ def test_every_source_compiled_into_a_kernel_is_hashed():
     assert _hashed_gaps(kc.SOURCES) == set()
     # the check can fail: drop the jit options, the kernels of one concept, a layout
     for rel in ("_nrt.py", "biped/_jit.py", "biped/_stride.py", "biped/_pack.py",
-                "simulation/_rk.py", "simulation/_specialise.py", "simulation/_stride.py"):
+                "simulation/_rk.py", "simulation/_stride.py"):
         assert _hashed_gaps(tuple(r for r in kc.SOURCES if r != rel)) == {_module(rel)}, rel
 
 

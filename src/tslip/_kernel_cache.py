@@ -35,10 +35,10 @@ __all__ = ["FAMILIES", "SOURCES", "check", "missing_families", "sources_hash"]
 _ROOT = Path(__file__).parent
 
 #: Package files whose code is compiled into the kernels (njit functions, the
-#: layout constants they read, and the naming of the per-method copies); a test
+#: layout constants they read); a test
 #: checks that every module defining or feeding a kernel is listed.
 SOURCES: tuple[str, ...] = (
-    "model/_pack.py", "simulation/_rk.py", "simulation/_specialise.py", "simulation/_stance.py",
+    "model/_pack.py", "simulation/_rk.py", "simulation/_stance.py",
     "simulation/_flight.py", "simulation/_stepper.py", "simulation/_stride.py",
     "simulation/_sincos.py", "simulation/_record.py", "simulation/_kernels.py",
     "simulation/_variational.py",
@@ -93,11 +93,10 @@ def check(dispatcher: object, module_file: str) -> None:
 #: (body kinematics, controller references), which workers compiled otherwise.
 FAMILIES: dict[str, tuple[str, tuple[str, ...]]] = {
     "TSLIP gait search and analyses": ("simulation", (
-        "_stride.stride_dopri5", "_stride.stride_dop853", "_stride.section_map_dop853",
-        "_variational.stride_jacobian_dop853", "_stride.run_row_dopri5",
-        "_flight.alpha_r_column")),
+        "_stride.stride", "_stride.section_map", "_variational.stride_jacobian",
+        "_stride.run_row", "_flight.alpha_r_column")),
     "TSLIP recorded runs": ("simulation", (
-        "_record.record_run_dopri5", "_stride.run_batch_serial_dopri5", "_flight.flight_state")),
+        "_record.record_run", "_stride.run_batch_serial", "_flight.flight_state")),
     "biped (dopri5)": ("biped", ("_stride._integrate_dopri5", "_tmt.kinematics",
                                  "_control.references")),
     "biped (dop853)": ("biped", ("_stride._integrate_dop853",)),

@@ -8,14 +8,13 @@ The kernels live by concept:
 * :mod:`._stance`: stance equations of motion, ground force, events;
 * :mod:`._flight`: closed-form flight and the touch-down search;
 * :mod:`._stepper`: the stance integrator (the :mod:`._rk` core with this ``rhs``);
-* :mod:`._stride`: strides and batches, one compiled kernel per integrator method;
+* :mod:`._stride`: strides and batches;
 * :mod:`._record`: the recorded run of ``tslip.simulate``;
 * :mod:`._variational`: the exact stride Jacobian.
 
-A kernel compiled per method is a tuple indexed by the method code
-(``STRIDE[O[O_METHOD]]``); the names below without a method (``stride``,
-``run_batch``, ...) pick the copy from the options ``O`` they are given, for
-callers from Python. The readable reference for the equations is
+Each kernel is compiled once for both Runge-Kutta pairs: it reads the pair from
+the options ``O`` it is given (``O[O_METHOD]``) at run time, and is called so
+from Python and from other kernels alike. The readable reference for the equations is
 :mod:`tslip.model.dynamics`; the tests check that both agree.
 """
 
@@ -24,7 +23,6 @@ from __future__ import annotations
 import numpy as np
 
 from .._kernel_cache import check as _check_cache
-from ..model._pack import O_METHOD
 from ._flight import (
     alpha_r_column,
     find_touchdown,
@@ -36,8 +34,7 @@ from ._flight import (
     stop_binds,
     stop_time,
 )
-from ._record import RECORD_RUN
-from ._specialise import ByMethod
+from ._record import record_run
 from ._stance import (
     L_COLLAPSE,
     NEVENTS,
@@ -51,22 +48,22 @@ from ._stance import (
     stance_initial,
 )
 from ._stride import (
-    RUN_BATCH,
-    RUN_BATCH_SERIAL,
-    SECTION_MAP,
-    STANCE_REC,
-    STRIDE,
-    STRIDE_BATCH,
-    STRIDE_BATCH_SERIAL,
+    run_batch,
+    run_batch_serial,
+    run_row,
+    section_map,
+    stance_rec,
+    stride,
+    stride_batch,
+    stride_batch_serial,
 )
 
 __all__ = [
-    "L_COLLAPSE", "NEVENTS", "NSTATE", "RECORD_RUN", "SECTION_MAP",
-    "STRIDE", "alpha_r_column", "com_velocity",
+    "L_COLLAPSE", "NEVENTS", "NSTATE", "alpha_r_column", "com_velocity",
     "event_values", "find_touchdown", "flight_leg_angle", "flight_samples", "flight_state",
     "grf", "hip_torque", "integrate_stance", "record_run", "retraction_start", "rhs",
-    "run_batch", "run_batch_serial", "stance_accel", "stance_initial", "stop_angle", "stop_binds",
-    "stop_time", "stride",
+    "run_batch", "run_batch_serial", "run_row", "section_map", "stance_accel",
+    "stance_initial", "stop_angle", "stop_binds", "stop_time", "stride",
     "stride_batch", "stride_batch_serial",
 ]
 
@@ -76,25 +73,18 @@ _NO_TERRAIN = np.empty(0)
 
 def integrate_stance(P: np.ndarray, O: np.ndarray, y0: np.ndarray,  # noqa: E741
                      yout: np.ndarray, rec: np.ndarray, rec_dt: float, stats: np.ndarray) -> int:
-    """The stance alone from the stance state ``y0``, recorded into ``rec`` (``STANCE_REC``).
+    """The stance alone from the stance state ``y0``, recorded into ``rec``
+    (:func:`._stride.stance_rec`).
 
     ``yout`` receives the final state, ``stats`` ``[t_end, n_accepted, n_rejected,
-    n_recorded, overflow]``; returns the status (see :func:`._stride._make_stride`).
+    n_recorded, overflow]``; returns the status (see :func:`._stride.stride`).
     """
     out = np.empty(NSTATE + 5)
-    status = STANCE_REC[int(O[O_METHOD])](P, O, y0, _NO_TERRAIN, _NO_TERRAIN, rec, rec_dt, out)
+    status = stance_rec(P, O, y0, _NO_TERRAIN, _NO_TERRAIN, rec, rec_dt, out)
     yout[:] = out[:NSTATE]
     stats[:] = out[NSTATE:]
     return int(status)
 
-#: ``(P, O, td, tx, th, rec, rec_dt, out) -> status``: one stride from the touch-down
-#: state ``td`` (7), the stance recorded into ``rec`` if it has rows (``._stride``).
-stride = ByMethod(STRIDE)
-record_run = ByMethod(RECORD_RUN)
-run_batch = ByMethod(RUN_BATCH)
-run_batch_serial = ByMethod(RUN_BATCH_SERIAL)
-stride_batch = ByMethod(STRIDE_BATCH)
-stride_batch_serial = ByMethod(STRIDE_BATCH_SERIAL)
 
 # numba does not notice when a kernel called from another file changes; drop
 # cached kernels compiled against other sources (see tslip._kernel_cache). This

@@ -26,7 +26,6 @@ import numpy as np
 
 from ..model import _pack as pk
 from . import _kernels as kn
-from ._stride import RUN_ROW
 
 __all__ = ["touchdown", "stride_map", "stride_jacobian", "check_exact", "alpha_r_column", "run"]
 
@@ -47,7 +46,7 @@ def stride_map(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E
 
     The next section is ``out[OUT_TD:OUT_TD + 5]``; as :func:`tslip.step_map`.
     """
-    return int(kn.SECTION_MAP[int(O[pk.O_METHOD])](P, O, *q.tolist(), float(h), out))
+    return int(kn.section_map(P, O, *q.tolist(), float(h), out))
 
 
 #: The last exact Jacobians, keyed by their exact inputs (P, O, q, h): gait search
@@ -147,6 +146,5 @@ def run(P: np.ndarray, O: np.ndarray, td: np.ndarray, n_steps: int,  # noqa: E74
     ``(status, strides completed)``, as one row of :func:`tslip.run_batch`.
     """
     hist = np.empty((n_steps + 1, pk.NTD))
-    run_row = RUN_ROW[int(O[pk.O_METHOD])]  # the strides in compiled code
-    st, done, _ = run_row(P, O, td, n_steps, tx, th, hist)
+    st, done, _ = kn.run_row(P, O, td, n_steps, tx, th, hist)  # the strides in compiled code
     return int(st), int(done)

@@ -1,8 +1,9 @@
 """Compiled recorded runs (``tslip.simulate``): strides sampled into compact rows.
 
-Private (see :mod:`._kernels`). :data:`RECORD_RUN` holds one kernel per
-integrator method (:func:`._stride.specialise`): the strides and their stance
-record rows (time and stance state) as the stride kernel writes them.
+Private (see :mod:`._kernels`). :func:`record_run` is one kernel for both
+integrator methods (the pair is read from the options ``O`` at run time, as the
+stride kernel :func:`._stride.stride` it calls reads it): the strides and their
+stance record rows (time and stance state) as the stride kernel writes them.
 :func:`fill_table` derives the trajectory's columns from those when they are first
 read, so a run that is not looked at row by row never pays for them;
 :func:`stance_forces` derives a stride's ground force and hip torque
@@ -15,7 +16,6 @@ two agree with each other bit for bit.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 
 import numpy as np
 from numba import njit
@@ -83,9 +83,8 @@ from ..model._pack import (
 from ._flight import flight_leg_angle, flight_point, retraction_start
 from ._rk import _INLINE, _JIT
 from ._sincos import sincos_array
-from ._specialise import specialise
 from ._stance import _com_velocity, grf_at, grf_of, hip_torque, leg_force, spring_energy
-from ._stride import stride_of
+from ._stride import stride
 
 
 @njit(**_INLINE)
@@ -111,81 +110,80 @@ def n_flight_samples(tf, dt, final):
     return n + 1 if final else n
 
 
-def _make_record_run(method: int) -> Callable:
-    def record_run(P, O, td, tx, th, first, last, close, dt, rows, starts, outs, info, pos):
-        """Strides ``first .. last - 1`` of a run, sampled every ``dt`` into compact rows.
+@njit(**_JIT)
+def record_run(P, O, td, tx, th, first, last, close, dt, rows, starts, outs, info, pos):
+    """Strides ``first .. last - 1`` of a run, sampled every ``dt`` into compact rows.
 
-        Starts from the touch-down state ``td`` (7) at time ``pos[1]`` and writes
-        from row ``pos[0]`` of ``rows`` (n x NREC), one row per trajectory sample:
-        each stance's record rows as the stride kernel writes them (``REC_*``: time
-        since touch-down and stance state, on the grid of
-        :func:`._stride._make_stride`, touch-down and lift-off rows included), then
-        one row per flight sample holding only its time since lift-off in ``REC_T``
-        (``dt, 2 dt, ...``, and the touch-down instant closing the last stride if
-        ``close``; otherwise the next stride's first row is that instant). Stride
-        ``s`` fills ``starts[s]`` (its touch-down state), ``outs[s]``
-        (:func:`._stride._make_stride`'s output) and ``info[s]`` (``RI_*``).
-        :func:`fill_table` derives the trajectory's columns (forces included) from
-        them when they are first read.
+    Starts from the touch-down state ``td`` (7) at time ``pos[1]`` and writes
+    from row ``pos[0]`` of ``rows`` (n x NREC), one row per trajectory sample:
+    each stance's record rows as the stride kernel writes them (``REC_*``: time
+    since touch-down and stance state, on the grid of
+    :func:`._stride.stride`, touch-down and lift-off rows included), then
+    one row per flight sample holding only its time since lift-off in ``REC_T``
+    (``dt, 2 dt, ...``, and the touch-down instant closing the last stride if
+    ``close``; otherwise the next stride's first row is that instant). Stride
+    ``s`` fills ``starts[s]`` (its touch-down state), ``outs[s]``
+    (:func:`._stride.stride`'s output) and ``info[s]`` (``RI_*``).
+    :func:`fill_table` derives the trajectory's columns (forces included) from
+    them when they are first read.
 
-        Returns the status of the last stride run (it stops at the first that is
-        not OK), or ``RUN_FULL`` if the next stride's rows would not fit; then
-        ``td``, ``pos = (row, t0, stride)`` say where to resume with more rows.
-        """
-        out = np.empty(NOUT)
-        lo = np.empty(6)
-        row = int(pos[0])
-        t0 = pos[1]
-        nmax = rows.shape[0]
-        status = ST_OK
-        for s in range(first, last):
-            pos[0] = row
-            pos[1] = t0
-            pos[2] = s
-            if nmax - row < 2:
-                return RUN_FULL
-            status = stride_of(method, P, O, td, tx, th, rows[row:], dt, out)
-            if out[OUT_RECOVF] != 0.0:
-                return RUN_FULL
-            nrec = int(out[OUT_NREC])
-            ts = out[OUT_TS]
-            tf = out[OUT_TF]
-            final = status != ST_OK or (close and s == last - 1)
-            nfl = n_flight_samples(tf, dt, final) if tf > 0.0 else 0
-            if row + nrec + nfl > nmax:
-                return RUN_FULL
-            for k in range(nfl):
-                tau = dt + k * dt
-                if final and k == nfl - 1:
-                    tau = tf
-                rows[row + nrec + k, REC_T] = tau
-            for j in range(6):
-                lo[j] = out[OUT_LO + j]
-            for j in range(NTD):
-                starts[s, j] = td[j]
-            for j in range(NOUT):
-                outs[s, j] = out[j]
-            inf = info[s]
-            inf[RI_T0] = t0
-            inf[RI_ROW0] = row
-            inf[RI_NSTANCE] = nrec
-            inf[RI_ROW1] = row + nrec + nfl
-            inf[RI_STATUS] = status
-            inf[RI_TDY] = td[6] + P[P_L0] * math.sin(td[0]) - P[P_R] * math.cos(td[1])
-            inf[RI_LOFY] = (lo[1] + P[P_R] * math.cos(lo[4])) - out[OUT_LO + 6] * math.sin(
-                out[OUT_LO + 7])
-            row += nrec + nfl
-            pos[0] = row
-            pos[2] = s + 1
-            if status != ST_OK:
-                break
-            t0 = t0 + ts + tf
-            pos[1] = t0
-            for j in range(NTD):
-                td[j] = out[OUT_TD + j]
-        return status
-
-    return record_run
+    The Runge-Kutta pair is ``O[O_METHOD]``. Returns the status of the last stride
+    run (it stops at the first that is not OK), or ``RUN_FULL`` if the next stride's
+    rows would not fit; then ``td``, ``pos = (row, t0, stride)`` say where to resume
+    with more rows.
+    """
+    out = np.empty(NOUT)
+    lo = np.empty(6)
+    row = int(pos[0])
+    t0 = pos[1]
+    nmax = rows.shape[0]
+    status = ST_OK
+    for s in range(first, last):
+        pos[0] = row
+        pos[1] = t0
+        pos[2] = s
+        if nmax - row < 2:
+            return RUN_FULL
+        status = stride(P, O, td, tx, th, rows[row:], dt, out)
+        if out[OUT_RECOVF] != 0.0:
+            return RUN_FULL
+        nrec = int(out[OUT_NREC])
+        ts = out[OUT_TS]
+        tf = out[OUT_TF]
+        final = status != ST_OK or (close and s == last - 1)
+        nfl = n_flight_samples(tf, dt, final) if tf > 0.0 else 0
+        if row + nrec + nfl > nmax:
+            return RUN_FULL
+        for k in range(nfl):
+            tau = dt + k * dt
+            if final and k == nfl - 1:
+                tau = tf
+            rows[row + nrec + k, REC_T] = tau
+        for j in range(6):
+            lo[j] = out[OUT_LO + j]
+        for j in range(NTD):
+            starts[s, j] = td[j]
+        for j in range(NOUT):
+            outs[s, j] = out[j]
+        inf = info[s]
+        inf[RI_T0] = t0
+        inf[RI_ROW0] = row
+        inf[RI_NSTANCE] = nrec
+        inf[RI_ROW1] = row + nrec + nfl
+        inf[RI_STATUS] = status
+        inf[RI_TDY] = td[6] + P[P_L0] * math.sin(td[0]) - P[P_R] * math.cos(td[1])
+        inf[RI_LOFY] = (lo[1] + P[P_R] * math.cos(lo[4])) - out[OUT_LO + 6] * math.sin(
+            out[OUT_LO + 7])
+        row += nrec + nfl
+        pos[0] = row
+        pos[2] = s + 1
+        if status != ST_OK:
+            break
+        t0 = t0 + ts + tf
+        pos[1] = t0
+        for j in range(NTD):
+            td[j] = out[OUT_TD + j]
+    return status
 
 
 @njit(**_INLINE)
@@ -394,7 +392,7 @@ def fill_table(P, rows, starts, outs, info, n, table, step, stance):
     """The trajectory columns (``TR_*``, one row of ``table`` each) of a recorded run.
 
     ``rows``, ``starts``, ``outs`` and ``info`` hold strides ``0 .. n - 1`` as
-    :func:`_make_record_run`'s ``record_run`` wrote them; ``table`` is
+    :func:`record_run` wrote them; ``table`` is
     ``NTRAJ x rows`` (column-major: a column of the trajectory is a row here). The
     stride and phase columns go to ``step`` (integers) and ``stance`` (booleans), as
     the trajectory's frame types them; ``table``'s ``TR_STEP`` and ``TR_STANCE`` rows
@@ -469,11 +467,6 @@ def stance_forces(P, rec, tsw, at_steps, grf):
         grf[k, 1], grf[k, 2], grf[k, 3] = grf_at(Pk, r[REC_L], r[REC_PHI], r[REC_LD],
                                                  r[REC_BETAD], r[REC_PHID], trig[1, k],
                                                  trig[2, k])
-
-
-#: ``(P, O, td, tx, th, first, last, close, dt, rows, starts, outs, info, pos)
-#: -> status`` by method (:func:`_make_record_run`).
-RECORD_RUN = specialise(_make_record_run, "record_run")
 
 
 # numba does not notice when a kernel called from another file changes; drop

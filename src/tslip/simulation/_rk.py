@@ -9,7 +9,9 @@ Private. Two explicit pairs (Hairer, Norsett & Wanner, *Solving ODEs I*, II.5 an
 
 Each tableau is padded into one row of the ``*_TAB`` arrays below (index =
 method code of :mod:`tslip.model._pack`), so every routine here is written
-once for both methods.
+once for both methods and takes the method as a value: the TSLIP's kernels pass
+it at run time (``O[O_METHOD]``: each compiles once for both pairs), the biped's
+as a constant of each per-method copy.
 
 Numba cannot cache a kernel that receives its right-hand side as a function
 argument (the cache key is the dispatcher type, which differs per process), so
@@ -43,8 +45,8 @@ from ..model._pack import M_DOP853, M_DOPRI5
 
 _JIT = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
 # the per-step helpers are inlined into the caller's stage loop (numba IR
-# inlining): with a constant method and state size, the loops over the
-# tableau compile like the hand-unrolled steppers this module replaced
+# inlining); the method is a run-time value in the TSLIP's kernels (one kernel for
+# both pairs) and a compile-time constant in the biped's
 _INLINE = dict(_JIT, inline="always")
 
 #: rows of the stage array ``K`` and of the dense-output array ``R`` that fit both methods
@@ -202,6 +204,12 @@ NDENSE = np.array([5, 8], dtype=np.int64)
 ORDER = np.array([5.0, 8.0])
 #: step-size exponent -1/(q+1), q the order of the error estimator (4 and 7)
 ERR_EXP = np.array([-0.2, -0.125])
+#: The safety factor on the step the error estimate asks for: aims below it, so that the
+#: next step is rarely rejected (Hairer's dopri5.f and dop853.f, ``safe``)
+SAFETY = 0.9
+#: The smallest step-size factor: a step shrinks at most fivefold at once, however large
+#: its error (dopri5.f's default ``fac1``; an error estimate that far off says little)
+FAC_MIN = 0.2
 
 
 @njit(**_INLINE)
@@ -281,10 +289,10 @@ def error_norm(method, n, y, ynew, h, K, rtol, atol):
 
 @njit(**_INLINE)
 def step_factor(method, err, fac_max):
-    """Step-size factor ``0.9 err^(-1/(q+1))`` clipped to ``[0.2, fac_max]``."""
+    """Step-size factor ``SAFETY err^(-1/(q+1))`` clipped to ``[FAC_MIN, fac_max]``."""
     if err <= 0.0:
         return fac_max
-    return min(fac_max, max(0.2, 0.9 * err ** ERR_EXP[method]))
+    return min(fac_max, max(FAC_MIN, SAFETY * err ** ERR_EXP[method]))
 
 
 @njit(**_INLINE)

@@ -224,6 +224,18 @@ def com_velocity(P, y):
 
 
 NEVENTS = 5  # event_values
+#: The stance events, indices into :func:`event_values` (each fires on a crossing from
+#: > 0 to <= 0): lift-off, ``F_y`` (eq. 2.8; ``l_rest - l`` when :func:`liftoff_on_spring`)
+EV_LIFTOFF = 0
+#: the hip at the ground, ``l sin(beta)`` (eq. 2.11): a fall
+EV_HIP_GROUND = 1
+#: moving backward, ``xdot_m`` (eq. 2.10): a fall
+EV_BACKWARD = 2
+#: the leg collapsed, ``l - L_COLLAPSE l0`` (the hip at the foot, which EV_HIP_GROUND cannot
+#: see): a fall
+EV_COLLAPSE = 3
+#: the leg thrust's switch, ``-ldot`` while it is pending: the stance goes on
+EV_THRUST = 4
 #: Leg length, as a fraction of ``l0``, at which a stance ends as the hip reaching the
 #: ground (eq. 2.11, ``Status.FALL_HIP_GROUND``): a leg compressed that far has put the
 #: hip on its foot. Without it such a stance ground on at ever smaller steps until
@@ -253,13 +265,13 @@ def put_events(P, y, sb, cb, cp, tau, fl, gv):
     """The event values (:func:`event_values`) from :func:`stance_terms`."""
     l, ld, bd, phd = y[0], y[3], y[4], y[5]
     if liftoff_on_spring(P):
-        gv[0] = rest_length(P) - l
+        gv[EV_LIFTOFF] = rest_length(P) - l
     else:
-        gv[0] = fl * sb + tau / l * cb  # F_y, eq. 2.6
-    gv[1] = l * sb
-    gv[2] = -ld * cb + l * sb * bd + P[P_R] * cp * phd  # xdot_m, eq. A.5
-    gv[3] = l - L_COLLAPSE * P[P_L0]
-    gv[4] = -ld if P[P_THRUST] > 0.0 else 1.0
+        gv[EV_LIFTOFF] = fl * sb + tau / l * cb  # F_y, eq. 2.6
+    gv[EV_HIP_GROUND] = l * sb
+    gv[EV_BACKWARD] = -ld * cb + l * sb * bd + P[P_R] * cp * phd  # xdot_m, eq. A.5
+    gv[EV_COLLAPSE] = l - L_COLLAPSE * P[P_L0]
+    gv[EV_THRUST] = -ld if P[P_THRUST] > 0.0 else 1.0
 
 
 @njit(**_INLINE)

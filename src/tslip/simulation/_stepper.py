@@ -1,6 +1,6 @@
 """The stance integrator's steps: the :mod:`._rk` stage loop with the stance ``rhs``, events.
 
-Private (see :mod:`._kernels`). The stride kernel (:func:`._stride._make_stride`)
+Private (see :mod:`._kernels`). The stride kernel (:func:`._stride.stride`)
 is the loop; its named steps are here, in the order a step takes them:
 
 * :func:`rk_step`: one Runge-Kutta step (the stages, FSAL);
@@ -15,12 +15,14 @@ is the loop; its named steps are here, in the order a step takes them:
 * :func:`record_row`, :func:`append_row`, :func:`record_grid`: the stance record.
 
 The per-step functions are small and ``inline="always"``, taking the
-Runge-Kutta pair ``method`` as an argument: the stride passes it as a
-compile-time constant, so each compiled stride holds one method's stage loop.
-Those called once a stride or so (:func:`initial_step`, :func:`first_event`)
-or only when recording (:func:`append_row`, :func:`record_grid`) compile on
-their own instead (``method`` a run-time argument; the same arithmetic): numba's type
-inference of the stride's body, most of a cold start, shrinks by their copies.
+Runge-Kutta pair ``method`` as a run-time argument (the stride reads it from its
+options), so the one compiled stride serves both pairs; :func:`stage_input` keeps the
+stage sums in registers. Those called once a stride or so (:func:`initial_step`,
+:func:`first_event`) or only when recording (:func:`append_row`, :func:`record_grid`)
+compile on their own instead: numba's type inference of the stride's body, most of a
+cold start, shrinks by their copies. The step-control constants (:data:`FAC_MAX`,
+:data:`NONFINITE_SHRINK`, the root's :data:`ROOT_TOL`, ...) are named below, the
+safety factor and smallest factor in :mod:`._rk`.
 """
 
 from __future__ import annotations
@@ -32,7 +34,71 @@ from numba import njit
 from .._kernel_cache import check as _check_cache
 from . import _rk
 from ._rk import _INLINE, _JIT
-from ._stance import NEVENTS, NSTATE, event_values, rhs, rhs_events_inline, rhs_inline
+from ._stance import (
+    EV_BACKWARD,
+    EV_COLLAPSE,
+    EV_HIP_GROUND,
+    EV_LIFTOFF,
+    EV_THRUST,
+    NEVENTS,
+    NSTATE,
+    event_values,
+    rhs,
+    rhs_events_inline,
+    rhs_inline,
+)
+
+#: The largest step-size factor after an accepted step (dopri5.f's default ``fac2``): a step
+#: grows at most tenfold, so that one lucky error estimate cannot jump past the
+#: stance's features (a rejected step's factor is below ``_rk.SAFETY`` anyway)
+FAC_MAX = 10.0
+#: The factor by which a step whose error is not finite (a NaN or infinite stage) is
+#: retried shorter: its error estimate says nothing about the size to take
+NONFINITE_SHRINK = 0.1
+#: The width in theta (the fraction of the step) to which an event's root is located:
+#: a few ulps of theta in [0, 1], so the event state is as exact as the step allows
+ROOT_TOL = 1e-15
+#: The most Illinois iterations for one root (it converges superlinearly: a bound only)
+ROOT_MAXITER = 100
+#: How much earlier (in theta) another event must be to win over one found before it in
+#: :data:`EVENT_ORDER`: ``F_y = F_l sin(beta)`` and the hip height ``l sin(beta)``
+#: vanish together when ``beta`` reaches 0, and their roots differ by rounding only
+EVENT_TIE = 1e-9
+#: The order in which :func:`first_event` searches the events: falls first, then
+#: lift-off, the thrust's switch last (a tie within EVENT_TIE goes to the earlier here)
+EVENT_ORDER = (EV_HIP_GROUND, EV_COLLAPSE, EV_BACKWARD, EV_LIFTOFF, EV_THRUST)
+
+
+assert NSTATE == 6, "stage_input's accumulators"
+
+
+@njit(**_INLINE)
+def stage_input(method, y, h, K, s, out):
+    """:func:`._rk.stage_state` for the stance's six states: ``out = y + h sum_{j<s} a_sj
+    K[j]``, the same sums in the same order, accumulated in six local variables.
+
+    The stride's arrays are views of one allocation (:func:`._stride.work_arrays`), so the
+    compiler cannot tell ``out`` from ``K`` and would store and reload ``out`` after every
+    term; locals stay in registers. With the pair a run-time value (one kernel for both),
+    this recovers what its loops over the tableau lost against a compile-time pair
+    (callgrind figures in :mod:`._stride`)."""
+    a = _rk.A_TAB[method, s]
+    o0 = o1 = o2 = o3 = o4 = o5 = 0.0
+    for j in range(s):  # row by row, skipping zeros, as _rk.stage_state
+        aj = a[j]
+        if aj != 0.0:
+            o0 += aj * K[j, 0]
+            o1 += aj * K[j, 1]
+            o2 += aj * K[j, 2]
+            o3 += aj * K[j, 3]
+            o4 += aj * K[j, 4]
+            o5 += aj * K[j, 5]
+    out[0] = y[0] + h * o0
+    out[1] = y[1] + h * o1
+    out[2] = y[2] + h * o2
+    out[3] = y[3] + h * o3
+    out[4] = y[4] + h * o4
+    out[5] = y[5] + h * o5
 
 
 @njit(**_INLINE)
@@ -41,16 +107,15 @@ def rk_step(P, method, y, h, K, ytmp, ynew, gv):
 
     Fills the stages ``K[1..ns]`` and ``ynew``; ``K[ns] = f(ynew)`` (FSAL), and the
     event values at ``ynew`` into ``gv`` (event detection needs them once the step is
-    accepted; they share the last stage's sines and cosines). With
-    a constant ``method`` the loops over the tableau compile like a hand-unrolled
-    stepper, which the cheap stance right-hand side makes worth it
-    (``benchmarks/bench_rk.py``).
+    accepted; they share the last stage's sines and cosines). ``method`` is a run-time
+    value: the stages are inlined into the stride's loop, the pair's tableau read row by
+    row (:func:`stage_input`).
     """
     ns = _rk.n_stages(method)
     for s in range(1, ns):
-        _rk.stage_state(method, NSTATE, y, h, K, s, ytmp)
+        stage_input(method, y, h, K, s, ytmp)
         rhs_inline(P, ytmp, K[s])
-    _rk.stage_state(method, NSTATE, y, h, K, ns, ynew)
+    stage_input(method, y, h, K, ns, ynew)
     rhs_events_inline(P, ynew, K[ns], gv)
 
 
@@ -59,7 +124,7 @@ def dense_output(P, method, y, ynew, h, K, R, ytmp):
     """Continuous extension of the step just taken (extra stages for dop853)."""
     ns = _rk.n_stages(method)
     for s in range(ns + 1, ns + 1 + _rk.n_extra(method)):
-        _rk.stage_state(method, NSTATE, y, h, K, s, ytmp)
+        stage_input(method, y, h, K, s, ytmp)
         rhs(P, ytmp, K[s])
     _rk.dense_coeffs_inline(method, y, ynew, h, K, R)
 
@@ -76,11 +141,11 @@ def initial_step(P, method, y, f0, rtol, atol, ytmp, f1):
 def event_root(P, method, R, ev, g_lo, g_hi, ytmp, gv, st):
     """Root in theta of event ``ev`` on the dense output (Illinois method)."""
     _rk.root_start_inline(st, g_lo, g_hi)
-    for _ in range(100):
+    for _ in range(ROOT_MAXITER):
         c = _rk.root_guess_inline(st)
         _rk.dense_eval_inline(method, R, c, ytmp)
         event_values(P, ytmp, gv)
-        if _rk.root_update_inline(st, c, gv[ev], 1e-15):
+        if _rk.root_update_inline(st, c, gv[ev], ROOT_TOL):
             break
     return st[1]  # the earliest theta known to be at or past the crossing
 
@@ -88,10 +153,10 @@ def event_root(P, method, R, ev, g_lo, g_hi, ytmp, gv, st):
 @njit(**_INLINE)
 def shrink_step(method, h, err):
     """The step size after a rejected step (error ``err`` > 1 or not finite): a NaN or
-    infinite stage shrinks it tenfold, else :func:`._rk.step_factor`."""
+    infinite stage shrinks it by NONFINITE_SHRINK, else :func:`._rk.step_factor`."""
     if not math.isfinite(err):
-        return h * 0.1
-    return h * _rk.step_factor(method, err, 10.0)
+        return h * NONFINITE_SHRINK
+    return h * _rk.step_factor(method, err, FAC_MAX)
 
 
 @njit(**_INLINE)
@@ -116,7 +181,7 @@ def retry_step(method, h, err, rising, gv_new):
 @njit(**_INLINE)
 def grow_step(method, h, err, last_rejected):
     """The step size after an accepted step; it does not grow right after a rejection."""
-    fac = _rk.step_factor(method, err, 10.0)
+    fac = _rk.step_factor(method, err, FAC_MAX)
     if last_rejected:
         fac = min(1.0, fac)
     return h * fac
@@ -167,17 +232,16 @@ def first_event(P, method, R, gv_old, gv_new, ytmp, gv_tmp, st):
     """The earliest event in the step with dense output ``R``: ``(theta, ev)``.
 
     ``theta`` is the fraction of the step at which event ``ev`` fires, ``(2.0, -1)``
-    if none does. Falls are searched first and lift-off wins only if strictly
-    earlier (``F_y = F_l sin(beta)`` and the hip height ``l sin(beta)`` vanish
-    together when ``beta`` reaches 0); the thrust's switch (event 4) comes last.
+    if none does. The events are searched in :data:`EVENT_ORDER` (falls first), and a
+    later one wins only if earlier by :data:`EVENT_TIE`.
     """
     theta_ev = 2.0
     first = -1
     for j in range(NEVENTS):
-        ev = (1, 3, 2, 0, 4)[j]
+        ev = EVENT_ORDER[j]
         if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
             theta = event_root(P, method, R, ev, gv_old[ev], gv_new[ev], ytmp, gv_tmp, st)
-            if theta < theta_ev - 1e-9:
+            if theta < theta_ev - EVENT_TIE:
                 theta_ev = theta
                 first = ev
     return theta_ev, first

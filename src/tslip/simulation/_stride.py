@@ -1,28 +1,41 @@
-"""Compiled strides (touch-down -> lift-off -> touch-down), one kernel per integrator method.
+"""Compiled strides (touch-down -> lift-off -> touch-down), one kernel for both integrator methods.
 
-Private (see :mod:`._kernels`). One kernel holds a whole stride: the stance's
-step-size and event loop (its named steps from :mod:`._stepper` and below:
-Runge-Kutta step, error control, event detection, dense output, event location,
-following the thesis's Section 2.3), the lift-off state and the closed-form
-flight. The Runge-Kutta pair is a compile-time constant of each copy
-(:mod:`._specialise`), and only what a call uses compiles: a first
-:func:`tslip.step_map` compiles one stride kernel and the functions it calls
+Private (see :mod:`._kernels`). One kernel, :func:`stride`, holds a whole stride: the
+stance's step-size and event loop (its named steps from :mod:`._stepper` and below:
+Runge-Kutta step, error control, event detection, dense output, event location, the
+step to the event, following the thesis's Section 2.3), the lift-off state and the
+closed-form flight. The Runge-Kutta pair is a run-time argument, read from the options
+(``O[O_METHOD]``): every kernel here (and :func:`._record.record_run`,
+:func:`._variational.stride_jacobian`) compiles once for both pairs, where one copy
+per pair, the pair a compile-time constant, compiled everything twice for a process
+using both: a first ``step_map``, ``step_jacobian`` and ``simulate`` with each pair took
+42 s of CPU from an empty cache, not 63 s (one pair alone, 36 s before: 15 % more, the
+branches on the pair now compiled in; a loaded machine, two runs side by side). The
+cost at run time: a Table 6.1 dopri5 stride executes 111,100 instructions, not 102,400
+(+8.6 %; dop853 98,400, not 94,600, +4.0 %; callgrind, ``NUMBA_CPU_NAME=generic``),
+though :func:`._stepper.stage_input` keeps the stage sums in registers; what remains is
+the tableau read at run time (loads and zero tests of its coefficients, loops of
+run-time length) in the error norm, the dense output and the step control: a copy of
+the stage loop per pair inside the one kernel (the pair a constant in each) ran no
+fewer instructions (112,300).
+
+Only what a call uses compiles: a first :func:`tslip.step_map` compiles
+:func:`section_map`, the stride kernel and the functions it calls
 (:func:`._stance.rhs`, :func:`._stance.event_values`,
 :func:`._flight.find_touchdown`, and, called once a stride, :func:`stride_finish`,
-:func:`._stepper.initial_step` and :func:`._stepper.first_event`), against 36
-when every helper was a kernel of its own and the method a run-time argument.
+:func:`._stepper.initial_step` and :func:`._stepper.first_event`).
 Those three compile on their own because numba types every inlined copy with
 the body it lands in: inlined, a cold first step_map took 18.4-18.7 s, not 16.5-17.1 s.
 The same kernel records the stance when given rows to record into
 (``tslip.simulate``, the exact Jacobian): a copy with recording compiled out ran
 no faster (``run_row`` and ``simulate`` within 1 %, alternate calls) and cost
-another 10 s of compilation per method.
+another 10 s of compilation.
 
 The small helpers are ``inline="always"``; a large body never is: numba copies
 an inlined function's IR block by block, each copy with its whole variable
 scope, so inlining the stance integrator into the stride took over a minute.
 
-Over 600 lines: one concept, the compiled stride and the per-method drivers built on it.
+Over 600 lines: one concept, the compiled stride and the drivers built on it.
 """
 
 from __future__ import annotations
@@ -35,7 +48,6 @@ from numba import njit, prange
 
 from .._kernel_cache import check as _check_cache
 from ..model._pack import (
-    M_DOPRI5,
     NOUT,
     NREC,
     NTD,
@@ -43,6 +55,7 @@ from ..model._pack import (
     O_H0,
     O_HMIN,
     O_MAXSTEPS,
+    O_METHOD,
     O_RTOL,
     O_TMAX_STANCE,
     OUT_CLEAR,
@@ -73,8 +86,12 @@ from ..model._pack import (
 from . import _rk
 from ._flight import find_touchdown, flight_state
 from ._rk import _INLINE, _JIT
-from ._specialise import specialise
 from ._stance import (
+    EV_BACKWARD,
+    EV_COLLAPSE,
+    EV_HIP_GROUND,
+    EV_LIFTOFF,
+    EV_THRUST,
     NEVENTS,
     NSTATE,
     com_velocity,
@@ -182,9 +199,9 @@ def touchdown_fall(gv, y):
     """The fall a stance starts in (``gv`` its event values, ``y`` its state), else ``ST_OK``:
     the hip at the ground, moving backward, or the leg lengthening (``ld > 0``: the
     spring would stretch past ``l0`` and pull on the ground; docs/conventions.md, "Events")."""
-    if gv[1] <= 0.0:
+    if gv[EV_HIP_GROUND] <= 0.0:
         return ST_FALL_HIP_GROUND
-    if gv[2] < 0.0:
+    if gv[EV_BACKWARD] < 0.0:
         return ST_FALL_BACKWARD
     if y[3] > 0.0:
         return ST_FALL_LENGTHENING
@@ -208,11 +225,32 @@ def event_status(ev):
     """How a stance ends at event ``ev`` (:func:`._stance.event_values`): lift-off
     (eq. 2.8) is ``ST_OK``; the hip at the ground (eq. 2.11, or the leg collapsed)
     and moving backward (eq. 2.10) are falls."""
-    if ev == 0:
+    if ev == EV_LIFTOFF:
         return ST_OK
-    if ev == 1 or ev == 3:
+    if ev == EV_HIP_GROUND or ev == EV_COLLAPSE:
         return ST_FALL_HIP_GROUND
     return ST_FALL_BACKWARD
+
+
+@njit(**_INLINE)
+def step_to_event(y, ynew, t, h):
+    """The stance at a located event: the end ``ynew`` of the step of ``h = theta h_acc``
+    from the start of the accepted step (of size ``h_acc``) in which the event was located
+    at ``theta`` (``y``, unless ``h`` is 0); returns the event's time ``t + h``.
+
+    The stride's loop takes that step as its next pass (the loop's one call of
+    :func:`._stepper.rk_step`, so that the stage arithmetic compiles once): a fresh step
+    of the pair's full order, whose end is a point of the numerical solution itself, not
+    the dense output's value at ``theta`` (one order lower: 4 against 5 for dopri5, 7
+    against 8 for dop853). Reaching the event from the dense output instead would save
+    the step's stages (6 or 12 right-hand sides a stance), but it is another
+    approximation of the event state, so every stride's result would change
+    (``benchmarks/compare_kernels.py`` requires the bits of the earlier checkouts), and
+    the stride Jacobian's replay (:mod:`._variational`) differentiates the steps the
+    stride takes, which would then end with an interpolation: so the fresh step is kept."""
+    if h > 0.0:
+        copy_state(y, ynew)
+    return t + h
 
 
 @njit(**_INLINE)
@@ -329,9 +367,10 @@ def work_arrays():
     return y, ynew, ytmp, gv_old, gv_new, gv_tmp, st, stats, K, R, W[a:a + 19]
 
 
-def _make_stride(method: int, fly: bool = True) -> Callable:
+def _make_stride(fly: bool) -> Callable:
     def stride(P, O, td, tx, th, rec, rec_dt, out):
-        """One stride from the touch-down state ``td`` (7) to the next, with the pair ``method``.
+        """One stride from the touch-down state ``td`` (7) to the next, with the Runge-Kutta
+        pair ``O[O_METHOD]``.
 
         With leg thrust (``P[P_THRUST] > 0``) the stance runs on a copy of ``P``
         whose rest length switches at the first ``ldot`` crossing from < 0 to >= 0
@@ -364,6 +403,7 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         overflow]``.
         """
         y, ynew, ytmp, gv_old, gv_new, gv_tmp, st, stats, K, R, scratch = work_arrays()
+        method = int(O[O_METHOD])
         P0 = P
         P = working_params(P0)
         if fly:
@@ -393,22 +433,16 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
                 # one Runge-Kutta step (the one loop holds the stage arithmetic once),
                 # with the event values at its end
                 rk_step(P, method, y, h, K, ytmp, ynew, gv_new)
-            if ev == 4:
-                # that was the exact step to the thrust's switch: the stance goes on
-                t += h
-                if h > 0.0:
-                    copy_state(y, ynew)
-                h = thrust_switch(P, O, method, y, K, gv_old, ytmp, fly, t, out)
-                rising = rising_from_zero(P, y, K[0], h, gv_old, ytmp, gv_tmp)
-                ev = -1
-                last_rejected = False
-            elif ev >= 0:
-                # that was the exact step to the event: the stance ends
-                t += h
-                if h > 0.0:
-                    copy_state(y, ynew)
-                status = event_status(ev)
-                ended = True
+            if ev >= 0:
+                t = step_to_event(y, ynew, t, h)
+                if ev == EV_THRUST:  # the stance goes on from the thrust's switch
+                    h = thrust_switch(P, O, method, y, K, gv_old, ytmp, fly, t, out)
+                    rising = rising_from_zero(P, y, K[0], h, gv_old, ytmp, gv_tmp)
+                    ev = -1
+                    last_rejected = False
+                else:  # the stance ends
+                    status = event_status(ev)
+                    ended = True
             else:
                 # error control
                 err = _rk.error_norm(method, NSTATE, y, ynew, h, K, rtol, atol)
@@ -456,59 +490,47 @@ def _make_stride(method: int, fly: bool = True) -> Callable:
         stance_out(y, stats, out)
         return status
 
-    return stride
+    # one name per copy: numba names a compiled function after its __qualname__ and a
+    # counter that restarts in every process, and of two cached libraries exporting one
+    # symbol the first loaded serves both (tests/simulation/test_kernel_variants.py)
+    stride.__name__ = stride.__qualname__ = "stride" if fly else "stance_rec"
+    return njit(**_JIT)(stride)
 
 
-#: The stride kernels ``(P, O, td, tx, th, rec, rec_dt, out) -> status``, by method
-#: (recording the stance into ``rec`` if it has rows).
-STRIDE = specialise(_make_stride, "stride")
+#: ``(P, O, td, tx, th, rec, rec_dt, out) -> status``: one stride from the touch-down state
+#: ``td`` (7), with the pair ``O[O_METHOD]``, recording the stance into ``rec`` if it has rows.
+stride = _make_stride(True)
 #: ``(P, O, y0, _, _, rec, rec_dt, out) -> status``: the stance alone from ``y0``, recorded
 #: into ``rec``; ``out`` (11) receives the final state and the stats (for the tests)
-STANCE_REC = specialise(_make_stride, "stance_rec", False)
-_STRIDE_DOPRI5, _STRIDE_DOP853 = STRIDE
+stance_rec = _make_stride(False)
 
 
-@njit(**_INLINE)
-def stride_of(method, P, O, td, tx, th, rec, rec_dt, out):
-    """``STRIDE[method]`` called from a kernel whose ``method`` is a constant."""
-    if method == M_DOPRI5:
-        return _STRIDE_DOPRI5(P, O, td, tx, th, rec, rec_dt, out)
-    return _STRIDE_DOP853(P, O, td, tx, th, rec, rec_dt, out)
+@njit(**_JIT)
+def section_map(P, O, beta, phi, xd, yd, phid, h, out):
+    """The Poincare map's stride (``tslip.step_map``, the analyses' ``_packed.stride_map``):
+    from the section ``(beta, phi, xd, yd, phid)`` just after touch-down at ``x = 0``
+    on level ground at height ``h``, nothing recorded; fills ``out``, returns the status.
 
-
-def _make_section_map(method: int) -> Callable:
-    def section_map(P, O, beta, phi, xd, yd, phid, h, out):
-        """The Poincare map's stride (``tslip.step_map``, the analyses' ``_packed.stride_map``):
-        from the section ``(beta, phi, xd, yd, phid)`` just after touch-down at ``x = 0``
-        on level ground at height ``h``, nothing recorded; fills ``out``, returns the status.
-
-        The stride kernel's arrays (touch-down state, terrain, empty record) are built
-        here, from the section's floats: built in Python (NumPy arrays from lists,
-        three more arrays for numba to dispatch) they cost about 1 us a map call,
-        a tenth of a Table 6.1 stride (``step_map`` 1.33 -> 1.23 times the stride
-        kernel, measured side by side with the Python construction).
-        """
-        W = np.empty(NTD + 1)
-        td = W[0:NTD]
-        td[0] = beta
-        td[1] = phi
-        td[2] = xd
-        td[3] = yd
-        td[4] = phid
-        td[5] = 0.0
-        td[6] = h
-        th = W[NTD:NTD + 1]  # the ground's one segment, at h
-        th[0] = h
-        tx = W[NTD + 1:]  # no breakpoints
-        rec = tx.reshape((0, NREC))  # no rows: nothing recorded
-        return stride_of(method, P, O, td, tx, th, rec, 0.0, out)
-
-    return section_map
-
-
-#: ``(P, O, beta, phi, xd, yd, phid, h, out) -> status`` by method: the map's stride
-#: from the section on level ground (:func:`_make_section_map`).
-SECTION_MAP = specialise(_make_section_map, "section_map")
+    The stride kernel's arrays (touch-down state, terrain, empty record) are built
+    here, from the section's floats: built in Python (NumPy arrays from lists,
+    three more arrays for numba to dispatch) they cost about 1 us a map call,
+    a tenth of a Table 6.1 stride (``step_map`` 1.33 -> 1.23 times the stride
+    kernel, measured side by side with the Python construction).
+    """
+    W = np.empty(NTD + 1)
+    td = W[0:NTD]
+    td[0] = beta
+    td[1] = phi
+    td[2] = xd
+    td[3] = yd
+    td[4] = phid
+    td[5] = 0.0
+    td[6] = h
+    th = W[NTD:NTD + 1]  # the ground's one segment, at h
+    th[0] = h
+    tx = W[NTD + 1:]  # no breakpoints
+    rec = tx.reshape((0, NREC))  # no rows: nothing recorded
+    return stride(P, O, td, tx, th, rec, 0.0, out)
 
 
 # ---------------------------------------------------------------------------
@@ -519,98 +541,74 @@ SECTION_MAP = specialise(_make_section_map, "section_map")
 # ---------------------------------------------------------------------------
 
 
-def _make_run_row(method: int) -> Callable:
-    def run_row(P, O, td0, n_steps, tx, th, hist):
-        """Run up to ``n_steps`` strides from ``td0``; returns ``(status, n_done, t_fall)``.
+@njit(**_JIT)
+def run_row(P, O, td0, n_steps, tx, th, hist):
+    """Run up to ``n_steps`` strides from ``td0``; returns ``(status, n_done, t_fall)``.
 
-        ``hist`` (n_steps + 1, 7) receives the touch-down states (rows after a
-        fall are left as they are); ``t_fall`` is NaN unless the run fell.
-        """
-        out = np.empty(NOUT)
-        no_rec = np.empty((0, NREC))
-        td = td0.copy()
+    ``hist`` (n_steps + 1, 7) receives the touch-down states (rows after a
+    fall are left as they are); ``t_fall`` is NaN unless the run fell.
+    """
+    out = np.empty(NOUT)
+    no_rec = np.empty((0, NREC))
+    td = td0.copy()
+    for j in range(7):
+        hist[0, j] = td[j]
+    t_total = 0.0
+    st = ST_OK
+    done = 0
+    t_fall = math.nan
+    for s in range(n_steps):
+        st = stride(P, O, td, tx, th, no_rec, 0.0, out)
+        if st != ST_OK:
+            if st < 10:
+                t_fall = t_total + out[OUT_TFALL]
+            break
+        t_total += out[OUT_TS] + out[OUT_TF]
         for j in range(7):
-            hist[0, j] = td[j]
-        t_total = 0.0
-        st = ST_OK
-        done = 0
-        t_fall = math.nan
-        for s in range(n_steps):
-            st = stride_of(method, P, O, td, tx, th, no_rec, 0.0, out)
-            if st != ST_OK:
-                if st < 10:
-                    t_fall = t_total + out[OUT_TFALL]
-                break
-            t_total += out[OUT_TS] + out[OUT_TF]
-            for j in range(7):
-                td[j] = out[OUT_TD + j]
-                hist[s + 1, j] = td[j]
-            done = s + 1
-        return st, done, t_fall
-
-    return run_row
+            td[j] = out[OUT_TD + j]
+            hist[s + 1, j] = td[j]
+        done = s + 1
+    return st, done, t_fall
 
 
-RUN_ROW = specialise(_make_run_row, "run_row")
-_RUN_ROW_DOPRI5, _RUN_ROW_DOP853 = RUN_ROW
+@njit(**_PAR)
+def run_batch(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall):
+    """``n_steps`` strides for each row, in parallel over rows (:func:`run_batch_serial`)."""
+    for i in prange(Ps.shape[0]):
+        status[i], n_done[i], t_fall[i] = run_row(Ps[i], O, TDs[i], n_steps, TX[i], TH[i],
+                                                  td_hist[i])
 
 
-@njit(**_INLINE)
-def run_row_of(method, P, O, td0, n_steps, tx, th, hist):
-    """``RUN_ROW[method]`` called from a kernel whose ``method`` is a constant."""
-    if method == M_DOPRI5:
-        return _RUN_ROW_DOPRI5(P, O, td0, n_steps, tx, th, hist)
-    return _RUN_ROW_DOP853(P, O, td0, n_steps, tx, th, hist)
+@njit(**_JIT)
+def run_batch_serial(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall):
+    """``n_steps`` strides for each row, in the calling thread. ``Ps`` (n, NP), ``TDs``
+    (n, 7), per-row terrain ``TX`` (n, nb) and ``TH`` (n, nb + 1) (pad breakpoints with
+    ``+inf``). Writes each row's touch-down states into ``td_hist`` (n, n_steps + 1, 7),
+    the final ``status``, the number of completed strides ``n_done`` and the time of the
+    fall ``t_fall`` (NaN if none)."""
+    for i in range(Ps.shape[0]):
+        status[i], n_done[i], t_fall[i] = run_row(Ps[i], O, TDs[i], n_steps, TX[i], TH[i],
+                                                  td_hist[i])
 
 
-def _make_run_batch(method: int, parallel: bool) -> Callable:
-    if parallel:
-        def run_batch(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall):
-            for i in prange(Ps.shape[0]):
-                status[i], n_done[i], t_fall[i] = run_row_of(method, Ps[i], O, TDs[i], n_steps,
-                                                             TX[i], TH[i], td_hist[i])
-        return run_batch
-
-    def run_batch_serial(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall):
-        for i in range(Ps.shape[0]):
-            status[i], n_done[i], t_fall[i] = run_row_of(method, Ps[i], O, TDs[i], n_steps,
-                                                         TX[i], TH[i], td_hist[i])
-    return run_batch_serial
+@njit(**_PAR)
+def stride_batch(Ps, O, TDs, TX, TH, OUTs, status):
+    """One stride per row (the batched Poincare map), in parallel over rows
+    (:func:`stride_batch_serial`)."""
+    no_rec = np.empty((0, NREC))  # zero rows: never written, shared by the threads
+    for i in prange(Ps.shape[0]):
+        status[i] = stride(Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0, OUTs[i])
 
 
-#: ``(Ps, O, TDs, n_steps, TX, TH, td_hist, status, n_done, t_fall)``: ``n_steps``
-#: strides for each row. ``Ps`` (n, NP), ``TDs`` (n, 7), per-row terrain ``TX``
-#: (n, nb) and ``TH`` (n, nb + 1) (pad breakpoints with ``+inf``). Writes each
-#: row's touch-down states into ``td_hist`` (n, n_steps + 1, 7), the final
-#: ``status``, the number of completed strides ``n_done`` and the time of the fall
-#: ``t_fall`` (NaN if none). In the calling thread, and in parallel over rows.
-RUN_BATCH_SERIAL = specialise(_make_run_batch, "run_batch_serial", False)
-RUN_BATCH = specialise(_make_run_batch, "run_batch", True, jit=_PAR)
-
-
-def _make_stride_batch(method: int, parallel: bool) -> Callable:
-    if parallel:
-        def stride_batch(Ps, O, TDs, TX, TH, OUTs, status):
-            no_rec = np.empty((0, NREC))  # zero rows: never written, shared by the threads
-            for i in prange(Ps.shape[0]):
-                status[i] = stride_of(method, Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0,
-                                      OUTs[i])
-        return stride_batch
-
-    def stride_batch_serial(Ps, O, TDs, TX, TH, OUTs, status):
-        no_rec = np.empty((0, NREC))
-        for i in range(Ps.shape[0]):
-            status[i] = stride_of(method, Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0,
-                                      OUTs[i])
-    return stride_batch_serial
-
-
-#: ``(Ps, O, TDs, TX, TH, OUTs, status)``: one stride per row (the batched Poincare
-#: map), in the calling thread and in parallel over rows.
-STRIDE_BATCH_SERIAL = specialise(_make_stride_batch, "stride_batch_serial", False)
-STRIDE_BATCH = specialise(_make_stride_batch, "stride_batch", True, jit=_PAR)
+@njit(**_JIT)
+def stride_batch_serial(Ps, O, TDs, TX, TH, OUTs, status):
+    """``(Ps, O, TDs, TX, TH, OUTs, status)``: one stride per row (the batched Poincare
+    map) in the calling thread, ``OUTs[i]`` and ``status[i]`` as :func:`stride` fills them."""
+    no_rec = np.empty((0, NREC))
+    for i in range(Ps.shape[0]):
+        status[i] = stride(Ps[i], O, TDs[i], TX[i], TH[i], no_rec, 0.0, OUTs[i])
 
 
 # numba does not notice when a kernel called from another file changes; drop
 # cached kernels compiled against other sources (see tslip._kernel_cache).
-_check_cache(_STRIDE_DOPRI5, __file__)
+_check_cache(stride, __file__)

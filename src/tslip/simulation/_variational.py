@@ -28,16 +28,16 @@ chain; each link is differentiated exactly:
 ``d qdd = M^-1 (dR - dM qdd)``, with the closed-form ``M^-1`` of
 :func:`._stance.stance_accel`.
 
-One kernel per integrator method (:func:`._stride.specialise`), which calls
-the method's stride kernel (:func:`._stride._make_stride`) recording every
-accepted step; :func:`_aug_rhs` compiles on its own, the other helpers are
-``inline="always"``.
+One kernel, :func:`stride_jacobian`, for both integrator methods (the pair is read
+from the options ``O`` at run time, ``O[O_METHOD]``), which calls the stride kernel
+(:func:`._stride.stride`) recording every accepted step, then takes the links above
+in turn, each a named helper; :func:`_aug_rhs` compiles on its own, the other helpers
+are ``inline="always"``.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 
 import numpy as np
 from numba import njit
@@ -46,9 +46,13 @@ from .._kernel_cache import check as _check_cache
 from ..model._pack import (
     NREC,
     O_ATOL,
+    O_METHOD,
     O_RTOL,
     OUT_LO,
+    OUT_NREC,
+    OUT_RECOVF,
     OUT_TF,
+    OUT_TSW,
     P_C0,
     P_CL,
     P_G,
@@ -65,7 +69,6 @@ from ..model._pack import (
 from . import _rk
 from ._flight import flight_leg_angle, retraction_start, stop_time
 from ._rk import _INLINE, _JIT
-from ._specialise import ByMethod, specialise
 from ._stance import (
     NSTATE,
     hip_torque,
@@ -75,7 +78,8 @@ from ._stance import (
     spring_slope,
     stance_initial,
 )
-from ._stride import stride_of
+from ._stepper import NONFINITE_SHRINK
+from ._stride import stride
 
 
 @njit(**_INLINE)
@@ -209,6 +213,12 @@ def _sens_step(P, method, z, h, K, ztmp, Jf):
 #: stance at ``n = 1.2``, ``k`` 20 x 0.15^-0.2, DOP853 at 1e-12: 40 recorded steps, 116
 #: attempted substeps, at most 9 in one step).
 MAX_SUBSTEPS = 10000
+#: The largest growth of a substep after an accepted one (below the stride's
+#: ``_stepper.FAC_MAX``: the substeps end at the recorded step's end, no further)
+SUBSTEP_FAC_MAX = 5.0
+#: A substep this small (a fraction of the recorded step) is accepted whatever its error:
+#: the error control of ``Phi`` cannot stall the replay at the spring's rest length
+SUBSTEP_MIN = 1e-12
 
 
 @njit(**_INLINE)
@@ -245,15 +255,15 @@ def _sens_steps(P, O, method, z, h, K, ztmp, zold, Jf, rec_row):
         _sens_step(P, method, z, hs, K, ztmp, Jf)
         _aug_rhs(P, z, K[ns], Jf)  # the FSAL row of the error estimate
         err = _rk.error_norm(method, NAUG, zold, z, hs, K, rtol, atol)
-        if err <= 1.0 or hs <= 1e-12 * h:
+        if err <= 1.0 or hs <= SUBSTEP_MIN * h:
             done += hs
             if last:
                 break
-            hs *= _rk.step_factor(method, err, 5.0)
+            hs *= _rk.step_factor(method, err, SUBSTEP_FAC_MAX)
         else:
             for i in range(NAUG):
                 z[i] = zold[i]
-            hs *= _rk.step_factor(method, err, 1.0) if math.isfinite(err) else 0.1
+            hs *= _rk.step_factor(method, err, 1.0) if math.isfinite(err) else NONFINITE_SHRINK
     for i in range(NSTATE):
         z[i] = rec_row[1 + i]
 
@@ -274,140 +284,177 @@ def _switch_saltation(Pw, z):
             z[NSTATE + i * NSTATE + c] += (fm[i] - fp[i]) * dt
 
 
-def _make_stride_jacobian(method: int) -> Callable:
-    def stride_jacobian(P, O, td, tx, th, Jq, out):
-        """Next touch-down state and its exact Jacobian ``Jq = dq'/dq`` (5 x 5).
+@njit(**_INLINE)
+def _fail(Jq):
+    """``Jq`` all NaN: a stride that did not end in a touch-down has no Jacobian."""
+    for i in range(5):
+        for j in range(5):
+            Jq[i, j] = math.nan
 
-        Returns the stride status; ``out`` is filled as by :func:`._stride._make_stride`.
-        """
-        rec = np.empty((4096, NREC))
-        status = stride_of(method, P, O, td, tx, th, rec, 0.0, out)
-        if status != ST_OK or out[26] != 0.0:  # OUT_RECOVF
-            for i in range(5):
-                for j in range(5):
-                    Jq[i, j] = math.nan
-            return status
-        nrec = int(out[25])  # OUT_NREC
-        l0 = P[P_L0]
-        r = P[P_R]
-        g = P[P_G]
-        # 1. dy0/dq (6 x 5), q = (beta, phi, xd, yd, phid)
-        y = np.empty(NSTATE)
-        stance_initial(P, td, y)
-        b, ph, xd, yd, phd = td[0], td[1], td[2], td[3], td[4]
-        sb, cb = math.sin(b), math.cos(b)
-        sp, cp = math.sin(ph), math.cos(ph)
-        u = xd - r * cp * phd
-        w = yd - r * sp * phd
-        du = np.array([0.0, r * sp * phd, 1.0, 0.0, -r * cp])
-        dw = np.array([0.0, -r * cp * phd, 0.0, 1.0, -r * sp])
-        D0 = np.zeros((NSTATE, 5))
-        D0[1, 0] = 1.0
-        D0[2, 1] = 1.0
-        D0[5, 4] = 1.0
+
+@njit(**_INLINE)
+def _touchdown_jacobian(P, td, y):
+    """Link 1: the stance state ``y`` at touch-down (eq. A.5 inverted, into ``y``) and its
+    Jacobian ``dy0/dq`` (6 x 5, returned), ``q = (beta, phi, xd, yd, phid)``."""
+    l0 = P[P_L0]
+    r = P[P_R]
+    stance_initial(P, td, y)
+    b, ph, xd, yd, phd = td[0], td[1], td[2], td[3], td[4]
+    sb, cb = math.sin(b), math.cos(b)
+    sp, cp = math.sin(ph), math.cos(ph)
+    u = xd - r * cp * phd
+    w = yd - r * sp * phd
+    du = np.array([0.0, r * sp * phd, 1.0, 0.0, -r * cp])
+    dw = np.array([0.0, -r * cp * phd, 0.0, 1.0, -r * sp])
+    D0 = np.zeros((NSTATE, 5))
+    D0[1, 0] = 1.0
+    D0[2, 1] = 1.0
+    D0[5, 4] = 1.0
+    for j in range(5):
+        D0[3, j] = -cb * du[j] + sb * dw[j]
+        D0[4, j] = (sb * du[j] + cb * dw[j]) / l0
+    D0[3, 0] += u * sb + w * cb
+    D0[4, 0] += (u * cb - w * sb) / l0
+    return D0
+
+
+@njit(**_INLINE)
+def _replay_stance(Pw, O, method, y, rec, nrec, tsw):
+    """Link 2: ``(y, Phi)`` at lift-off (returned, :data:`NAUG`), the stride's accepted steps
+    (``rec``'s ``nrec`` rows) replayed from ``y`` with sensitivities (:func:`_sens_steps`),
+    the thrust's switch at ``tsw`` (NaN if none) crossed by :func:`_switch_saltation`
+    (which switches the working parameters ``Pw`` in place)."""
+    z = np.zeros(NAUG)
+    for i in range(NSTATE):
+        z[i] = y[i]
+        # Phi's column 0, the response to the touch-down leg length, stays 0: that
+        # length is l0 on the section (D0's row 0 is 0), and the stiffness |x|^(n-1)
+        # of a power-law leg is not smooth at touch-down (_sens_steps)
+        z[NSTATE + i * NSTATE + i] = 1.0 if i > 0 else 0.0
+    K = np.empty((_rk.NK, NAUG))
+    ztmp = np.empty(NAUG)
+    zold = np.empty(NAUG)
+    Jf = np.empty((NSTATE, NSTATE))
+    for k in range(1, nrec):
+        h = rec[k, 0] - rec[k - 1, 0]
+        if h > 0.0:
+            _sens_steps(Pw, O, method, z, h, K, ztmp, zold, Jf, rec[k])
+        if rec[k, 0] == tsw and Pw[P_THRUST] > 0.0:
+            _switch_saltation(Pw, z)
+    return z
+
+
+@njit(**_INLINE)
+def _liftoff_saltation(Pw, z, D0, y):
+    """Link 3: ``dy_LO/dq`` (6 x 5, returned) from the replay's ``z = (y, Phi)``: ``Phi D0``
+    corrected by the lift-off's saltation ``dt_LO = -(grad F_y . Phi) / (grad F_y . f)``
+    (:func:`fy_gradient`); ``y`` receives the lift-off stance state."""
+    for i in range(NSTATE):
+        y[i] = z[i]
+    Phi = z[NSTATE:].copy().reshape((NSTATE, NSTATE))
+    f = np.empty(NSTATE)
+    rhs(Pw, y, f)
+    gr = np.empty(NSTATE)
+    fy_gradient(Pw, y, gr)
+    gf = 0.0
+    for i in range(NSTATE):
+        gf += gr[i] * f[i]
+    S = Phi @ D0  # dy_LO/dq before the event correction
+    dtlo = np.zeros(5)
+    for j in range(5):
+        acc = 0.0
+        for i in range(NSTATE):
+            acc += gr[i] * S[i, j]
+        dtlo[j] = -acc / gf
+    for i in range(NSTATE):
         for j in range(5):
-            D0[3, j] = -cb * du[j] + sb * dw[j]
-            D0[4, j] = (sb * du[j] + cb * dw[j]) / l0
-        D0[3, 0] += u * sb + w * cb
-        D0[4, 0] += (u * cb - w * sb) / l0
-        # 2. replay the accepted steps with sensitivities
-        z = np.zeros(NAUG)
-        for i in range(NSTATE):
-            z[i] = y[i]
-            # Phi's column 0, the response to the touch-down leg length, stays 0: that
-            # length is l0 on the section (D0's row 0 is 0), and the stiffness |x|^(n-1)
-            # of a power-law leg is not smooth at touch-down (_sens_steps)
-            z[NSTATE + i * NSTATE + i] = 1.0 if i > 0 else 0.0
-        K = np.empty((_rk.NK, NAUG))
-        ztmp = np.empty(NAUG)
-        zold = np.empty(NAUG)
-        Jf = np.empty((NSTATE, NSTATE))
-        tsw = out[27]  # OUT_TSW: the thrust's switch, NaN if none
-        Pw = P.copy() if P[P_THRUST] > 0.0 else P  # the stance's working parameters
-        for k in range(1, nrec):
-            h = rec[k, 0] - rec[k - 1, 0]
-            if h > 0.0:
-                _sens_steps(Pw, O, method, z, h, K, ztmp, zold, Jf, rec[k])
-            if rec[k, 0] == tsw and Pw[P_THRUST] > 0.0:
-                _switch_saltation(Pw, z)
-        for i in range(NSTATE):
-            y[i] = z[i]
-        Phi = z[NSTATE:].copy().reshape((NSTATE, NSTATE))
-        # 3. saltation at lift-off: dt_LO = -(grad Fy . Phi) / (grad Fy . f)
-        f = np.empty(NSTATE)
-        rhs(Pw, y, f)
-        gr = np.empty(NSTATE)
-        fy_gradient(Pw, y, gr)
-        gf = 0.0
-        for i in range(NSTATE):
-            gf += gr[i] * f[i]
-        S = Phi @ D0  # dy_LO/dq before the event correction
-        dtlo = np.zeros(5)
-        for j in range(5):
-            acc = 0.0
-            for i in range(NSTATE):
-                acc += gr[i] * S[i, j]
-            dtlo[j] = -acc / gf
-        for i in range(NSTATE):
-            for j in range(5):
-                S[i, j] += f[i] * dtlo[j]
-        # 4. lift-off CoM state lo = (y_m, xd, yd, phi, phid) and its Jacobian (5 x 6)
-        l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
-        sb, cb = math.sin(b), math.cos(b)
-        sp, cp = math.sin(ph), math.cos(ph)
-        L = np.zeros((5, NSTATE))
-        L[0, 0], L[0, 1], L[0, 2] = sb, l * cb, r * sp
-        L[1, 0], L[1, 1], L[1, 2] = sb * bd, ld * sb + l * cb * bd, -r * sp * phd
-        L[1, 3], L[1, 4], L[1, 5] = -cb, l * sb, r * cp
-        L[2, 0], L[2, 1], L[2, 2] = cb * bd, ld * cb - l * sb * bd, r * cp * phd
-        L[2, 3], L[2, 4], L[2, 5] = sb, l * cb, r * sp
-        L[3, 2] = 1.0
-        L[4, 5] = 1.0
-        G = L @ S  # d lo / dq
-        # 5. flight: foot height f(t) = y + yd t - g t^2/2 + r cos(phi(t)) - l0 sin(beta(t)) - H
-        tf = out[OUT_TF]
-        phi0 = out[OUT_LO + 4]
-        phid0 = out[OUT_LO + 5]
-        yd0 = out[OUT_LO + 3]
-        ta = retraction_start(P, yd0)
-        bt, bdot = flight_leg_angle(P, phi0, phid0, tf, ta)
-        pht = phi0 + phid0 * tf
-        local = P[P_GLOBAL] == 0.0
-        dbdphi = -1.0 if local else 0.0
-        dbdphid = -tf if local else 0.0
-        # apex clock: beta = alpha_r + omega_r (t - yd0 / g) [- phi(t)] once retracting,
-        # until the retraction stop (then the hip angle is a constant)
-        dbdyd = -P[P_OMEGA] / g if (ta > 0.0 and tf >= ta and tf < stop_time(P, ta)) else 0.0
-        spt, cbt = math.sin(pht), math.cos(bt)
-        # partials of f with respect to lo = (y, xd, yd, phi, phid) and t
-        df = np.array([1.0, 0.0, tf, -r * spt - l0 * cbt * dbdphi,
-                       -r * spt * tf - l0 * cbt * dbdphid])
+            S[i, j] += f[i] * dtlo[j]
+    return S
+
+
+@njit(**_INLINE)
+def _liftoff_com_jacobian(r, y):
+    """Link 4: the Jacobian (5 x 6) of the lift-off CoM state ``lo = (y_m, xd, yd, phi,
+    phid)`` with respect to the stance state ``y`` (eqs A.3-A.5; ``r = P[P_R]``)."""
+    l, b, ph, ld, bd, phd = y[0], y[1], y[2], y[3], y[4], y[5]
+    sb, cb = math.sin(b), math.cos(b)
+    sp, cp = math.sin(ph), math.cos(ph)
+    L = np.zeros((5, NSTATE))
+    L[0, 0], L[0, 1], L[0, 2] = sb, l * cb, r * sp
+    L[1, 0], L[1, 1], L[1, 2] = sb * bd, ld * sb + l * cb * bd, -r * sp * phd
+    L[1, 3], L[1, 4], L[1, 5] = -cb, l * sb, r * cp
+    L[2, 0], L[2, 1], L[2, 2] = cb * bd, ld * cb - l * sb * bd, r * cp * phd
+    L[2, 3], L[2, 4], L[2, 5] = sb, l * cb, r * sp
+    L[3, 2] = 1.0
+    L[4, 5] = 1.0
+    return L
+
+
+@njit(**_INLINE)
+def _flight_jacobian(P, out, G, Jq):
+    """Link 5: ``Jq = dq'/dq`` from ``G = d lo/dq`` through the closed-form flight of the
+    stride ``out``, with the touch-down time's implicit derivative for the foot height
+    ``f(t) = y + yd t - g t^2/2 + r cos(phi(t)) - l0 sin(beta(t)) - H``."""
+    l0 = P[P_L0]
+    r = P[P_R]
+    g = P[P_G]
+    tf = out[OUT_TF]
+    phi0 = out[OUT_LO + 4]
+    phid0 = out[OUT_LO + 5]
+    yd0 = out[OUT_LO + 3]
+    ta = retraction_start(P, yd0)
+    bt, bdot = flight_leg_angle(P, phi0, phid0, tf, ta)
+    pht = phi0 + phid0 * tf
+    local = P[P_GLOBAL] == 0.0
+    dbdphi = -1.0 if local else 0.0
+    dbdphid = -tf if local else 0.0
+    # apex clock: beta = alpha_r + omega_r (t - yd0 / g) [- phi(t)] once retracting,
+    # until the retraction stop (then the hip angle is a constant)
+    dbdyd = -P[P_OMEGA] / g if (ta > 0.0 and tf >= ta and tf < stop_time(P, ta)) else 0.0
+    spt, cbt = math.sin(pht), math.cos(bt)
+    # partials of f with respect to lo = (y, xd, yd, phi, phid) and t
+    df = np.array([1.0, 0.0, tf, -r * spt - l0 * cbt * dbdphi,
+                   -r * spt * tf - l0 * cbt * dbdphid])
+    if dbdyd != 0.0:
+        df[2] -= l0 * cbt * dbdyd
+    dfdt = yd0 - g * tf - r * spt * phid0 - l0 * cbt * bdot
+    dttd = np.zeros(5)
+    for j in range(5):
+        acc = 0.0
+        for i in range(5):
+            acc += df[i] * G[i, j]
+        dttd[j] = -acc / dfdt
+    # q' = (beta(t), phi(t), xd, yd - g t, phid)
+    for j in range(5):
+        Jq[0, j] = dbdphi * G[3, j] + dbdphid * G[4, j] + bdot * dttd[j]
         if dbdyd != 0.0:
-            df[2] -= l0 * cbt * dbdyd
-        dfdt = yd0 - g * tf - r * spt * phid0 - l0 * cbt * bdot
-        dttd = np.zeros(5)
-        for j in range(5):
-            acc = 0.0
-            for i in range(5):
-                acc += df[i] * G[i, j]
-            dttd[j] = -acc / dfdt
-        # q' = (beta(t), phi(t), xd, yd - g t, phid)
-        for j in range(5):
-            Jq[0, j] = dbdphi * G[3, j] + dbdphid * G[4, j] + bdot * dttd[j]
-            if dbdyd != 0.0:
-                Jq[0, j] += dbdyd * G[2, j]
-            Jq[1, j] = G[3, j] + tf * G[4, j] + phid0 * dttd[j]
-            Jq[2, j] = G[1, j]
-            Jq[3, j] = G[2, j] - g * dttd[j]
-            Jq[4, j] = G[4, j]
+            Jq[0, j] += dbdyd * G[2, j]
+        Jq[1, j] = G[3, j] + tf * G[4, j] + phid0 * dttd[j]
+        Jq[2, j] = G[1, j]
+        Jq[3, j] = G[2, j] - g * dttd[j]
+        Jq[4, j] = G[4, j]
+
+
+@njit(**_JIT)
+def stride_jacobian(P, O, td, tx, th, Jq, out):
+    """Next touch-down state and its exact Jacobian ``Jq = dq'/dq`` (5 x 5), the links of
+    the module docstring in turn, with the Runge-Kutta pair ``O[O_METHOD]``.
+
+    Returns the stride status; ``out`` is filled as by :func:`._stride.stride`.
+    """
+    rec = np.empty((4096, NREC))
+    status = stride(P, O, td, tx, th, rec, 0.0, out)
+    if status != ST_OK or out[OUT_RECOVF] != 0.0:
+        _fail(Jq)
         return status
-
-    return stride_jacobian
-
-
-#: ``(P, O, td, tx, th, Jq, out) -> status`` by method, and called as one by ``O``'s method.
-STRIDE_JACOBIAN = specialise(_make_stride_jacobian, "stride_jacobian")
-stride_jacobian = ByMethod(STRIDE_JACOBIAN)
+    y = np.empty(NSTATE)
+    D0 = _touchdown_jacobian(P, td, y)
+    Pw = P.copy() if P[P_THRUST] > 0.0 else P  # the stance's working parameters
+    z = _replay_stance(Pw, O, int(O[O_METHOD]), y, rec, int(out[OUT_NREC]), out[OUT_TSW])
+    S = _liftoff_saltation(Pw, z, D0, y)
+    G = _liftoff_com_jacobian(P[P_R], y) @ S  # d lo / dq
+    _flight_jacobian(P, out, G, Jq)
+    return status
 
 
 # numba does not notice when a kernel called from another file changes; drop

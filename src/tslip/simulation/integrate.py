@@ -81,9 +81,8 @@ class Disturbance:
 
 #: The default options, built (and validated) once: ``step_map`` runs once a stride.
 _DEFAULT_OPTIONS = IntegratorOptions()
-#: ... packed once, with their stride kernel (never written into)
+#: ... packed once (never written into)
 _DEFAULT_O = _DEFAULT_OPTIONS.packed()
-_DEFAULT_MAP = kn.SECTION_MAP[int(_DEFAULT_O[pk.O_METHOD])]
 _F64 = np.dtype(float)
 #: ``Status`` by code (the enum's own lookup costs a microsecond, once a stride in ``step_map``)
 _STATUS = {int(s): s for s in Status}
@@ -248,11 +247,10 @@ def step_map(
     vals, h = _section_values(q, h)
     out = np.empty(pk.NOUT)
     if options is None:
-        O, section_map = _DEFAULT_O, _DEFAULT_MAP
+        O = _DEFAULT_O
     else:
         O = options.packed()
-        section_map = kn.SECTION_MAP[int(O[pk.O_METHOD])]
-    status = section_map(P, O, *vals, h, out)
+    status = kn.section_map(P, O, *vals, h, out)
     return _new_tuple(MapResult, (out[pk.OUT_TD : pk.OUT_TD + 5], out.item(pk.OUT_TS),
                                   out.item(pk.OUT_TF), _STATUS[status]))
 
@@ -377,9 +375,8 @@ class _Recording:
         """Run strides ``first .. last - 1`` from ``td`` (updated to the next touch-down)."""
         tx, th = terrain.arrays()
         close = last == self.n_steps
-        record_run = kn.RECORD_RUN[int(self.O[pk.O_METHOD])]
         while True:
-            st = int(record_run(self.P, self.O, td, tx, th, first, last, close, self.dt,
+            st = int(kn.record_run(self.P, self.O, td, tx, th, first, last, close, self.dt,
                                 self.rows, self.starts, self.outs, self.info, self.pos))
             if st != pk.RUN_FULL:
                 return _STATUS[st]

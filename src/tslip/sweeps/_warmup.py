@@ -101,7 +101,7 @@ def cache_dirs(packages: tuple[str, ...] = ("simulation", "biped")) -> dict[str,
     if "simulation" in packages:
         from ..simulation import _stride
 
-        dirs["simulation"] = Path(_stride.STRIDE[0]._cache.cache_path)
+        dirs["simulation"] = Path(_stride.stride._cache.cache_path)  # type: ignore[attr-defined]
     if "biped" in packages:
         from ..biped import _stride as biped_stride
 
