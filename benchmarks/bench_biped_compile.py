@@ -5,7 +5,8 @@ Run by hand (not in CI): ``python benchmarks/bench_biped_compile.py [--rev 9b672
 ``NUMBA_CACHE_DIR``: the CPU seconds of its first stride from the Table E.2
 start (``tslip.biped.step``) minus those of a second one, once with each
 Runge-Kutta pair (dopri5 first, so dop853's figure excludes the kernels both
-share, such as the right-hand side), and numba's compile CPU seconds per
+share, such as the right-hand side; since one loop serves both pairs, dop853's
+is about 0 s where the loop takes the pair at run time), and numba's compile CPU seconds per
 function (its callees' compiles excluded). The two revisions alternate, round
 by round; printed: each round with the 1-minute load before it, then medians.
 """

@@ -204,7 +204,7 @@ def same_results(a: Path, b: Path) -> list[str]:
 def _family_of(fn: str) -> str:
     """A compiled function's kernel family (by its top-level kernel's package and method)."""
     if ".biped." in fn:
-        return "biped (dop853)" if fn.endswith("dop853") else "biped (dopri5) and helpers"
+        return "biped"
     if "_record." in fn or "run_batch" in fn or "flight_state" in fn:
         return "TSLIP recorded runs"
     return "TSLIP gait search and analyses"

@@ -89,7 +89,8 @@ def check(dispatcher: object, module_file: str) -> None:
 #: index files ``module.function-LINE.pyXY.nbi``) that must all be cached.
 #: Measured: the kernels each workload of :mod:`tslip.sweeps._warmup` compiles
 #: that no other family compiles (their callees are cached with them); the
-#: biped's first family also holds the helpers Appendix E calls from Python
+#: biped's family (one stride loop for both Runge-Kutta pairs) also holds the
+#: helpers Appendix E calls from Python
 #: (body kinematics, controller references), which workers compiled otherwise.
 FAMILIES: dict[str, tuple[str, tuple[str, ...]]] = {
     "TSLIP gait search and analyses": ("simulation", (
@@ -97,9 +98,7 @@ FAMILIES: dict[str, tuple[str, tuple[str, ...]]] = {
         "_stride.run_row", "_flight.alpha_r_column")),
     "TSLIP recorded runs": ("simulation", (
         "_record.record_run", "_stride.run_batch_serial", "_flight.flight_state")),
-    "biped (dopri5)": ("biped", ("_stride._integrate_dopri5", "_tmt.kinematics",
-                                 "_control.references")),
-    "biped (dop853)": ("biped", ("_stride._integrate_dop853",)),
+    "biped": ("biped", ("_stride._integrate", "_tmt.kinematics", "_control.references")),
 }
 
 

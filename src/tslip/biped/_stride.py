@@ -38,21 +38,21 @@ touch-down a switching condition that ends the stride):
 Speed (``benchmarks/bench_biped.py``): the loop and everything it calls are
 compiled without numba's reference counting (:mod:`tslip._nrt`), so
 :func:`run` allocates every work array and passes it in; the loop is
-compiled once per Runge-Kutta pair (:func:`_integrate_dopri5`,
-:func:`_integrate_dop853`), only for the pair a run uses, so that the
-tableau is a constant (numba types the pair's code as a literal and compiles
-each function that takes it once per pair); the switching functions at the
-end of a step read the sines and cosines the right-hand side has just
-computed there. The steps are ``inline="always"`` into the loop, each with
-one call site, so the loop compiles as one function, as it did when it was
-one body: each function compiled on its own costs a first run some 0.5 s
-of compilation (its own module, optimised again with everything it calls),
-and only :func:`rhs` (eq. E.22, called from every stage), :func:`_record`
-(only when recording) and :func:`dense_output` are. Inlining :func:`rhs` too
-would make a stride faster but compile for over twice as long (see
-:func:`rk_step`); inlining :func:`dense_output` (its extra stages call
-:func:`rhs`) cost some 6 s more compile CPU for the two pairs than compiling
-it on its own.
+compiled once for both Runge-Kutta pairs: the pair is a run-time argument,
+read from ``O_METHOD``, and the tableau rows and stage counts are read from
+the arrays of :mod:`tslip.simulation._rk` (compiling the loop once per pair,
+with the pair a constant, cost some 7 s of compile CPU more for the second
+pair); the switching functions at the end of a step read the sines and
+cosines the right-hand side has just computed there. The steps are
+``inline="always"`` into the loop, each with one call site, so the loop
+compiles as one function, as it did when it was one body: each function
+compiled on its own costs a first run some 0.5 s of compilation (its own
+module, optimised again with everything it calls), and only :func:`rhs`
+(eq. E.22, called from every stage), :func:`_record` (only when recording)
+and :func:`dense_output` are. Inlining :func:`rhs` too would make a stride
+faster but compile for over twice as long (see :func:`rk_step`); inlining
+:func:`dense_output` (its extra stages call :func:`rhs`) cost some 6 s more
+compile CPU for the two pairs than compiling it on its own.
 """
 
 from __future__ import annotations
@@ -63,7 +63,6 @@ import numpy as np
 from numba import njit
 
 from .._kernel_cache import check as _check_cache
-from ..model._pack import M_DOP853, M_DOPRI5
 from ..simulation import _rk
 from ._contact import contact_force_trig, contact_switch
 from ._control import actuation, ctl_switch, ctl_switch_time, init_ctl
@@ -157,13 +156,12 @@ def run(P, O, t0, y0, cs0, n_strides, rec, ev, strides, yend, csend, stats):
     ``stats``. Returns the status. ``y0`` and ``cs0`` are not changed.
 
     A Python function: it allocates the work arrays and calls the compiled
-    loop of the run's Runge-Kutta pair (see the module docstring).
+    loop (one for both Runge-Kutta pairs, see the module docstring).
     """
     y = np.array(y0, dtype=np.float64)
     cs = np.array(cs0, dtype=np.float64)
-    loop = _integrate_dop853 if int(O[O_METHOD]) == M_DOP853 else _integrate_dopri5
-    return loop(P, O, float(t0), y, cs, int(n_strides), rec, ev, strides, yend, csend, stats,
-                make_work())
+    return _integrate(P, O, float(t0), y, cs, int(n_strides), rec, ev, strides, yend, csend,
+                      stats, make_work())
 
 
 # ---------------------------------------------------------------------------
@@ -467,10 +465,11 @@ def _finish(t, y, cs, status, ev, nev, yend, csend, stats, nrec, nstr, nacc, nre
     stats[S_NFEV] = nfev
 
 
-@njit(**INLINE)
-def _integrate(method, P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend, stats, work):
-    """The loop of :func:`run` with the Runge-Kutta pair ``method`` (a constant);
-    integrates ``y`` and ``cs`` in place. Its steps: see the module docstring."""
+@njit(**FAST)
+def _integrate(P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend, stats, work):
+    """The loop of :func:`run`, with the Runge-Kutta pair ``O_METHOD`` (read at run
+    time); integrates ``y`` and ``cs`` in place. Its steps: see the module docstring."""
+    method = int(O[O_METHOD])
     ws, aux, K, R, st, ytmp, ynew, yev, ctl, tsw, active, g_old, g_new, trig_ev = work
     trig = ws[5]  # sines and cosines of the last right-hand side's state
     rtol = O[O_RTOL]
@@ -551,20 +550,6 @@ def _integrate(method, P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend
     return status
 
 
-@njit(**FAST)
-def _integrate_dopri5(P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend, stats, work):
-    """:func:`_integrate` with Dormand-Prince 5(4)."""
-    return _integrate(M_DOPRI5, P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend,
-                      stats, work)
-
-
-@njit(**FAST)
-def _integrate_dop853(P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend, stats, work):
-    """:func:`_integrate` with Dormand-Prince 8(5,3)."""
-    return _integrate(M_DOP853, P, O, t0, y, cs, n_strides, rec, ev, strides, yend, csend,
-                      stats, work)
-
-
 # numba does not notice when a kernel called from another file changes; drop
 # cached kernels compiled against other sources (see tslip._kernel_cache).
-_check_cache(_integrate_dopri5, __file__)
+_check_cache(_integrate, __file__)

@@ -75,19 +75,16 @@ def _recorded() -> None:
     pitch_rate_variants(_table61_gait())  # disturbances in flight: batches of runs
 
 
-def _biped(method: str) -> Callable[[], None]:
-    def run() -> None:
-        from ..biped import BipedParams, BipedState, simulate
-        from ..biped.simulate import BipedOptions
+def _biped() -> None:
+    """A biped stride (one loop serves both Runge-Kutta pairs) and what Appendix E
+    calls from Python besides a run."""
+    from ..biped import BipedParams, BipedState, simulate
+    from ..biped.dynamics import controller_references, momentum
 
-        params, state = BipedParams(), BipedState.thesis()
-        simulate(params, state, 1, options=BipedOptions(method=method))
-        if method == "dopri5":  # once: what Appendix E calls from Python besides a run
-            from ..biped.dynamics import controller_references, momentum
-
-            momentum(params, state)
-            controller_references(params, 0.5)
-    return run
+    params, state = BipedParams(), BipedState.thesis()
+    simulate(params, state, 1)
+    momentum(params, state)
+    controller_references(params, 0.5)
 
 
 def cache_dirs(packages: tuple[str, ...] = ("simulation", "biped")) -> dict[str, Path]:
@@ -105,7 +102,7 @@ def cache_dirs(packages: tuple[str, ...] = ("simulation", "biped")) -> dict[str,
     if "biped" in packages:
         from ..biped import _stride as biped_stride
 
-        dirs["biped"] = Path(biped_stride._integrate_dopri5._cache.cache_path)
+        dirs["biped"] = Path(biped_stride._integrate._cache.cache_path)
     return dirs
 
 
@@ -127,8 +124,7 @@ def _missing(packages: tuple[str, ...]) -> tuple[dict[str, Path], str, list[str]
 WORKLOADS: dict[str, Callable[[], None]] = {
     "TSLIP gait search and analyses": _study_point,
     "TSLIP recorded runs": _recorded,
-    "biped (dopri5)": _biped("dopri5"),
-    "biped (dop853)": _biped("dop853"),
+    "biped": _biped,
 }
 
 
