@@ -23,9 +23,12 @@ spatial_app = typer.Typer(help="3-D spring-mass runner (Seipel & Holmes 2005): s
 def _params(preset_name: str, sets: list[str] | None) -> Any:
     import dataclasses
 
-    from ..spatial import preset
+    from ..spatial import TrunkParams, preset
 
     p = preset(preset_name)
+    if isinstance(p, TrunkParams):
+        raise ValueError(f"--preset must be slip3d or slip3d-feedback here, got "
+                         f"{preset_name!r} (the 3-D TSLIP: tslip spatial lateral)")
     changes: dict[str, Any] = {}
     names = {f.name for f in dataclasses.fields(p)}
     for item in sets or []:
