@@ -41,10 +41,12 @@ import math
 import sys
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .._io import atomic_write
 from ..simulation.options import IntegratorOptions
 from .parameters import TABLE21_3D_SPLAY
 from .trunk_parameters import TrunkParams
@@ -54,7 +56,7 @@ __all__ = ["LateralPoint", "table21_gait", "lateral_multipliers", "lateral_point
            "splay_table", "r_table", "gain_table", "markdown", "main", "OPTIONS",
            "SPLAY_STEP", "R_STEP", "GAIN_STEP", "N_TRIVIAL", "TABLE21_SECTION", "TABLE21_VX",
            "TABLE21_ALPHA_R", "table21_params", "gain_matrix", "SPLAYS", "RS", "K_SPLAYS",
-           "K_TRAILS"]
+           "K_TRAILS", "tables"]
 
 #: Integrator tolerances of every gait and Jacobian here.
 OPTIONS = IntegratorOptions(rtol=1e-12, atol=1e-12)
@@ -268,26 +270,39 @@ def gain_matrix(points: Sequence[LateralPoint]) -> str:
     return "\n".join(lines)
 
 
+def tables(small: bool = False, options: IntegratorOptions | None = None) -> str:
+    """The docs page's tables as markdown (``small``: one point of each, a smoke run)."""
+    parts = []
+    splays, rs = (SPLAYS[1:2], RS[2:3]) if small else (SPLAYS, RS)
+    parts.append("### Splay (r 0.3, no coupling)\n\n"
+                 + markdown(splay_table(splays, options=options)))
+    parts.append("### Mass offset r (splay 0.05, no coupling)\n\n"
+                 + markdown(r_table(rs, options=options)))
+    ks, kt = ((1.0,), (1.0,)) if small else (K_SPLAYS, K_TRAILS)
+    for splay in ((TABLE21_3D_SPLAY,) if small else (TABLE21_3D_SPLAY, 0.15)):
+        pts = gain_table(ks, kt, splay=splay, options=options)
+        parts.append(f"### Roll couplings (r 0.3, splay {splay:g}): largest non-trivial "
+                     f"|multiplier| (c: a complex pair)\n\n" + gain_matrix(pts))
+        if pts:
+            best = min(pts, key=lambda p: p.largest)
+            parts.append(f"Best: k_splay {best.params.k_splay:g}, k_trail "
+                         f"{best.params.k_trail:g}: {best.largest:.4f} ({best.kind}); stable "
+                         f"points: {sum(p.stable for p in pts)} of {len(pts)}")
+    return "\n\n".join(parts) + "\n"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m tslip.spatial.lateral [--small]``: print the tables as markdown."""
+    """``python -m tslip.spatial.lateral [--small] [--out FILE]``: the tables as markdown."""
     ap = argparse.ArgumentParser(prog="python -m tslip.spatial.lateral",
                                  description="Lateral multipliers of the 3-D Table 2.1 TSLIP.")
     ap.add_argument("--small", action="store_true", help="one point of each table")
+    ap.add_argument("--out", help="write the Markdown there (else print it)")
     a = ap.parse_args(argv)
-    out = sys.stdout
-    splays, rs = (SPLAYS[1:2], RS[2:3]) if a.small else (SPLAYS, RS)
-    out.write("### Splay (r 0.3, no coupling)\n\n" + markdown(splay_table(splays)) + "\n\n")
-    out.write("### Mass offset r (splay 0.05, no coupling)\n\n" + markdown(r_table(rs))
-              + "\n\n")
-    ks, kt = ((1.0,), (1.0,)) if a.small else (K_SPLAYS, K_TRAILS)
-    for splay in ((TABLE21_3D_SPLAY,) if a.small else (TABLE21_3D_SPLAY, 0.15)):
-        pts = gain_table(ks, kt, splay=splay)
-        out.write(f"### Roll couplings (r 0.3, splay {splay:g}): largest non-trivial "
-                  f"|multiplier| (c: a complex pair)\n\n" + gain_matrix(pts) + "\n\n")
-        best = min(pts, key=lambda p: p.largest)
-        out.write(f"Best: k_splay {best.params.k_splay:g}, k_trail {best.params.k_trail:g}: "
-                  f"{best.largest:.4f} ({best.kind}); stable points: "
-                  f"{sum(p.stable for p in pts)} of {len(pts)}\n\n")
+    text = tables(a.small)
+    if a.out:  # replaced atomically: a link at that name is replaced, never written through
+        atomic_write(a.out, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+    else:
+        sys.stdout.write(text)
     return 0
 
 
