@@ -132,7 +132,7 @@ class LateralPoint:
         return self.largest < 1.0
 
     def row(self) -> dict[str, float | str]:
-        """The table row: parameters varied here, the largest |multiplier| and its kind."""
+        """The table row: parameters varied here, the largest ``|multiplier|`` and its kind."""
         p = self.params
         return {"r": p.r, "splay": p.splay, "k_splay": p.k_splay, "k_trail": p.k_trail,
                 "largest": self.largest, "kind": self.kind,
@@ -253,7 +253,7 @@ def markdown(points: Sequence[LateralPoint]) -> str:
 
 
 def gain_matrix(points: Sequence[LateralPoint]) -> str:
-    """The largest non-trivial |multiplier| of :func:`gain_table` as a k_splay x k_trail
+    """The largest non-trivial ``|multiplier|`` of :func:`gain_table` as a k_splay x k_trail
     markdown matrix (``-`` where no gait was reached)."""
     ks = sorted({p.params.k_splay for p in points})
     kt = sorted({p.params.k_trail for p in points})
