@@ -40,3 +40,26 @@ def test_bad_input_is_one_line_with_exit_2(tmp_path):
         assert r.exit_code == 2, (args, r.output)
         lines = [ln for ln in r.output.splitlines() if ln.strip()]
         assert len(lines) == 1 and lines[0].startswith("error: ") and field in lines[0], r.output
+
+
+def test_spatial_lateral_one_gait_and_small_tables(tmp_path):
+    r = runner.invoke(app, ["spatial", "lateral", "--k-trail", "2"])
+    assert r.exit_code == 0, r.output
+    row = [ln for ln in r.output.splitlines() if ln.startswith("| 0.3 |")][0]
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[:4] == ["0.3", "0.05", "0", "2"] and cells[6] == "no"
+    assert 1.0 < float(cells[4]) < 1.2  # the trail pulls the 1.75 of the uncoupled gait down
+    out = tmp_path / "l.md"
+    r = runner.invoke(app, ["spatial", "lateral", "--small", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    text = out.read_text()
+    assert "### Mass offset r" in text and "| 0.3 | 0.05 | 0 | 0 | 1.7" in text
+
+
+def test_spatial_lateral_bad_input_is_one_line_with_exit_2(tmp_path):
+    for args, field in ((["--splay", "2"], "TrunkParams.splay"),
+                        (["--splay", "0"], "splay must be in"),
+                        (["--out", str(tmp_path / "l.txt")], "--out")):
+        r = runner.invoke(app, ["spatial", "lateral", *args])
+        assert r.exit_code == 2, (args, r.output)
+        assert field in r.output and len(r.output.strip().splitlines()) == 1, r.output

@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 EXAMPLES = sorted((ROOT / "examples").glob("plot_*.py"))
 ANALYSES = ("gait", "stability", "slip", "robustness", "impulse", "stride", "studies", "experiment",
-            "biped", "spatial")
+            "biped", "spatial", "spatial_tslip")
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,5 @@
-"""``tslip spatial ...``: the 3-D spring-mass runner of Seipel & Holmes (issue 43, Part 1).
+"""``tslip spatial ...``: the 3-D spring-mass runner of Seipel & Holmes (issue 43, Part 1)
+and the 3-D TSLIP's lateral multipliers (Part 2: ``tslip spatial lateral``).
 
 :data:`spatial_app` is added to the app as the ``spatial`` command group by
 :mod:`tslip.cli.main`. Each command imports the model when it runs (a fast ``--help``).
@@ -16,16 +17,20 @@ from ._common import Failed, errors, make_console
 
 __all__ = ["spatial_app"]
 
-spatial_app = typer.Typer(help="3-D spring-mass runner (Seipel & Holmes 2005): symmetric "
-                               "gaits, multipliers, the paper's claims.", no_args_is_help=True)
+spatial_app = typer.Typer(help="3-D running: the spring-mass runner of Seipel & Holmes 2005 "
+                               "(symmetric gaits, multipliers, the paper's claims) and the "
+                               "TSLIP's lateral multipliers.", no_args_is_help=True)
 
 
 def _params(preset_name: str, sets: list[str] | None) -> Any:
     import dataclasses
 
-    from ..spatial import preset
+    from ..spatial import TrunkParams, preset
 
     p = preset(preset_name)
+    if isinstance(p, TrunkParams):
+        raise ValueError(f"--preset must be slip3d or slip3d-feedback here, got "
+                         f"{preset_name!r} (the 3-D TSLIP: tslip spatial lateral)")
     changes: dict[str, Any] = {}
     names = {f.name for f in dataclasses.fields(p)}
     for item in sets or []:
@@ -80,3 +85,39 @@ def claims_cmd(
 
         claims_main((["--out", str(out)] if out is not None else []) + (["--small"] if small
                                                                           else []))
+
+
+@spatial_app.command("lateral")
+def lateral_cmd(
+    out: Annotated[Path | None, typer.Option("--out", help="Markdown file (.md).")] = None,
+    small: Annotated[bool, typer.Option(
+        "--small", help="One point of each table (seconds instead of a minute).")] = False,
+    r: Annotated[float | None, typer.Option(
+        "--r", help="One gait only: mass offset r [L] (default 0.3).")] = None,
+    splay: Annotated[float | None, typer.Option(
+        "--splay", help="One gait only: splay [rad] (default 0.05).")] = None,
+    k_splay: Annotated[float | None, typer.Option(
+        "--k-splay", help="One gait only: splay per roll angle (default 0).")] = None,
+    k_trail: Annotated[float | None, typer.Option(
+        "--k-trail", help="One gait only: placement yaw per roll angle (default 0).")] = None,
+) -> None:
+    """Lateral multipliers of the 3-D Table 2.1 TSLIP (docs/analyses/spatial_tslip.md): the
+    tables over splay, r and the roll couplings, or one gait (--r, --splay, --k-splay,
+    --k-trail)."""
+    with errors():
+        if out is not None:
+            check_output(out, "--out", (".md",))
+        one = {key: v for key, v in (("r", r), ("splay", splay), ("k_splay", k_splay),
+                                     ("k_trail", k_trail)) if v is not None}
+        from ..spatial import lateral
+
+        if not one:
+            lateral.main((["--out", str(out)] if out is not None else [])
+                         + (["--small"] if small else []))
+            return
+        p = lateral.table21_params(**one)  # refuses a bad field in one line
+        text = lateral.markdown([lateral.lateral_point(p)]) + "\n"
+        if out is not None:
+            lateral.atomic_write(out, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+        else:
+            make_console().print(text, markup=False)

@@ -1,15 +1,29 @@
-"""The 3-D spring-mass runner (3D-SLIP) of Seipel & Holmes (2005): issue 43, Part 1.
+"""Running in three dimensions (issue 43).
 
-* :mod:`.parameters`: :class:`SpatialParams` (spring, leg angles, feedback, heading rule);
+Part 1, the 3-D spring-mass runner (3D-SLIP) of Seipel & Holmes (2005):
+
+* :mod:`.parameters`: :class:`SpatialParams` (spring, leg angles, feedback, heading rule)
+  and the presets of both parts (:func:`preset`);
 * :mod:`.stride`: the apex-to-apex step, its statuses and its exact Jacobian;
 * :mod:`.gait`: left-right symmetric gaits and the Floquet multipliers of the two-step map;
 * :mod:`._kernels`: the compiled stance loop on the project's Runge-Kutta core.
+
+Part 2, the TSLIP in three dimensions (docs/analyses/spatial_tslip.md):
+
+* :mod:`.trunk_parameters`: :class:`TrunkParams` (Table 2.1 with ``J_roll``, ``J_yaw``,
+  ``splay`` and the roll couplings ``k_splay``, ``k_trail``);
+* :mod:`.trunk`: the stride touch-down -> touch-down (:func:`trunk_step`), its statuses
+  (:class:`TrunkStatus`, the crossed leg among the falls) and the planar-limit maps;
+* :mod:`.trunk_section`: the 10-D touch-down section (:data:`TRUNK_SECTION_NAMES`), its
+  mirror, left-right symmetric gaits (:func:`symmetric_gait`) and the two-step map and
+  its Jacobian by central differences;
+* :mod:`._trunk_kernels`: the compiled stance and flight loop on the same core.
 """
 
 from __future__ import annotations
 
 from .gait import Multipliers, SymmetricGait, floquet, symmetric_gaits
-from .parameters import HEADINGS, SpatialParams, preset, presets
+from .parameters import HEADINGS, SpatialParams, preset, preset_description, presets
 from .stride import (
     SECTION_NAMES,
     SpatialApex,
@@ -22,8 +36,27 @@ from .stride import (
     section_map,
     step_jacobian,
 )
+from .trunk import TrunkStatus, TrunkStep, TrunkTouchdown, trunk_energy, trunk_step
+from .trunk_parameters import TrunkParams
+from .trunk_section import MIRROR as TRUNK_MIRROR
+from .trunk_section import SECTION_NAMES as TRUNK_SECTION_NAMES
+from .trunk_section import (
+    from_section,
+    mirror_section,
+    one_step_map,
+    section,
+    symmetric_gait,
+    two_step_jacobian,
+    two_step_map,
+    yaw_rotated,
+)
 
-__all__ = ["HEADINGS", "SpatialParams", "preset", "presets", "SECTION_NAMES", "SpatialApex",
-           "SpatialStatus", "SpatialStep", "apex_step", "apex_steps", "energy", "mirror",
-           "section_map", "step_jacobian", "Multipliers", "SymmetricGait", "floquet",
-           "symmetric_gaits"]
+__all__ = ["HEADINGS", "SpatialParams", "preset", "preset_description", "presets",
+           "SECTION_NAMES", "SpatialApex", "SpatialStatus", "SpatialStep", "apex_step",
+           "apex_steps", "energy", "mirror", "section_map", "step_jacobian", "Multipliers",
+           "SymmetricGait", "floquet", "symmetric_gaits",
+           # Part 2: the 3-D TSLIP
+           "TrunkParams", "TrunkStatus", "TrunkStep", "TrunkTouchdown", "trunk_energy",
+           "trunk_step", "TRUNK_MIRROR", "TRUNK_SECTION_NAMES", "from_section",
+           "mirror_section", "one_step_map", "section", "symmetric_gait", "two_step_jacobian",
+           "two_step_map", "yaw_rotated"]

@@ -31,14 +31,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Literal, get_args
+from typing import Any, Literal, get_args, overload
 
 import numpy as np
 
 from .._checks import check_fields
+from ..model.parameters import preset as _planar_preset
 from ._kernels import NP, P_G, P_K, P_L0, P_M
+from .trunk_parameters import TrunkParams
 
-__all__ = ["SpatialParams", "HEADINGS", "Heading", "preset", "presets"]
+__all__ = ["SpatialParams", "HEADINGS", "Heading", "TABLE21_3D_SPLAY", "preset",
+           "preset_description", "presets"]
 
 Heading = Literal["fixed", "velocity"]
 #: The allowed values of :attr:`SpatialParams.heading`.
@@ -106,20 +109,55 @@ _PRESETS: dict[str, tuple[str, dict[str, object]]] = {
 }
 
 
+#: The default splay [rad] of the 3-D Table 2.1 TSLIP: small, so that the foot lands
+#: outside the body's mid-plane (at splay 0 any roll crosses a leg) and the gait stays
+#: close to the planar one (docs/analyses/spatial_tslip.md).
+TABLE21_3D_SPLAY = 0.05
+
+#: The TSLIP presets (:class:`~tslip.spatial.trunk_parameters.TrunkParams`): description.
+_TRUNK_PRESETS: dict[str, str] = {
+    "table2.1-3d": (f"the TSLIP of thesis Table 2.1 in 3-D: the planar table2.1 preset with "
+                    f"J_roll = J_yaw = J and splay {TABLE21_3D_SPLAY} rad, no roll coupling"),
+}
+
+
 def presets() -> list[str]:
     """Names accepted by :func:`preset`."""
-    return list(_PRESETS)
+    return [*_PRESETS, *_TRUNK_PRESETS]
 
 
-def preset(name: str) -> SpatialParams:
-    """Named 3-D parameter set (``slip3d``, ``slip3d-feedback``).
+def preset_description(name: str) -> str:
+    """One-line description of a preset."""
+    key = _key(name)
+    return _PRESETS[key][0] if key in _PRESETS else _TRUNK_PRESETS[key]
+
+
+def _key(name: Any) -> str:
+    key = name.strip().lower() if isinstance(name, str) else name
+    if key not in _PRESETS and key not in _TRUNK_PRESETS:
+        raise ValueError(f"preset must be one of {presets()}, got {name!r}")
+    return str(key)
+
+
+@overload
+def preset(name: Literal["table2.1-3d"]) -> TrunkParams: ...  # type: ignore[overload-overlap]
+@overload
+def preset(name: str) -> SpatialParams: ...
+
+
+def preset(name: str) -> SpatialParams | TrunkParams:
+    """Named 3-D parameter set: the 3-D spring-mass runner (``slip3d``,
+    ``slip3d-feedback``: :class:`SpatialParams`) and the 3-D TSLIP of Table 2.1
+    (``table2.1-3d``: :class:`~tslip.spatial.trunk_parameters.TrunkParams`, the planar
+    ``tslip.preset("table2.1")`` with ``J_roll = J_yaw = J`` and ``splay``
+    :data:`TABLE21_3D_SPLAY`).
 
     Raises
     ------
     ValueError
         If ``name`` is not one of :func:`presets`.
     """
-    key = name.strip().lower() if isinstance(name, str) else name
-    if key not in _PRESETS:
-        raise ValueError(f"preset must be one of {presets()}, got {name!r}")
+    key = _key(name)
+    if key in _TRUNK_PRESETS:
+        return TrunkParams.from_planar(_planar_preset("table2.1"), splay=TABLE21_3D_SPLAY)
     return SpatialParams(**_PRESETS[key][1])  # type: ignore[arg-type]
