@@ -207,7 +207,7 @@ def test_pure_python_kernel_agrees_with_the_compiled_one():
 def test_presets_and_a_bad_name():
     from tslip.spatial import preset, presets
 
-    assert presets() == ["slip3d", "slip3d-feedback"]
+    assert presets() == ["slip3d", "slip3d-feedback", "table2.1-3d"]
     p = preset("slip3d")
     assert (p.k, p.beta0, p.gamma0, p.k_lat, p.heading) == (25.0, 1.19, 0.05, 0.0, "fixed")
     assert preset("slip3d-feedback").k_lat == 1.5
