@@ -174,6 +174,7 @@ def test_the_scheduler_check_works_inside_a_running_event_loop():
     runs (a notebook, or a test that left one running) it still judges the address,
     instead of failing with asyncio's "cannot be called from a running event loop"."""
     import asyncio
+    import threading
 
     from tslip.sweeps._schedule import check_scheduler
 
@@ -182,5 +183,29 @@ def test_the_scheduler_check_works_inside_a_running_event_loop():
             check_scheduler("foo", 0.5)
         return str(err.value)
 
-    assert asyncio.run(main()).startswith(
+    said = []  # this test's loop runs in a thread of its own: the suite's main thread may
+    # hold a loop left running by an earlier test, where asyncio.run refuses to start one
+    thread = threading.Thread(target=lambda: said.append(asyncio.run(main())))
+    thread.start()
+    thread.join(30)
+    assert said and said[0].startswith(
         "--scheduler 'foo' is not a Dask scheduler's address (ValueError: missing port")
+
+
+def test_the_scheduler_check_works_in_a_thread_that_holds_a_running_loop():
+    """As the suite's main thread was left by an earlier test: a loop marked running here
+    (asyncio's own marker, restored after) does not stop the check judging the address."""
+    import asyncio
+
+    from tslip.sweeps._schedule import check_scheduler
+
+    previous = asyncio.events._get_running_loop()
+    loop = asyncio.new_event_loop()
+    asyncio.events._set_running_loop(loop)
+    try:
+        with pytest.raises(ValueError, match=r"^--scheduler 'foo' is not a Dask scheduler's "
+                                             r"address \(ValueError: missing port"):
+            check_scheduler("foo", 0.5)
+    finally:
+        asyncio.events._set_running_loop(previous)
+        loop.close()

@@ -13,6 +13,7 @@ from typing import Annotated, Any
 import typer
 
 from .._checks import check_output, parse_number
+from .._io import write_text
 from ._common import Failed, errors, make_console
 
 __all__ = ["spatial_app"]
@@ -118,6 +119,6 @@ def lateral_cmd(
         p = lateral.table21_params(**one)  # refuses a bad field in one line
         text = lateral.markdown([lateral.lateral_point(p)]) + "\n"
         if out is not None:
-            lateral.atomic_write(out, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+            write_text(out, text)  # atomically: a link at --out is replaced
         else:
             make_console().print(text, markup=False)
