@@ -471,6 +471,26 @@ def jumped_hump(g_start, g_end, g_probe):
     return g_end <= 0.0 and left_zero_upward(g_start, g_probe)
 
 
+@njit(**_INLINE)
+def all_finite(n, y):
+    """Whether the first ``n`` components of ``y`` are finite (an accepted step's end)."""
+    for i in range(n):
+        if not math.isfinite(y[i]):
+            return False
+    return True
+
+
+@njit(**_INLINE)
+def accept_step(method, n, y, ynew, K):
+    """Move a loop of ``n`` states on to its accepted step's end: ``y = ynew`` and the
+    step's last stage as the next step's first (FSAL). The TSLIP's stride has its own
+    twin with the event values (``_stride.advance``); the spatial loops call this."""
+    ns = n_stages(method)
+    for i in range(n):
+        y[i] = ynew[i]
+        K[0, i] = K[ns, i]
+
+
 # ---------------------------------------------------------------------------
 # The same routines inlined: the TSLIP's stride kernels call these twins, so a
 # stride compiles as one function (each separately compiled callee costs a

@@ -208,16 +208,11 @@ def stance(P, O, y0, out):  # noqa: E741
             out[OUT_T] = t + theta_ev * h
             status = ST_OK if which == EV_LIFTOFF else ST_FALL
             break
-        ok = True
-        for i in range(n):
-            ok = ok and math.isfinite(ynew[i])
-        if not ok:
+        if not _rk.all_finite(n, ynew):
             status = ST_ERR_NONFINITE
             break
         t += h
-        for i in range(n):
-            y[i] = ynew[i]
-            K[0, i] = K[ns, i]
+        _rk.accept_step(method, n, y, ynew, K)
         gv_old[0] = gv_new[0]
         gv_old[1] = gv_new[1]
         fac = _rk.step_factor(method, err, 10.0)

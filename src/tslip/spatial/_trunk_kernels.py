@@ -420,16 +420,11 @@ def run_phase(P, O, phase, y0, tmax, out, rec):
             else:
                 status = ST_OK
             break
-        ok = True
-        for i in range(n):
-            ok = ok and math.isfinite(ynew[i])
-        if not ok:
+        if not _rk.all_finite(n, ynew):
             status = ST_ERR_NONFINITE
             break
         t += h
-        for i in range(n):
-            y[i] = ynew[i]
-            K[0, i] = K[ns, i]
+        _rk.accept_step(method, n, y, ynew, K)
         if nrec < rec.shape[0]:
             rec[nrec, 0] = t
             for i in range(n):
