@@ -31,6 +31,11 @@ warm and checks that ``claims.json`` and every study's ``results.parquet``
 compile events in every process of the cold run (a ``sitecustomize`` on
 ``PYTHONPATH``) and prints the compile CPU seconds per process, per kernel
 family and per top-level kernel, and any signature compiled in two processes.
+``--against REV`` then does the same for a clone checked out at ``REV``, right
+after, and prints the ratios this checkout / REV of the cold run's wall, CPU
+and (with ``--compile-log``) compile CPU seconds: issue 41's compile target is
+``--first-run --compile-log --against 07e68e4`` (the revision before one
+compiled loop per model) at a ratio <= 0.75.
 
 ``--warm`` measures warm runs instead (issue 25: quick within 4 s, full within
 8 s, first line within 5 s): ``tslip reproduce --quick --workers 2`` of this
@@ -210,12 +215,13 @@ def _family_of(fn: str) -> str:
     return "TSLIP gait search and analyses"
 
 
-def compile_breakdown(log: Path) -> None:
-    """Print the compile CPU seconds of ``log`` per process, family and top-level kernel."""
+def compile_breakdown(log: Path) -> float:
+    """Print the compile CPU seconds of ``log`` per process, family and top-level kernel;
+    return their sum."""
     recs = [json.loads(line) for line in log.read_text().splitlines()]
     if not recs:
         print("no compiles recorded")
-        return
+        return 0.0
     per_proc: dict[tuple[int, str], float] = defaultdict(float)
     per_top: dict[tuple[str, str], float] = defaultdict(float)
     where: dict[tuple[str, str], set[int]] = defaultdict(set)
@@ -240,16 +246,26 @@ def compile_breakdown(log: Path) -> None:
             if f2 == f and c2 >= 0.2:
                 print(f"      {top:52s} {c2:6.2f} s (with its callees)")
     twice = {k: v for k, v in where.items() if len(v) > 1}
-    print(f"signatures compiled in two processes: {len(twice)}"
-          + "".join(f"\n  {fn} {args[:80]}" for fn, args in twice))
+    ours = [k for k in twice if k[0].startswith("tslip.")]
+    theirs = sum(r["cpu"] for r in recs if (r["fn"], r["args"]) in twice
+                 and not r["fn"].startswith("tslip."))
+    print(f"signatures compiled in two processes: {len(ours)} of tslip"
+          + "".join(f"\n  {fn} {args[:80]}" for fn, args in ours)
+          + f"; {len(twice) - len(ours)} of numba's own overloads (never cached: every "
+            f"process compiling anything compiles them), {theirs:.1f} s in all")
+    return sum(r["cpu"] for r in recs)
 
 
-def first_run(reuse_venv: str | None, compile_log: bool, keep: bool) -> None:
-    """Clone, install (or reuse a venv), then a cold and a warm ``tslip reproduce --quick``."""
+def first_run(reuse_venv: str | None, compile_log: bool, keep: bool,
+              rev: str | None = None) -> dict[str, float]:
+    """Clone (at ``rev``: default HEAD), install (or reuse a venv), then a cold and a warm
+    ``tslip reproduce --quick``; returns the cold run's wall, CPU and compile CPU seconds."""
     _subreaper()
     tmp = Path(tempfile.mkdtemp(prefix="tslip-first-run-"))
     clone = tmp / "clone"
     subprocess.run(["git", "clone", "-q", str(ROOT), str(clone)], check=True)
+    if rev is not None:
+        subprocess.run(["git", "-C", str(clone), "checkout", "-q", rev], check=True)
     env = {k: v for k, v in os.environ.items()
            if k not in ("NUMBA_CACHE_DIR", "PYTHONPATH", "VIRTUAL_ENV")}
     env["XDG_CACHE_HOME"] = str(tmp / "user-cache")  # numba's fallback cache folder: empty
@@ -281,7 +297,7 @@ def first_run(reuse_venv: str | None, compile_log: bool, keep: bool) -> None:
             [str(site), *([env["PYTHONPATH"]] if "PYTHONPATH" in env else [])])
         run_env["TSLIP_BENCH_COMPILE_LOG"] = str(tmp / "compiles.jsonl")
     cmd = [python, "-m", "tslip", "reproduce", "--quick", "--out"]
-    print(f"clone {clone}; package {pkg}; install: "
+    print(f"clone {clone} at {rev or 'HEAD'}; package {pkg}; install: "
           f"{'reused ' + str(venv) if reuse_venv else readme_install()}", flush=True)
     cold = timed_run([*cmd, "report-cold"], run_env, clone, tmp / "cold.log")
     warm = timed_run([*cmd, "report-warm"], env, clone, tmp / "warm.log")
@@ -295,14 +311,14 @@ def first_run(reuse_venv: str | None, compile_log: bool, keep: bool) -> None:
           f"{not re.search('compil', (tmp / 'warm.log').read_text())}")
     diffs = same_results(clone / "report-cold", clone / "report-warm")
     print("results identical to the warm run's" if not diffs else f"results DIFFER: {diffs}")
-    if compile_log:
-        compile_breakdown(tmp / "compiles.jsonl")
+    compiled = compile_breakdown(tmp / "compiles.jsonl") if compile_log else float("nan")
     if keep:
         print(f"kept {tmp}")
     else:
         import shutil
 
         shutil.rmtree(tmp, ignore_errors=True)
+    return {"wall": cold["wall"], "cpu": cold["cpu"], "compile": compiled}
 
 
 def warm_runs(rounds: int, full: bool, rev: str, baseline_src: str | None,
@@ -369,6 +385,9 @@ def main() -> None:
     ap.add_argument("--compile-log", action="store_true",
                     help="with --first-run: numba's compile events of every process")
     ap.add_argument("--keep", action="store_true", help="with --first-run: keep the folder")
+    ap.add_argument("--against", metavar="REV",
+                    help="with --first-run: then the same at REV, and the ratios (issue 41: "
+                         "07e68e4, the revision before one loop per model)")
     ap.add_argument("--warm", action="store_true",
                     help="warm `tslip reproduce` runs against a baseline instead")
     ap.add_argument("--rounds", type=int, default=3, help="with --warm: interleaved rounds")
@@ -379,7 +398,12 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2, help="with --warm: worker processes")
     args = ap.parse_args()
     if args.first_run:
-        first_run(args.reuse_venv, args.compile_log, args.keep)
+        new = first_run(args.reuse_venv, args.compile_log, args.keep)
+        if args.against:
+            old = first_run(args.reuse_venv, args.compile_log, args.keep, args.against)
+            for k in ("wall", "cpu", "compile"):
+                print(f"first run {k:8s}: {new[k]:6.1f} s, at {args.against} {old[k]:6.1f} s, "
+                      f"ratio {new[k] / old[k]:.2f}")
         return
     if args.warm:
         warm_runs(args.rounds, args.full, args.warm_rev, args.baseline_src, args.workers)

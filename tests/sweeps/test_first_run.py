@@ -77,17 +77,26 @@ _RUN = textwrap.dedent("""
 
     if __name__ == "__main__":
         tasks = [Task(("a",), gait, ("table2.1",)), Task(("b",), gait, ("table6.1",))]
-        run_tasks(tasks, lambda task, result: [], workers=2, preload=sys.argv[1:])
+        if sys.argv[1] == "split":  # as tslip reproduce: the recorded runs compile here
+            from tslip.sweeps._warmup import warm_in_background
+            warm = warm_in_background(("TSLIP recorded runs",))
+        run_tasks(tasks, lambda task, result: [], workers=2, preload=sys.argv[2:])
+        if sys.argv[1] == "split":
+            warm.join()
+            print("MAIN", __import__("os").getpid())
 """)
 
 
 @pytest.mark.slow
 def test_no_kernel_is_compiled_in_two_processes(tmp_path):
     """Two gait searches at once on 2 workers from an empty cache, as a study's pool runs
-    them: every kernel signature compiles in one process (here, the fork server).
+    them, while this process warms the recorded runs (as ``tslip reproduce`` does): every
+    kernel signature compiles in one process (the gait search's in the fork server, the
+    recorded runs' here, after the gait search's are cached).
 
     Without ``tslip.sweeps._prewarm`` in the preload, both workers compile the
-    stride kernels at the same moment (the break check of this test).
+    stride kernels at the same moment; without the wait for the gait search
+    (``_warmup.NEEDS``), this process compiles them too (the break checks).
     """
     site = tmp_path / "site"
     site.mkdir()
@@ -98,14 +107,21 @@ def test_no_kernel_is_compiled_in_two_processes(tmp_path):
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
            "TSLIP_TEST_COMPILE_LOG": str(log),
            "PYTHONPATH": os.pathsep.join([str(site), src])}
-    subprocess.run([sys.executable, str(tmp_path / "run.py"), "tslip.sweeps._prewarm"],
-                   env=env, check=True, timeout=1800, cwd=tmp_path, capture_output=True)
+    out = subprocess.run([sys.executable, str(tmp_path / "run.py"), "split",
+                          "tslip.sweeps._prewarm"], env=env, check=True, timeout=1800,
+                         cwd=tmp_path, capture_output=True, text=True).stdout
+    main = out.split("MAIN ")[1].strip()
     where: dict[tuple[str, str], set[str]] = {}
     for line in log.read_text().splitlines():
         pid, fn, args = line.split("\t")
         where.setdefault((fn, args), set()).add(pid)
-    assert any(fn == "tslip.simulation._stride.stride" for fn, _ in where)  # it did compile
-    twice = {k: v for k, v in where.items() if len(v) > 1}
+    by_fn = {fn: pids for (fn, _), pids in where.items()}
+    # the compiling was split: the gait search in the fork server, the recorded runs here
+    assert by_fn["tslip.simulation._stride.stride"] - {main}
+    assert by_fn["tslip.simulation._record.record_run"] == {main}
+    # numba's own overloads (np.empty, int, ...) compile in every process that compiles
+    # anything and are never cached: only the package's kernels count
+    twice = {k: v for k, v in where.items() if len(v) > 1 and k[0].startswith("tslip.")}
     assert not twice, twice
 
 
@@ -131,9 +147,11 @@ def test_study_and_reproduce_pools_warm_their_kernels_before_forking(monkeypatch
         run.run_study(catalogue.study("leg_damping", "tiny"), workers=2)
     assert seen["study"] == ["tslip.sweeps._prewarm"]
     monkeypatch.setattr(_pool, "prestart", prestart)
+    monkeypatch.setattr(reproduce, "warm_in_background", lambda: seen.setdefault("main", seen))
     with pytest.raises(Stop):
         reproduce.run_catalogue(tmp_path, "tiny", workers=2)
     assert seen["reproduce"][-1] == "tslip.sweeps._prewarm"
+    assert "main" in seen  # its own families claimed before the fork server starts
 
 
 _BIPED_WARM = textwrap.dedent("""
@@ -177,3 +195,67 @@ def test_the_biped_warm_up_compiles_what_appendix_e_calls_from_python(tmp_path):
     got = json.loads(out.splitlines()[-1])
     assert "biped" not in got["missing"]
     assert got["compiled"] == []
+
+
+@pytest.fixture
+def claims(monkeypatch, tmp_path):
+    """Claims as lock files in ``tmp_path``, and a fake family whose workload is logged."""
+    from tslip.sweeps import _warmup
+
+    monkeypatch.setattr(_warmup, "_claim_path", lambda name: tmp_path / f"{name}.lock")
+    state = {"missing": True, "runs": []}
+    monkeypatch.setitem(_warmup.WORKLOADS, "fake", lambda: state["runs"].append(1))
+    monkeypatch.setattr(_warmup, "_is_missing", lambda name: state["missing"])
+    return _warmup, state
+
+
+def test_a_claim_held_elsewhere_is_seen_and_waited_for(claims):
+    import threading
+
+    warmup, state = claims
+    held, release, order = threading.Event(), threading.Event(), []
+
+    def holder():
+        with warmup.claim("fake") as ok:
+            assert ok
+            held.set()
+            release.wait(10)
+            order.append("holder done")
+            state["missing"] = False  # the holder cached it
+
+    t = threading.Thread(target=holder)
+    t.start()
+    held.wait(10)
+    with warmup.claim("fake", wait=False) as ok:  # a second open file: the lock is busy
+        assert not ok
+    assert warmup.warm(["fake"], wait=False) == ["fake"] and state["runs"] == []
+    threading.Timer(0.3, release.set).start()
+    warmup.ensure(("fake",))  # waits for the holder, then finds it cached: runs nothing
+    order.append("ensure done")
+    t.join()
+    assert order == ["holder done", "ensure done"] and state["runs"] == []
+    with warmup.claim("fake", wait=False) as ok:  # released
+        assert ok
+
+
+def test_ensure_warms_a_family_nobody_warms_once(claims):
+    warmup, state = claims
+
+    def workload():
+        state["runs"].append(1)
+        state["missing"] = False
+
+    warmup.WORKLOADS["fake"] = workload
+    warmup.ensure(("fake",))
+    warmup.ensure(("fake",))
+    assert state["runs"] == [1]
+
+
+def test_a_link_at_the_claim_file_is_not_followed(claims, tmp_path):
+    warmup, _ = claims
+    target = tmp_path / "elsewhere" / "created.txt"  # a link may point anywhere
+    target.parent.mkdir()
+    (tmp_path / "fake.lock").symlink_to(target)
+    with warmup.claim("fake") as ok:
+        assert ok  # unclaimed, as when the folder cannot be written
+    assert not target.exists()

@@ -10,6 +10,12 @@ minute compiling. Two things make that bearable:
   (it imports :mod:`._prewarm`, which calls it): each kernel is then
   compiled in one process only, and every worker starts with all kernels in
   memory.
+* :func:`warm` holds a claim on each family while it runs the family's
+  workload (an exclusive lock on a file beside numba's cache,
+  :func:`claim`), so that two processes warming at once (``tslip
+  reproduce``'s own process and its fork server: :func:`warm_in_background`)
+  never compile the same family: the second waits for the first and then
+  loads the kernels from the cache.
 * :func:`announce`, in the process the user watches, names the families
   that are not cached yet (from the cache folders alone:
   :func:`tslip._kernel_cache.missing_families`) and reports each as its
@@ -19,10 +25,11 @@ minute compiling. Two things make that bearable:
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -31,7 +38,9 @@ from .. import _kernel_cache
 if TYPE_CHECKING:
     from rich.console import Console
 
-__all__ = ["WORKLOADS", "announce", "warm", "warm_in_background", "warm_missing"]
+__all__ = ["MAIN_PROCESS_FAMILIES", "WORKLOADS", "announce", "claim", "ensure", "warm",
+           "warm_in_background",
+           "warm_missing"]
 
 #: Seconds between two looks at the cache folders while compiling.
 POLL_SECONDS = 0.5
@@ -128,40 +137,162 @@ WORKLOADS: dict[str, Callable[[], None]] = {
 }
 
 
-def warm(families: list[str]) -> None:
+#: The families ``tslip reproduce``'s own process warms (:func:`warm_in_background`), in
+#: this order, while its fork server warms the others (the TSLIP's gait search): the
+#: fork server forks the workers once its own families are warm, and the tasks that need
+#: these wait for them (:func:`ensure`). The recorded runs' workload finds gaits, so it
+#: waits for the gait search's kernels to be cached first and loads them: compiled
+#: alone from an empty cache, it compiles 34 of the 35 signatures the gait search's
+#: workload compiles (numba's compile events, 2026-12-06).
+MAIN_PROCESS_FAMILIES: tuple[str, ...] = ("biped", "TSLIP recorded runs")
+#: What a family's workload needs cached before it starts without compiling another
+#: family's kernels (see :data:`MAIN_PROCESS_FAMILIES`).
+NEEDS: dict[str, tuple[str, ...]] = {"TSLIP recorded runs": ("TSLIP gait search and analyses",)}
+#: Seconds :func:`warm_in_background` waits at most for a family it needs, and at least
+#: (the fork server may not have claimed it yet) before it stops waiting for one nobody warms.
+NEEDS_TIMEOUT = 600.0
+NEEDS_GRACE = 30.0
+
+
+def _claim_path(name: str) -> Path | None:
+    """The lock file of family ``name``: beside its kernels' numba cache (None: unknown)."""
+    package = _kernel_cache.FAMILIES[name][0]
+    try:
+        folder = cache_dirs((package,))[package]
+    except (OSError, AttributeError, ImportError):
+        return None
+    slug = "".join(c if c.isalnum() else "-" for c in name.lower())
+    return folder / f"tslip-warming-{slug}.lock"
+
+
+@contextmanager
+def claim(name: str, wait: bool = True) -> Iterator[bool]:
+    """Hold family ``name``'s claim while the body runs; yields whether it is held.
+
+    An exclusive ``flock`` on :func:`_claim_path`. With ``wait`` it blocks while
+    another process holds the claim; without, it yields False at once if so.
+    The file is opened without following a link: a link there (not ours), or a
+    folder that cannot be written, runs the body unclaimed (yields True, as
+    before claims existed). The lock ends with its process, so a killed holder
+    never blocks a later run.
+    """
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: unclaimed
+        yield True
+        return
+    path = _claim_path(name)
+    fd = -1
+    held = True
+    if path is not None:
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+            fcntl.flock(fd, fcntl.LOCK_EX | (0 if wait else fcntl.LOCK_NB))
+        except BlockingIOError:
+            held = False
+        except OSError:
+            pass
+    try:
+        yield held
+    finally:
+        if fd >= 0:
+            os.close(fd)  # releases the lock, if held
+
+
+def _is_missing(name: str) -> bool:
+    return name in _missing((_kernel_cache.FAMILIES[name][0],))[2]
+
+
+def warm(families: list[str], wait: bool = True) -> list[str]:
     """Compile or load the kernels of ``families`` by running each one's workload.
 
-    Never raises: a family that fails here is compiled where it is first used.
-    Starts no threads (no workload runs a parallel kernel): it runs in the
-    fork server.
+    Each workload runs under its family's :func:`claim`. With ``wait``, a
+    family another process is warming is waited for and then loaded from the
+    cache; without, it is left to that process (and to :func:`ensure` in the
+    tasks that need it). Returns the families left so. Never raises: a family
+    that fails here is compiled where it is first used. Starts no threads (no
+    workload runs a parallel kernel): it runs in the fork server.
     """
+    left = []
     for name in families:
-        try:
-            WORKLOADS[name]()
-        except Exception:  # noqa: BLE001, S110 - the task that needs it will say why
-            pass
+        with claim(name, wait) as held:
+            if held:
+                _run_workload(name)
+            else:
+                left.append(name)
+    return left
 
 
 def warm_missing(packages: tuple[str, ...] = ("simulation", "biped")) -> list[str]:
-    """:func:`warm` the families of ``packages`` not in numba's cache yet; those families."""
+    """Warm the families of ``packages`` not in numba's cache yet, but those another
+    process is warming (:func:`warm` without waiting); returns the missing families."""
     missing = _missing(packages)[2]
-    warm(missing)
+    warm(missing, wait=False)
     return missing
 
 
-def warm_in_background(packages: tuple[str, ...]) -> threading.Thread:
-    """:func:`warm_missing` of ``packages`` in a daemon thread of this process.
+def _run_workload(name: str) -> None:
+    try:
+        WORKLOADS[name]()
+    except Exception:  # noqa: BLE001, S110 - the task that needs it will say why
+        pass
 
-    ``tslip reproduce`` compiles the biped's families here while the fork
-    server compiles the TSLIP's (first in :data:`tslip._kernel_cache.FAMILIES`):
-    the two share no cached kernel, so the fork server then loads the biped's
-    from disk instead of compiling them after the TSLIP's, on the second core.
+
+def ensure(families: tuple[str, ...]) -> None:
+    """Before a task that needs ``families``: wait for any another process is warming;
+    warm here, under the claim, any still missing. Costs a look at the cache when warm."""
+    for name in families:
+        if _is_missing(name):
+            with claim(name):  # a second claim in this process would wait for this one
+                if _is_missing(name):
+                    _run_workload(name)
+
+
+def _held_elsewhere(name: str) -> bool:
+    with claim(name, wait=False) as held:
+        return not held
+
+
+def _wait_for(names: tuple[str, ...]) -> None:
+    """Wait while a family of ``names`` is missing and another process warms it (or may
+    be about to: :data:`NEEDS_GRACE` seconds), for at most :data:`NEEDS_TIMEOUT`."""
+    t0 = time.monotonic()
+    for name in names:
+        while _is_missing(name):
+            waited = time.monotonic() - t0
+            if waited > NEEDS_TIMEOUT or (waited > NEEDS_GRACE and not _held_elsewhere(name)):
+                return
+            time.sleep(POLL_SECONDS)
+
+
+def warm_in_background(families: tuple[str, ...] = MAIN_PROCESS_FAMILIES) -> threading.Thread:
+    """Warm the missing ones of ``families``, in order, in a daemon thread of this process.
+
+    ``tslip reproduce`` calls it right after starting its fork server, which
+    warms the gait search meanwhile (:mod:`._prewarm`, :func:`warm_missing`):
+    the compiling is split over the two processes. Every claim of
+    ``families`` is taken at once, so the fork server finds them held and
+    leaves them; each family then waits for what it :data:`NEEDS`, so no
+    kernel is compiled in both processes.
     """
-    thread = threading.Thread(target=warm_missing, args=(packages,), daemon=True,
-                              name="tslip-warm")
-    thread.start()
-    return thread
+    missing = [f for f in families if _is_missing(f)]
+    ready = threading.Event()
 
+    def run() -> None:
+        with ExitStack() as claims:
+            for name in missing:
+                claims.enter_context(claim(name))
+            ready.set()
+            for name in missing:
+                _wait_for(NEEDS.get(name, ()))
+                _run_workload(name)
+        ready.set()
+
+    thread = threading.Thread(target=run, daemon=True, name="tslip-warm")
+    thread.start()
+    ready.wait()
+    return thread
 
 @contextmanager
 def announce(echo: Callable[[str], None], packages: tuple[str, ...] = ("simulation", "biped"),

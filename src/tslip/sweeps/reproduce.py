@@ -52,7 +52,7 @@ from ..simulation.options import IntegratorOptions
 from . import _pool, catalogue
 from ._lock import folder_locks
 from ._schedule import Task, Timing, choose_workers, own_seconds, run_tasks
-from ._warmup import warm_in_background
+from ._warmup import ensure, warm_in_background
 from .claims import ClaimResult, evaluate
 from .run import StudyJob
 
@@ -341,18 +341,26 @@ def single_figures(quick: bool | str = False, progress: Progress | None = None,
     return out
 
 
+#: The kernel families the single-gait figures and Table 6.1 use (the workers may start
+#: before ``tslip reproduce``'s own process has them cached: :func:`._warmup.ensure`).
+_TSLIP_FAMILIES = ("TSLIP gait search and analyses", "TSLIP recorded runs")
+
+
 def _figure_task(res: str, key: str, tick: Any = None) -> Any:
     """One single-gait figure (a task)."""
+    ensure(_TSLIP_FAMILIES)
     return _figure_jobs(res)[key]()
 
 
 def _table61_task(name: str, tick: Any = None) -> Any:
     """One piece of Table 6.1 (a task)."""
+    ensure(_TSLIP_FAMILIES)
     return TABLE61_PIECES[name][0](_table61_gait())
 
 
 def _piece_task(fn: Callable[..., Any], args: tuple[Any, ...], tick: Any = None) -> Any:
     """One piece of Appendix E (a task)."""
+    ensure(("biped",))
     return fn(*args)
 
 
@@ -505,8 +513,8 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
     preload = ["tslip.sweeps.run", __name__, *(extra.modules if extra is not None else ()),
                "tslip.sweeps._prewarm"]  # last: compiles what the modules above use, once
     if scheduler is None and workers != 1:  # likely parallel: the workers' imports start now
-        _pool.prestart(preload)
-        warm_in_background(("biped",))  # on the other core, while the fork server warms
+        warm_in_background()  # biped, recorded runs: here (claimed before the fork server
+        _pool.prestart(preload)  # starts), while the fork server warms the gait search
     with folder_locks((out / "studies" / name for name in specs), root=out):
         folder(out, out / "figures")  # the report's figures: a link there is refused
         jobs = {name: StudyJob(spec, out / "studies" / name, writes=scheduler is None)
