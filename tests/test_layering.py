@@ -19,7 +19,7 @@ ALLOWED = {
     "plotting": {"model", "simulation", "gait", "sweeps", "experiment", "biped"},
 }
 TOP = {"_io", "_lines", "_safefile", "_results", "_checks", "_gridsize", "_kernel_cache",
-       "_nrt", "_codehash",
+       "_nrt", "_codehash", "_first_failure",
        "_renamed", "protocols", "__init__", "__main__", "_typing", "__version__"}
 
 

@@ -12,8 +12,8 @@ import math
 import pytest
 
 import tslip
+from tslip._first_failure import MAX_GRID_POINTS, limit_search
 from tslip.gait import robustness
-from tslip.gait._first_failure import MAX_GRID_POINTS, limit_search
 
 
 def _never(m):

@@ -85,7 +85,7 @@ and :class:`RobustnessLimits`.
 
 The parts live beside this module, which re-exports their names: the
 disturbances and the runs that start from them in
-:mod:`tslip.gait._disturbances`, the search in :mod:`tslip.gait._first_failure`;
+:mod:`tslip.gait._disturbances`, the search in :mod:`tslip._first_failure`;
 here are the grid steps, the results and the searches of a gait.
 """
 
@@ -97,6 +97,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._first_failure import (
+    LimitSearch,
+    _deprecated_start,
+    _grid_step,
+    _grid_steps,
+    limit_search,
+)
 from .._results import Result, frame
 from ..model.parameters import Params
 from ..model.state import TouchdownState
@@ -112,13 +119,6 @@ from ._disturbances import (
     _check_placement,
     _touchdown_runner,
     run_disturbed,
-)
-from ._first_failure import (
-    LimitSearch,
-    _deprecated_start,
-    _grid_step,
-    _grid_steps,
-    limit_search,
 )
 from .fixed_point import Gait
 

@@ -28,13 +28,12 @@ shrink roughly by the multiplier for every two strides added to ``n_steps``.
 They compare gaits and couplings on the same horizon; they are not a basin of
 attraction.
 
-The search (:func:`lateral_limit`) is the planar one's (:mod:`tslip.gait._first_failure`,
-reimplemented here because :mod:`tslip.spatial` builds on the model and
-simulation layers only): a grid scan ``h, 2h, ...`` up to the first failing
-magnitude, then bisection of the bracket to ``tol``; the limit is the last
-surviving magnitude ``lo`` and ``first_failing`` (within ``tol`` of it) fails.
-As there, survival need not be monotone: the limit is the first failure at
-resolution ``h``.
+The search (:func:`lateral_limit`) is the planar one's,
+:func:`tslip._first_failure.limit_search`, one magnitude a call: a grid scan
+``h, 2h, ...`` up to the first failing magnitude, then bisection of the bracket to
+``tol``; the limit is the last surviving magnitude ``lo`` and ``first_failing``
+(within ``tol`` of it) fails. As there, survival need not be monotone: the limit is
+the first failure at resolution ``h``.
 """
 
 from __future__ import annotations
@@ -45,6 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._first_failure import limit_search
 from ..simulation.options import IntegratorOptions
 from .trunk import TrunkStatus, trunk_step
 from .trunk_parameters import TrunkParams
@@ -149,40 +149,21 @@ def lateral_limit(params: TrunkParams, x: np.ndarray, kind: str, *, sign: int = 
     for name, v in (("h", step), ("tol", tol), ("max_magnitude", max_magnitude)):
         if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be in (0, inf), got {v!r}")
-    runs = 0
-
-    def run(m: float) -> tuple[TrunkStatus, int]:
-        nonlocal runs
-        runs += 1
-        return disturbed_run(params, x, kind, sign * m, n_steps=n_steps, options=options)
-
-    st0, i0 = run(0.0)
+    st0, i0 = disturbed_run(params, x, kind, 0.0, n_steps=n_steps, options=options)
     if st0 != TrunkStatus.OK:
         raise ValueError(f"lateral_limit: the undisturbed gait fails ({st0.name} in stride "
                          f"{i0}); pass a periodic gait")
-    lo, hi, fail = 0.0, math.inf, (TrunkStatus.OK, -1)
-    j = 1
-    while True:  # grid scan
-        m = min(j * step, max_magnitude)
-        res = run(m)
-        if res[0] != TrunkStatus.OK:
-            hi, fail = m, res
-            break
-        lo = m
-        if m >= max_magnitude:
-            return LateralLimit(kind, sign, sign * math.inf, sign * math.inf, TrunkStatus.OK,
-                                -1, runs)
-        j += 1
-    while hi - lo > tol:  # bisection
-        mid = 0.5 * (lo + hi)
-        if not lo < mid < hi:
-            break
-        res = run(mid)
-        if res[0] == TrunkStatus.OK:
-            lo = mid
-        else:
-            hi, fail = mid, res
-    return LateralLimit(kind, sign, sign * lo, sign * hi, fail[0], fail[1], runs)
+    outcomes: dict[float, tuple[TrunkStatus, int]] = {}
+
+    def survives(m: np.ndarray) -> np.ndarray:
+        for v in m.tolist():
+            outcomes[v] = disturbed_run(params, x, kind, sign * v, n_steps=n_steps,
+                                        options=options)
+        return np.array([outcomes[v][0] == TrunkStatus.OK for v in m.tolist()])
+
+    s = limit_search(survives, h=step, tol=tol, ladder=1, k=1, max_magnitude=max_magnitude)
+    fail = outcomes.get(s.hi, (TrunkStatus.OK, -1))
+    return LateralLimit(kind, sign, sign * s.lo, sign * s.hi, fail[0], fail[1], s.n_evals + 1)
 
 
 def lateral_limits(params: TrunkParams, x: np.ndarray, *,

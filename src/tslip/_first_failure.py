@@ -5,6 +5,10 @@ array``, so the simulation stays outside the algorithm; the algorithm and why
 it replaces the thesis's binary search are in the module notes of
 :mod:`tslip.gait.robustness`, which re-exports these names. The grid step
 ``h`` of a report is resolved here for both models (:func:`_grid_steps`).
+At the package's top level, below every model: the planar TSLIP's and the
+biped's robustness (through :mod:`tslip.gait.robustness`) and the 3-D TSLIP's
+lateral limits (:func:`tslip.spatial.trunk_robustness.lateral_limit`) all search
+with it.
 """
 
 from __future__ import annotations
@@ -15,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._renamed import warn_renamed
+from ._renamed import warn_renamed
 
 __all__ = ["LimitSearch", "limit_search"]
 
