@@ -253,3 +253,29 @@ def test_bad_method_and_failing_stride():
     x[5] = 3.0  # the leg lengthens at touch-down
     with pytest.raises(ValueError, match="two_step_jacobian: one_step_jacobian: .*FALL"):
         two_step_jacobian(ODD, x)
+
+
+def test_pure_python_kernels_agree_with_the_compiled_ones():
+    """The variational kernels run with NUMBA_DISABLE_JIT=1 (CONTRIBUTING's rule) to the
+    same Jacobian."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    setup = ("import numpy as np, tslip\n"
+             "from tslip.model.controllers import ConstantTorque\n"
+             "from tslip.spatial.trunk_parameters import TrunkParams\n"
+             "p = TrunkParams(m=1.4, J=0.11, J_roll=0.07, J_yaw=0.045, r=0.25, k=28.0, l0=0.9,"
+             " g=1.3, c_l=0.05, splay=0.08, alpha_r=0.95, omega_r=0.8,"
+             " controller=ConstantTorque(tau_c=0.25, c_h=0.05))\n"
+             "o = tslip.IntegratorOptions(rtol=1e-7, atol=1e-7, method='dopri5')\n"
+             "x = np.array([1.0, 0.1, 0.05, -0.03, 2.2, -0.4, 0.15, 0.3, -0.25, -0.2])\n")
+    code = (setup + "import json\nfrom tslip.spatial.trunk_jacobian import one_step_jacobian\n"
+            "print(json.dumps(one_step_jacobian(p, x, options=o)[1].tolist()))\n")
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                         check=True).stdout
+    o = tslip.IntegratorOptions(rtol=1e-7, atol=1e-7, method="dopri5")
+    _, J = one_step_jacobian(ODD, X_ODD, options=o)
+    np.testing.assert_allclose(json.loads(out), J, rtol=0, atol=1e-12 * np.linalg.norm(J))

@@ -158,8 +158,9 @@ def two_step_jacobian(params: TrunkParams, x: np.ndarray, *, side: int = 1,
     ``method="exact"`` (the default): the variational equations on the same Runge-Kutta
     core with the event-time corrections at lift-off and touch-down
     (:func:`tslip.spatial.trunk_jacobian.two_step_jacobian_exact`; within 1e-8 of
-    central differences relative to its norm at the Table 2.1 gait, and about 20 times
-    faster). ``"fd"``: central differences with ``step`` (the only use of ``step``).
+    central differences relative to its norm at the gaits of
+    docs/analyses/spatial_tslip.md). ``"fd"``: central differences with ``step`` (the
+    only use of ``step``).
     ``columns`` limits it to those section components (10 x len(columns)); the planar
     ones ``(0, 2, 4, 5, 9)`` keep a planar gait with ``splay = 0`` in its plane, where a
     roll of either sign would cross a leg."""
