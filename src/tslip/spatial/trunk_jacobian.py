@@ -29,9 +29,11 @@ Issue 43, Part 2. The one-step map on the 10-D touch-down section
    the global reset), yaw, pitch and roll of ``R``, the velocities (:func:`chart_out`).
 
 The map's value comes from the same integration (its state part is
-:func:`~tslip.spatial._trunk_kernels.run_phase`'s arithmetic), so it equals
-:func:`~tslip.spatial.trunk_section.one_step_map`. Agreement with central differences:
-tests/spatial/test_trunk_jacobian.py and docs/analyses/spatial_tslip.md.
+:func:`~tslip.spatial._trunk_kernels.run_phase`'s arithmetic, the step sizes
+controlled by the state alone), so it is :func:`~tslip.spatial.trunk_section.one_step_map`'s
+(to the tolerance for a power-law leg, whose steps the sensitivity's error controls
+too). Agreement with central differences: tests/spatial/test_trunk_jacobian.py and
+docs/analyses/spatial_tslip.md.
 """
 
 from __future__ import annotations
