@@ -16,7 +16,8 @@ Issue 43, Part 2. The one-step map on the 10-D touch-down section
    integrated with the state on the same Runge-Kutta core, ``Df`` exact to rounding
    (:mod:`tslip.spatial._trunk_variational`); a thrust's switch (``-ldot = 0``, where the
    field jumps) adds ``(f- - f+) dt_sw``;
-3. lift-off at ``g = F . e_y = 0`` (eq. 2.8): ``dy_LO = Phi dy0 + f dt_LO``, ``dt_LO = -(grad
+3. lift-off at ``g = F . e_y = 0`` (eq. 2.8; ``l_rest - l`` under the planar rule
+   for a power-law leg): ``dy_LO = Phi dy0 + f dt_LO``, ``dt_LO = -(grad
    g . Phi dy0) / (grad g . f)``; the quaternion's renormalisation
    ``(I - q q^T) / |q|``;
 4. the flight flow (ballistic CoM, torque-free trunk: Euler's equations) the same way,
