@@ -16,7 +16,9 @@ Part 2, the TSLIP in three dimensions (docs/analyses/spatial_tslip.md):
   (:class:`TrunkStatus`, the crossed leg among the falls) and the planar-limit maps;
 * :mod:`.trunk_section`: the 10-D touch-down section (:data:`TRUNK_SECTION_NAMES`), its
   mirror, left-right symmetric gaits (:func:`symmetric_gait`) and the two-step map and
-  its Jacobian by central differences;
+  its Jacobian (exact by default, or by central differences);
+* :mod:`.trunk_jacobian`: the exact one- and two-step Jacobians (variational equations
+  with the event-time corrections; the compiled part in :mod:`._trunk_variational`);
 * :mod:`._trunk_kernels`: the compiled stance and flight loop on the same core.
 """
 

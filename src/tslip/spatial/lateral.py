@@ -21,13 +21,14 @@ planar sweep of the thesis holds the touch-down speed ``v0`` and angle ``beta0``
 solves ``alpha_r`` at each ``r`` instead: a different family away from ``r = 0.3``).
 
 Its multipliers (:func:`lateral_multipliers`) are the eigenvalues of the two-step
-map's Jacobian by central differences (:func:`two_step_jacobian`, step
-``1e-5``, ``IntegratorOptions(rtol=atol=1e-12)``). Three of the ten are trivial
-(the energy of the conservative model, the heading by yaw invariance, and a
-Jordan partner of the heading: a turned gait drifts sideways), exactly 1 for the
-exact map; the three closest to 1 are set aside and their distance from 1 is
-reported (``trivial_error``) as a check. "Asymptotically stable" means every
-other multiplier inside the unit circle.
+map's exact Jacobian (:func:`two_step_jacobian`: variational equations with the
+event-time corrections, :mod:`tslip.spatial.trunk_jacobian`;
+``IntegratorOptions(rtol=atol=1e-12)``; central differences with step ``1e-5`` on
+request). Three of the ten are trivial (the energy of the conservative model, the
+heading by yaw invariance, and a Jordan partner of the heading: a turned gait
+drifts sideways), exactly 1 for the exact map; the three closest to 1 are set
+aside and their distance from 1 is reported (``trivial_error``) as a check.
+"Asymptotically stable" means every other multiplier inside the unit circle.
 
 ``python -m tslip.spatial.lateral`` prints the tables as markdown
 (``--small``: one point of each, a smoke test).
@@ -106,8 +107,8 @@ class LateralPoint:
         Those left after setting aside the :data:`N_TRIVIAL` closest to 1, by modulus
         (largest first).
     trivial_error : float
-        The largest distance of a set-aside multiplier from 1 (the finite-difference
-        error of the trivial ones: about 1e-5 and less here).
+        The largest distance of a set-aside multiplier from 1 (the error of the trivial
+        ones: 2e-8 and less here with the exact Jacobian, about 1e-7 by differences).
     """
 
     params: TrunkParams
@@ -181,10 +182,12 @@ def table21_gait(params: TrunkParams, *, guess: np.ndarray | None = None,
 
 
 def lateral_multipliers(params: TrunkParams, x: np.ndarray, *,
-                        options: IntegratorOptions | None = None) -> LateralPoint:
-    """The multipliers of the gait ``x`` of ``params`` (module docstring)."""
+                        options: IntegratorOptions | None = None,
+                        method: str = "exact") -> LateralPoint:
+    """The multipliers of the gait ``x`` of ``params`` (module docstring); ``method``
+    ``"fd"`` takes the Jacobian by central differences (step ``1e-5``) instead."""
     opt = OPTIONS if options is None else options
-    J = two_step_jacobian(params, x, step=_FD_STEP, options=opt)
+    J = two_step_jacobian(params, x, step=_FD_STEP, options=opt, method=method)
     ev = np.linalg.eigvals(J)
     near = np.argsort(np.abs(ev - 1.0))
     trivial, rest = near[:N_TRIVIAL], near[N_TRIVIAL:]
