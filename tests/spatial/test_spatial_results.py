@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 
 import tslip
 from _result_checks import check_frozen, check_plot, check_repr, check_round_trip, check_units
-from tslip.spatial import SpatialApex, floquet, preset, symmetric_gaits
+from tslip.spatial import Multipliers, SpatialApex, floquet, preset, symmetric_gaits
 from tslip.spatial.lateral import (
     TABLE21_3D_SECTION,
     LateralTable,
@@ -125,6 +125,9 @@ def test_multiplier_table_is_the_eigenvalues_of_the_jacobian(objects):
     assert np.allclose(df["modulus"], np.abs(z))
     assert df["modulus"][~df["trivial"]].max() == pytest.approx(m.largest)
     assert abs(z[df["trivial"].to_numpy()][0] - 1.0) < 1e-6  # the energy's multiplier
+    pair = Multipliers(np.array([0.3 + 0.4j, 0.3 - 0.4j, 1.0]), np.array([0.3 + 0.4j,
+                       0.3 - 0.4j]), np.array([1.0 + 0j]), np.eye(3), "fd")
+    assert pair.to_dataframe()["modulus"].tolist() == pytest.approx([0.5, 0.5, 1.0])
 
 
 def test_multiplier_plot_puts_the_points_at_the_multipliers(objects):
