@@ -135,10 +135,14 @@ def plot_run(run: TrunkRun, ax: Axes | None = None) -> Figure:
 
 
 def _path(run: TrunkRun, ax: Axes, col: str, label: str) -> None:
-    st = run["stance"] > 0.5
-    ax.plot(run["x"], run[col], color="C0", lw=1.0, label="CoM")
-    ax.plot(np.where(st, run["x"], np.nan), np.where(st, run[col], np.nan), color="C0",
-            lw=2.2, label="stance")
+    t = run["t"]
+    if len(t):  # the integrator's steps are long in flight: the interpolated path
+        k = _C[col]
+        rows = run.sample(np.linspace(t[0], t[-1], max(200, 60 * run.n_strides)))
+        x, v, st = rows[:, _C["x"]], rows[:, k], rows[:, _C["stance"]] > 0.5
+        ax.plot(x, v, color="C0", lw=1.0, label="CoM")
+        ax.plot(np.where(st, x, np.nan), np.where(st, v, np.nan), color="C0", lw=2.2,
+                label="stance")
     feet = run.touchdowns
     if len(feet):
         fy = feet[:, 14 if col == "y" else 15]
