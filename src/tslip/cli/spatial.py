@@ -23,6 +23,7 @@ from ._common import (
     errors,
     file_size,
     make_console,
+    progress_bar,
 )
 
 __all__ = ["spatial_app"]
@@ -264,5 +265,9 @@ def animate_cmd(
         p, state = _trunk_start(r, splay, k_splay, k_trail, push, console)
         run = trunk_run(p, state, steps)
         console.print(_status(run))
-        animate_run(run, out, fps=fps, speed=speed, dpi=dpi)
+        with progress_bar("frames") as bar:  # on stderr
+            task = bar.add_task(f"rendering {out.name}", total=None)
+            animate_run(run, out, fps=fps, speed=speed, dpi=dpi,
+                        progress=lambda done, total: bar.update(task, completed=done,
+                                                                total=total))
         console.print(f"wrote {out} ({file_size(out)})")

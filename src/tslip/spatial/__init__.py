@@ -17,6 +17,8 @@ Part 2, the TSLIP in three dimensions (docs/analyses/spatial_tslip.md):
 * :mod:`.trunk_section`: the 10-D touch-down section (:data:`TRUNK_SECTION_NAMES`), its
   mirror, left-right symmetric gaits (:func:`symmetric_gait`) and the two-step map and
   its Jacobian by central differences;
+* :mod:`.trunk_run`: a recorded multi-stride run (:func:`trunk_run`, :class:`TrunkRun`),
+  drawn in a front and a side view by :mod:`tslip.plotting.spatial`;
 * :mod:`._trunk_kernels`: the compiled stance and flight loop on the same core.
 """
 
@@ -38,6 +40,7 @@ from .stride import (
 )
 from .trunk import TrunkStatus, TrunkStep, TrunkTouchdown, trunk_energy, trunk_step
 from .trunk_parameters import TrunkParams
+from .trunk_run import TrunkRun, trunk_run
 from .trunk_section import MIRROR as TRUNK_MIRROR
 from .trunk_section import SECTION_NAMES as TRUNK_SECTION_NAMES
 from .trunk_section import (
@@ -59,4 +62,4 @@ __all__ = ["HEADINGS", "SpatialParams", "preset", "preset_description", "presets
            "TrunkParams", "TrunkStatus", "TrunkStep", "TrunkTouchdown", "trunk_energy",
            "trunk_step", "TRUNK_MIRROR", "TRUNK_SECTION_NAMES", "from_section",
            "mirror_section", "one_step_map", "section", "symmetric_gait", "two_step_jacobian",
-           "two_step_map", "yaw_rotated"]
+           "two_step_map", "yaw_rotated", "TrunkRun", "trunk_run"]
