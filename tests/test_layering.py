@@ -16,7 +16,7 @@ ALLOWED = {
     "experiment": {"model", "simulation", "gait", "biped"},
     "biped": {"model", "simulation", "gait"},
     "spatial": {"model", "simulation"},
-    "plotting": {"model", "simulation", "gait", "sweeps", "experiment", "biped"},
+    "plotting": {"model", "simulation", "gait", "sweeps", "experiment", "biped", "spatial"},
 }
 TOP = {"_io", "_lines", "_safefile", "_results", "_checks", "_gridsize", "_kernel_cache",
        "_nrt", "_codehash", "_first_failure",

@@ -19,6 +19,8 @@ Part 2, the TSLIP in three dimensions (docs/analyses/spatial_tslip.md):
   its Jacobian (exact by default, or by central differences);
 * :mod:`.trunk_jacobian`: the exact one- and two-step Jacobians (variational equations
   with the event-time corrections; the compiled part in :mod:`._trunk_variational`);
+* :mod:`.trunk_run`: a recorded multi-stride run (:func:`trunk_run`, :class:`TrunkRun`),
+  drawn in a front and a side view by :mod:`tslip.plotting.spatial`;
 * :mod:`._trunk_kernels`: the compiled stance and flight loop on the same core.
 """
 
@@ -40,6 +42,7 @@ from .stride import (
 )
 from .trunk import TrunkStatus, TrunkStep, TrunkTouchdown, trunk_energy, trunk_step
 from .trunk_parameters import TrunkParams
+from .trunk_run import TrunkRun, trunk_run
 from .trunk_section import MIRROR as TRUNK_MIRROR
 from .trunk_section import SECTION_NAMES as TRUNK_SECTION_NAMES
 from .trunk_section import (
@@ -61,4 +64,4 @@ __all__ = ["HEADINGS", "SpatialParams", "preset", "preset_description", "presets
            "TrunkParams", "TrunkStatus", "TrunkStep", "TrunkTouchdown", "trunk_energy",
            "trunk_step", "TRUNK_MIRROR", "TRUNK_SECTION_NAMES", "from_section",
            "mirror_section", "one_step_map", "section", "symmetric_gait", "two_step_jacobian",
-           "two_step_map", "yaw_rotated"]
+           "two_step_map", "yaw_rotated", "TrunkRun", "trunk_run"]

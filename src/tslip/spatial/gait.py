@@ -36,32 +36,64 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.optimize import brentq, root
 
 from .._checks import check_number
+from .._results import Result, frame
 from ..simulation.options import IntegratorOptions
 from .parameters import SpatialParams
-from .stride import SpatialApex, section_map, step_jacobian
+from .stride import APEX_UNITS, SpatialApex, section_map, step_jacobian
 
-__all__ = ["SymmetricGait", "Multipliers", "symmetric_gaits", "floquet", "two_step_map",
-           "two_step_jacobian"]
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["SymmetricGait", "Multipliers", "MULTIPLIER_UNITS", "symmetric_gaits", "floquet",
+           "two_step_map", "two_step_jacobian"]
 
 
-@dataclass(frozen=True, slots=True)
-class SymmetricGait:
-    """A left-right symmetric gait: the apex before its right step, and how well it closes."""
+@dataclass(frozen=True, slots=True, repr=False)
+class SymmetricGait(Result):
+    """A left-right symmetric gait: the apex before its right step, and how well it closes.
+
+    A :class:`~tslip._results.Result`; its table is one row, the apex with the energy and
+    the residual.
+    """
 
     params: SpatialParams
     apex: SpatialApex  # before the right step (side +1)
     energy: float  # [MgL]
     residual: float  # max |mirror(F_R(x)) - x| over (y, vx, vz) (rotation removed)
 
+    def _repr_fields(self) -> dict[str, object]:
+        a = self.apex
+        return {"y": a.y, "vx": a.vx, "vz": a.vz, "energy": self.energy,
+                "residual": self.residual}
 
-@dataclass(frozen=True, slots=True)
-class Multipliers:
-    """Floquet multipliers of the two-step map at a symmetric gait (module docstring)."""
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row: the apex (:data:`~tslip.spatial.stride.APEX_UNITS`), ``energy`` [MgL]
+        and ``residual`` [-]."""
+        row = {k: getattr(self.apex, k) for k in APEX_UNITS}
+        row.update(energy=self.energy, residual=self.residual)
+        return frame([row], {**APEX_UNITS, "energy": "MgL", "residual": "-"})
+
+
+#: Units of the multipliers' table.
+MULTIPLIER_UNITS: dict[str, str] = {"real": "-", "imag": "-", "modulus": "-", "trivial": "-"}
+
+
+@dataclass(frozen=True, slots=True, repr=False)
+class Multipliers(Result):
+    """Floquet multipliers of the two-step map at a symmetric gait (module docstring).
+
+    A :class:`~tslip._results.Result`: its table has one row per eigenvalue of the full
+    Jacobian (``trivial`` marks the ones set aside), ``plot()`` draws them in the unit
+    circle.
+    """
 
     all: np.ndarray  # eigenvalues of the 3 x 3 Jacobian of the two-step map
     nontrivial: np.ndarray  # eigenvalues of the reduced Jacobian (energy, heading removed)
@@ -74,6 +106,27 @@ class Multipliers:
         """The largest non-trivial modulus: the gait is asymptotically stable (on its
         energy level, up to heading) when it is below 1."""
         return float(np.max(np.abs(self.nontrivial)))
+
+    def _repr_fields(self) -> dict[str, object]:
+        return {"largest": self.largest, "n_nontrivial": len(self.nontrivial),
+                "method": self.method}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """The non-trivial multipliers, then the trivial ones: real and imaginary part,
+        modulus, and whether it is trivial."""
+        z = np.concatenate([np.asarray(self.nontrivial, dtype=complex),
+                            np.asarray(self.trivial, dtype=complex)])
+        triv = np.arange(len(z)) >= len(self.nontrivial)
+        return frame({"real": z.real, "imag": z.imag, "modulus": np.abs(z), "trivial": triv},
+                     MULTIPLIER_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The multipliers in the complex plane with the unit circle, trivial ones hollow
+        (:func:`tslip.plotting.spatial.plot_multipliers`)."""
+        from ..plotting.spatial import plot_multipliers
+
+        return plot_multipliers(self.nontrivial, self.trivial, ax,
+                                title=f"two-step map: max |lambda| = {self.largest:.4g}")
 
 
 def _options(options: IntegratorOptions | None) -> IntegratorOptions:

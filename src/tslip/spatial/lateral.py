@@ -40,21 +40,28 @@ import argparse
 import dataclasses
 import math
 import sys
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 
 from .._io import atomic_write
+from .._results import Result, frame
 from ..simulation.options import IntegratorOptions
 from .parameters import TABLE21_3D_SPLAY
 from .trunk_parameters import TrunkParams
 from .trunk_section import symmetric_gait, two_step_jacobian
 
-__all__ = ["LateralPoint", "table21_gait", "lateral_multipliers", "lateral_point",
-           "splay_table", "r_table", "gain_table", "markdown", "main", "OPTIONS",
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["LateralPoint", "LateralTable", "ROW_UNITS", "table21_gait", "lateral_multipliers",
+           "lateral_point", "TABLE21_3D_SECTION", "splay_table", "r_table", "gain_table",
+           "markdown", "main", "OPTIONS",
            "SPLAY_STEP", "R_STEP", "GAIN_STEP", "N_TRIVIAL", "TABLE21_SECTION", "TABLE21_VX",
            "TABLE21_ALPHA_R", "table21_params", "gain_matrix", "SPLAYS", "RS", "K_SPLAYS",
            "K_TRAILS", "tables"]
@@ -82,6 +89,15 @@ TABLE21_VX = float(TABLE21_SECTION[4])
 #: Its leg reset angle [rad]: ``find_gait`` solves ``alpha_r`` (the preset's 1.0 is a
 #: start), and every gait here keeps it.
 TABLE21_ALPHA_R = 0.7934842721919153
+#: The 3-D gait of :func:`table21_params` (splay 0.05, ``r`` 0.3, no coupling):
+#: ``table21_gait(table21_params())``, its right touch-down, stored so that a run can start
+#: from it without the continuation (tests/spatial/test_trunk_run.py checks that it is a
+#: left-right symmetric gait).
+TABLE21_3D_SECTION = np.array([1.0457133205643967, 2.7532576437633286e-05,
+                               -0.004192260572694797, 0.004354317052413445, 4.998408015786053,
+                               -0.12611452418636432, 0.010130424562713219,
+                               0.03452648750189442, -1.3329114843007927e-22,
+                               -0.033241800254926006])
 
 
 def table21_params(**changes: Any) -> TrunkParams:
@@ -92,9 +108,18 @@ def table21_params(**changes: Any) -> TrunkParams:
                                **changes)
 
 
-@dataclass(frozen=True)
-class LateralPoint:
+#: Units of :meth:`LateralPoint.row` (the columns of the tables).
+ROW_UNITS: dict[str, str] = {"r": "L", "splay": "rad", "k_splay": "-", "k_trail": "-",
+                             "largest": "-", "kind": "-", "stable": "-", "trivial_error": "-",
+                             "lateral_speed": "g^1/2 L^1/2"}
+
+
+@dataclass(frozen=True, repr=False)
+class LateralPoint(Result):
     """One gait and its multipliers (module docstring).
+
+    A :class:`~tslip._results.Result`: a table of one row (:meth:`row`, units
+    :data:`ROW_UNITS`); ``plot()`` draws the multipliers in the unit circle.
 
     Attributes
     ----------
@@ -138,6 +163,85 @@ class LateralPoint:
         return {"r": p.r, "splay": p.splay, "k_splay": p.k_splay, "k_trail": p.k_trail,
                 "largest": self.largest, "kind": self.kind,
                 "trivial_error": self.trivial_error, "lateral_speed": float(self.x[6])}
+
+    @property
+    def trivial(self) -> np.ndarray:
+        """The :data:`N_TRIVIAL` multipliers set aside (those closest to 1)."""
+        ev = np.asarray(self.multipliers)
+        return ev[np.argsort(np.abs(ev - 1.0), kind="stable")[:N_TRIVIAL]]
+
+    def _repr_fields(self) -> dict[str, object]:
+        return {**{k: v for k, v in self.row().items() if k != "lateral_speed"},
+                "stable": self.stable}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row: :meth:`row` and ``stable``, units :data:`ROW_UNITS`."""
+        return frame([{**self.row(), "stable": self.stable}], ROW_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The multipliers in the unit circle, the trivial ones hollow
+        (:func:`tslip.plotting.spatial.plot_multipliers`)."""
+        from ..plotting.spatial import plot_multipliers
+
+        p = self.params
+        return plot_multipliers(self.nontrivial, self.trivial, ax, title=(
+            f"r {p.r:g}, splay {p.splay:g}, k_splay {p.k_splay:g}, k_trail {p.k_trail:g}: "
+            f"max |lambda| = {self.largest:.4g}"))
+
+
+@dataclass(frozen=True, repr=False)
+class LateralTable(Result):
+    """Gaits and their multipliers, as :func:`splay_table`, :func:`r_table` and
+    :func:`gain_table` return them (a list): ``LateralTable(r_table())``.
+
+    A sequence of :class:`LateralPoint` (``len``, iteration, indexing; :func:`markdown`
+    and :func:`gain_matrix` take it) and a :class:`~tslip._results.Result`: one table row
+    per gait (units :data:`ROW_UNITS`); ``plot()`` draws the largest non-trivial
+    ``|multiplier|`` over the parameter that varies (``r``, ``splay``, ``k_splay`` or
+    ``k_trail``), or over the ``k_splay`` x ``k_trail`` grid when both gains vary
+    (:func:`tslip.plotting.spatial.plot_lateral_table`).
+    """
+
+    points: tuple[LateralPoint, ...]
+
+    def __post_init__(self) -> None:
+        pts = tuple(self.points)
+        for i, pt in enumerate(pts):
+            if not isinstance(pt, LateralPoint):
+                raise TypeError(f"LateralTable.points[{i}] must be a LateralPoint, got "
+                                f"{type(pt).__name__}")
+        object.__setattr__(self, "points", pts)
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    def __iter__(self) -> Iterator[LateralPoint]:
+        return iter(self.points)
+
+    @overload
+    def __getitem__(self, i: int) -> LateralPoint: ...
+
+    @overload
+    def __getitem__(self, i: slice) -> tuple[LateralPoint, ...]: ...
+
+    def __getitem__(self, i: int | slice) -> LateralPoint | tuple[LateralPoint, ...]:
+        return self.points[i]
+
+    def _repr_fields(self) -> dict[str, object]:
+        return {"n_points": len(self.points),
+                "n_stable": sum(pt.stable for pt in self.points)}
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per gait: :meth:`LateralPoint.row` and ``stable``."""
+        rows = [{**pt.row(), "stable": pt.stable} for pt in self.points]
+        return frame(rows or {k: [] for k in ROW_UNITS}, ROW_UNITS)
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The largest non-trivial ``|multiplier|`` over the varied parameter, or the gain
+        grid (class docstring)."""
+        from ..plotting.spatial import plot_lateral_table
+
+        return plot_lateral_table(self.to_dataframe(), ax)
 
 
 def _steps(a: float, b: float, h: float) -> list[float]:

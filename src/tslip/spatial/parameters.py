@@ -30,7 +30,7 @@ planar SLIP (``tslip.preset("slip")``) whose leg angle ``alpha_r`` (= its
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any, Literal, get_args, overload
 
 import numpy as np
@@ -86,6 +86,10 @@ class SpatialParams:
             raise ValueError(
                 f"SpatialParams.k_lat must be 0 with heading='velocity' (v_n is 0 by "
                 f"construction there, so the feedback has no effect), got {self.k_lat!r}")
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain ``dict`` of the fields (JSON friendly; the run record of a saved result)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
 
     def packed(self) -> np.ndarray:
         """The kernel's parameter vector (:mod:`tslip.spatial._kernels`)."""

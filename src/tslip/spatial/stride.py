@@ -28,17 +28,21 @@ from __future__ import annotations
 import enum
 import math
 from dataclasses import astuple, dataclass
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from .._checks import check_number
+from .._results import Result, frame
 from ..simulation.options import IntegratorOptions
 from . import _kernels as kn
 from .parameters import SpatialParams
 
-__all__ = ["SpatialStatus", "SpatialApex", "SpatialStep", "SECTION_NAMES", "apex_step",
-           "apex_steps", "section_map", "step_jacobian", "energy", "mirror"]
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = ["SpatialStatus", "SpatialApex", "APEX_UNITS", "SpatialStep", "SECTION_NAMES",
+           "apex_step", "apex_steps", "section_map", "step_jacobian", "energy", "mirror"]
 
 #: Names of the apex-section vector, in order.
 SECTION_NAMES: tuple[str, ...] = ("y", "vx", "vz")
@@ -58,9 +62,17 @@ class SpatialStatus(enum.IntEnum):
     NONFINITE = kn.ST_ERR_NONFINITE
 
 
-@dataclass(frozen=True, slots=True)
-class SpatialApex:
+#: Units of the apex's fields (its table's columns; thesis Table 3.1).
+APEX_UNITS: dict[str, str] = {"y": "L", "vx": "g^1/2 L^1/2", "vz": "g^1/2 L^1/2", "x": "L",
+                              "z": "L", "side": "-"}
+
+
+@dataclass(frozen=True, slots=True, repr=False)
+class SpatialApex(Result):
     """State at an apex (vertical velocity 0) before a step of side ``side``.
+
+    A :class:`~tslip._results.Result`: it saves, loads and tabulates (one row) like the
+    planar results.
 
     Parameters
     ----------
@@ -109,6 +121,10 @@ class SpatialApex:
     def as_array(self) -> np.ndarray:
         """All fields ``(y, vx, vz, x, z, side)``."""
         return np.array(astuple(self), dtype=float)
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row: the fields, units in ``attrs`` (:data:`APEX_UNITS`)."""
+        return frame([{k: getattr(self, k) for k in APEX_UNITS}], APEX_UNITS)
 
 
 def energy(params: SpatialParams, apex: SpatialApex) -> float:

@@ -100,6 +100,16 @@ class TrunkParams:
         base.update(changes)
         return cls(**base)
 
+    def to_dict(self) -> dict[str, Any]:
+        """Plain ``dict`` (JSON friendly; the run record of a saved result), the controller
+        as a sub-table, ``alpha_stop`` omitted when ``None`` (no stop)."""
+        out: dict[str, Any] = {f.name: getattr(self, f.name) for f in fields(self)
+                               if f.name not in ("controller", "alpha_stop")}
+        if self.alpha_stop is not None:
+            out["alpha_stop"] = self.alpha_stop
+        out["controller"] = self.controller.to_dict()
+        return out
+
     def packed(self, side: int = 1) -> np.ndarray:
         """The kernel's parameter vector (:mod:`tslip.spatial._trunk_kernels`), for ``side``."""
         P = np.zeros(kn.NP)

@@ -41,17 +41,22 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .._first_failure import limit_search
+from .._results import Result, frame
 from ..simulation.options import IntegratorOptions
 from .trunk import TrunkStatus, trunk_step
 from .trunk_parameters import TrunkParams
 from .trunk_section import from_section
 
-__all__ = ["KINDS", "UNITS", "GRID_STEPS", "LateralLimit", "disturbed_run", "lateral_limit",
-           "lateral_limits"]
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = ["KINDS", "UNITS", "LIMIT_UNITS", "GRID_STEPS", "LateralLimit", "disturbed_run",
+           "lateral_limit", "lateral_limits"]
 
 #: The disturbances and the section component each is added to (module docstring).
 KINDS: dict[str, int] = {"lateral_push": 6, "roll_rate": 7, "yaw_rate": 8}
@@ -66,9 +71,18 @@ UNITS: dict[str, str] = {"lateral_push": "g^1/2 L^1/2", "roll_rate": "rad g^1/2 
 GRID_STEPS: dict[str, float] = {"lateral_push": 1e-5, "roll_rate": 1e-5, "yaw_rate": 2e-6}
 
 
-@dataclass(frozen=True, slots=True)
-class LateralLimit:
+#: Units of a limit's table: the disturbance's own unit is in its ``unit`` column.
+LIMIT_UNITS: dict[str, str] = {**dict.fromkeys(("kind", "sign", "unit", "status", "fall_stride",
+                                                "n_runs"), "-"),
+                               "limit": "column unit", "first_failing": "column unit"}
+
+
+@dataclass(frozen=True, slots=True, repr=False)
+class LateralLimit(Result):
     """The limit of one disturbance in one direction (module docstring).
+
+    A :class:`~tslip._results.Result` (a table of one row, as the planar
+    :class:`tslip.gait.robustness.RobustnessLimit`).
 
     Attributes
     ----------
@@ -100,6 +114,14 @@ class LateralLimit:
     @property
     def unit(self) -> str:
         return UNITS[self.kind]
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row; ``limit`` and ``first_failing`` are in the unit of column ``unit``."""
+        row: dict[str, Any] = {"kind": self.kind, "sign": self.sign, "limit": self.limit,
+                               "first_failing": self.first_failing, "unit": self.unit,
+                               "status": self.status.name, "fall_stride": self.fall_stride,
+                               "n_runs": self.n_runs}
+        return frame([row], LIMIT_UNITS)
 
 
 def _check(kind: str, n_steps: int) -> None:
