@@ -121,10 +121,22 @@ def test_a_point_without_a_gait_is_a_record_not_an_error():
     assert "splay must be in (0, pi/2)" in f["message"][0]
 
 
-def test_the_example_spec_reads():
+def test_the_example_grid_is_the_docs_gain_matrix(tmp_path):
+    """examples/lateral.toml (k_splay x k_trail at splay 0.05, r 0.3): the largest
+    non-trivial |multiplier| of docs/analyses/spatial_tslip.md's gain matrix (c: complex)."""
     spec = StudySpec.from_toml(EXAMPLE)
     assert spec.model == "tslip3d" and isinstance(spec.base, SpatialBase)
-    assert spec.n_points <= 20
+    f = run_study(spec, tmp_path / "lateral", workers=2).frame  # worker processes
+    docs = {(0.0, 0.0): 1.750, (0.0, 1.0): 1.181, (0.0, 2.0): 1.091, (0.5, 0.0): 1.208,
+            (0.5, 1.0): 1.097, (0.5, 2.0): 1.142, (1.0, 0.0): 1.105, (1.0, 1.0): 1.131,
+            (1.0, 2.0): 1.203}
+    complex_ = {(0.5, 2.0), (1.0, 1.0), (1.0, 2.0)}
+    assert len(f) == len(docs)
+    for _, row in f.iterrows():
+        point = (row["k_splay"], row["k_trail"])
+        assert row["max_nontrivial"] == pytest.approx(docs[point], abs=6e-4), point
+        assert row["kind"] == ("complex" if point in complex_ else "real"), point
+    assert f["k_trail"].tolist()[:3] == [0.0, 1.0, 2.0]  # axes order: the last inner
 
 
 def test_a_spatial_preset_names_its_model_and_the_spec_round_trips():
@@ -232,3 +244,18 @@ def test_editing_spatial_code_rekeys_exactly_the_3d_points_it_computes(copied):
     now = keys()
     changed = {name for name, k in edit("simulation/_rk.py").items() if k != now[name]}
     assert changed == set(specs)  # the integrator core every model shares
+
+
+def test_tslip_study_runs_a_3d_spec(tmp_path):
+    from typer.testing import CliRunner
+
+    from tslip.cli.main import app
+
+    spec = tmp_path / "slip.toml"
+    spec.write_text('preset = "slip3d"\n[[axis]]\nparam = "energy"\nvalues = [2.2]\n')
+    res = CliRunner().invoke(app, ["study", str(spec), "--out", str(tmp_path / "o"),
+                                   "--workers", "1"])
+    assert res.exit_code == 0, res.output
+    assert "slip: 1 points (0 cached), 1 with a periodic gait, 0 stable" in res.output
+    f = pd.read_parquet(tmp_path / "o" / "results.parquet")
+    assert f["stability"].tolist() == ["unstable"]  # fixed heading, no feedback (claim 1)

@@ -354,7 +354,9 @@ def _run(spec: StudySpec, out: Path | None, n_workers: int | None, scheduler: st
     timing: dict[Hashable, tuple[float, float, Hashable]] = {}
     run_tasks(job.start(), job.on_done, workers, tick=job.tick, timing=timing,
               scheduler=scheduler,
-              preload=["tslip.sweeps._prewarm"])  # compiles missing kernels once, pre-fork
+              # compiles the planar kernels missing from numba's cache once, pre-fork (a 3-D
+              # study runs none of them)
+              preload=["tslip.sweeps._prewarm"] if spec.model == "tslip" else [])
     return job.result(workers, scheduler, csv, timing)
 
 
