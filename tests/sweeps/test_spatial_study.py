@@ -49,6 +49,7 @@ def test_tslip3d_study_gives_the_docs_table_and_resumes_bit_for_bit(tmp_path):
     cache.write_text(lines[0])
     again = run_study(spec, tmp_path / "s", workers=1)
     assert (again.meta["cached"], again.meta["computed"]) == (1, 1)
+    assert len(cache.read_text().splitlines()) == 2  # the cached point was not computed again
     pd.testing.assert_frame_equal(again.frame.drop(columns="seconds"),
                                   f.drop(columns="seconds"))
     assert run_study(spec, tmp_path / "s", workers=1).meta["cached"] == 2
