@@ -260,3 +260,21 @@ def test_tslip_study_runs_a_3d_spec(tmp_path):
     assert "slip: 1 points (0 cached), 1 with a periodic gait, 0 stable" in res.output
     f = pd.read_parquet(tmp_path / "o" / "results.parquet")
     assert f["stability"].tolist() == ["unstable"]  # fixed heading, no feedback (claim 1)
+
+
+def test_a_3d_study_plots_its_multipliers():
+    """StudyResult.plot on both 3-D models: the non-trivial multipliers and the trivial
+    ones (3 of 10, or 1 of 3) as separate series; a point without a gait marked."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    for text, n_trivial in (('model = "tslip3d"\n[[axis]]\nparam = "splay"\n'
+                             'values = [-0.05, 0.05]\n', 3),
+                            ('preset = "slip3d"\n[[axis]]\nparam = "energy"\n'
+                             'values = [2.2]\n', 1)):
+        res = run_study(_spec(text), None, workers=1)
+        fig = res.plot()
+        lines = {ln.get_label(): ln for ln in fig.axes[0].get_lines()}
+        trivial = lines[next(k for k in lines if "trivial (energy)" in k)].get_ydata()
+        assert np.sum(np.isfinite(trivial)) == n_trivial
+        np.testing.assert_allclose(trivial[np.isfinite(trivial)], 1.0, atol=3e-5)

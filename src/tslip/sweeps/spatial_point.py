@@ -189,8 +189,8 @@ def solve_gaits(spec: StudySpec, assignment: dict[str, float], values: Sequence[
         gait, message = _solve(spec, point)
         seconds = time.perf_counter() - t0
         if gait is None:
-            rec = {**point, "converged": False, "stability": "none", "message": message,
-                   "seconds": seconds}
+            rec = {**point, "converged": False, "stability": "none", "n_trivial": 0,
+                   "message": message, "seconds": seconds}
             records[i] = rec
             if emit is not None:
                 emit(i, rec)
@@ -228,7 +228,7 @@ def _slip3d(gaits: tuple[SymmetricGait, ...]) -> dict[str, Any]:
     try:
         f = floquet(g, "exact")
     except ValueError:
-        return {**rec, "stability": "unknown"}
+        return {**rec, "stability": "unknown", "n_trivial": 0}
     mags = sorted(np.abs(f.all).tolist(), reverse=True)
     rec.update({f"abs_lambda_{j + 1}": m for j, m in enumerate(mags)})
     nt = np.abs(f.nontrivial)
@@ -246,7 +246,7 @@ def _tslip3d(spec: StudySpec, params: TrunkParams, x: np.ndarray) -> dict[str, A
     try:
         pt = lateral_multipliers(params, x, options=OPTIONS)
     except ValueError as exc:
-        return {**rec, "stability": "unknown", "floquet_message": str(exc)}
+        return {**rec, "stability": "unknown", "n_trivial": 0, "floquet_message": str(exc)}
     mags = sorted(np.abs(pt.multipliers).tolist(), reverse=True)
     rec.update({f"abs_lambda_{j + 1}": m for j, m in enumerate(mags)})
     rec.update(max_nontrivial=pt.largest, min_nontrivial=float(np.abs(pt.nontrivial).min()),
