@@ -94,6 +94,7 @@ FILES = {
                         'param = "k"\nvalues = [25.0]\n'),
     "s3_klat.toml": ('preset = "slip3d-feedback"\n[params]\nheading = "velocity"\n[[axis]]\n'
                      'param = "k"\nvalues = [25.0]\n'),
+    "s3_analyses.toml": 'model = "tslip3d"\nanalyses = 3\n[[axis]]\nparam = "r"\nvalues = [0.1]\n',
     "s3_kbool.toml": ('model = "tslip3d"\n[params]\nk = true\n[[axis]]\nparam = "r"\n'
                       'values = [0.1]\n'),
 }
@@ -338,6 +339,8 @@ CASES: list[tuple[str, str]] = [
      "heading must be one of ['fixed', 'velocity'], got 'sideways'"),
     ("study {d}/s3_klat.toml --out {o}/s", "k_lat must be 0 with heading='velocity'"),
     ("study {d}/s3_kbool.toml --out {o}/s", "k [MgL^-1] must be a number"),
+    ("study {d}/s3_analyses.toml --out {o}/s",
+     "analyses must be a list of names from ['floquet', 'lateral_robustness'], got 3"),
     ("study {d}/missing.toml --out {o}/s", "study file '{d}/missing.toml' does not exist"),
 ]
 

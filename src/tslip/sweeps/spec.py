@@ -322,7 +322,7 @@ class StudySpec:
             raise ValueError(f"study {name}: needs at least one [[axis]]")
         axes = tuple(Axis.from_dict(a) for a in axes_data)
         analyses = name_list(data.get("analyses", ["floquet"]), f"study {name}: analyses",
-                             ANALYSES)
+                             ANALYSES if isinstance(base, Params) else base.analyses)
         return cls(name=name, base=base, axes=axes, analyses=analyses,
                    n_steps=data.get("n_steps", 25),
                    description=str(data.get("description", "")), meta=meta)
