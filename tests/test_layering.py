@@ -12,7 +12,9 @@ ALLOWED = {
     "model": set(),
     "simulation": {"model"},
     "gait": {"model", "simulation"},
-    "sweeps": {"model", "simulation", "gait", "biped"},
+    # spatial: the 3-D studies (issue 43) run on the sweep machinery; spatial itself builds on
+    # model and simulation only, so this adds no cycle
+    "sweeps": {"model", "simulation", "gait", "biped", "spatial"},
     "experiment": {"model", "simulation", "gait", "biped"},
     "biped": {"model", "simulation", "gait"},
     "spatial": {"model", "simulation"},

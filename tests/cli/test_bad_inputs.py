@@ -74,6 +74,29 @@ FILES = {
     "study_kbool.toml": '[params]\nk = true\n[[axis]]\nparam = "r"\nvalues = [0.1]\n',
     "study_empty_range.toml": '[[axis]]\nparam = "r"\nfrom = 0.5\nto = 0.1\npoints = 3\n',
     "study_analysis.toml": 'analyses = ["nope"]\n[[axis]]\nparam = "r"\nvalues = [0.1]\n',
+    # 3-D studies (issue 43): the model, its preset, its [params], its axes and analyses
+    "s3_model.toml": 'model = "tslip4d"\n[[axis]]\nparam = "r"\nvalues = [0.1]\n',
+    "s3_modelint.toml": 'model = 3\n[[axis]]\nparam = "r"\nvalues = [0.1]\n',
+    "s3_preset.toml": ('model = "tslip3d"\npreset = "slip3d"\n[[axis]]\nparam = "r"\n'
+                       'values = [0.1]\n'),
+    "s3_cl.toml": ('model = "tslip3d"\n[params]\nc_l = 0.1\n[[axis]]\nparam = "r"\n'
+                   'values = [0.1]\n'),
+    "s3_k.toml": 'model = "tslip3d"\n[[axis]]\nparam = "k"\nfrom = -1.0\nto = 30.0\n',
+    "s3_splay.toml": 'model = "tslip3d"\n[[axis]]\nparam = "splay"\nvalues = [0.1, 2.0]\n',
+    "s3_vx.toml": 'model = "tslip3d"\n[[axis]]\nparam = "vx"\nvalues = [0.0, 5.0]\n',
+    "s3_energy.toml": 'preset = "slip3d"\n[[axis]]\nparam = "energy"\nvalues = [-1.0]\n',
+    "s3_beta0.toml": 'preset = "slip3d"\n[[axis]]\nparam = "beta0"\nvalues = [1.0, 1.7]\n',
+    "s3_phi.toml": 'preset = "slip3d"\n[[axis]]\nparam = "r"\nvalues = [0.1]\n',
+    "s3_analysis.toml": ('model = "tslip3d"\nanalyses = ["robustness"]\n[[axis]]\nparam = "r"\n'
+                         'values = [0.1]\n'),
+    "s3_tol.toml": 'model = "slip3d"\ntol = 1e-8\n[[axis]]\nparam = "k"\nvalues = [25.0]\n',
+    "s3_heading.toml": ('preset = "slip3d"\n[params]\nheading = "sideways"\n[[axis]]\n'
+                        'param = "k"\nvalues = [25.0]\n'),
+    "s3_klat.toml": ('preset = "slip3d-feedback"\n[params]\nheading = "velocity"\n[[axis]]\n'
+                     'param = "k"\nvalues = [25.0]\n'),
+    "s3_analyses.toml": 'model = "tslip3d"\nanalyses = 3\n[[axis]]\nparam = "r"\nvalues = [0.1]\n',
+    "s3_kbool.toml": ('model = "tslip3d"\n[params]\nk = true\n[[axis]]\nparam = "r"\n'
+                      'values = [0.1]\n'),
 }
 
 SIM = "simulate --steps 2"
@@ -297,6 +320,27 @@ CASES: list[tuple[str, str]] = [
      "--out '/sys/report/index.html': cannot write in '/sys'"),
     ("study {d}/study_empty_range.toml --out {o}/s", "empty range"),
     ("study {d}/study_analysis.toml --out {o}/s", "unknown analysis 'nope'"),
+    ("study {d}/s3_model.toml --out {o}/s",
+     "study model must be one of ['tslip', 'slip3d', 'tslip3d'], got 'tslip4d'"),
+    ("study {d}/s3_modelint.toml --out {o}/s", "study model must be one of"),
+    ("study {d}/s3_preset.toml --out {o}/s",
+     "study preset must be one of ['table2.1-3d'] for model 'tslip3d', got 'slip3d'"),
+    ("study {d}/s3_cl.toml --out {o}/s", "unknown tslip3d parameter 'c_l'; allowed: ["),
+    ("study {d}/s3_k.toml --out {o}/s", "axis k: k [MgL^-1] must be"),
+    ("study {d}/s3_splay.toml --out {o}/s", "axis splay: splay [rad] must be"),
+    ("study {d}/s3_vx.toml --out {o}/s", "axis vx: vx [g^1/2 L^1/2] must be"),
+    ("study {d}/s3_energy.toml --out {o}/s", "axis energy: energy [MgL] must be"),
+    ("study {d}/s3_beta0.toml --out {o}/s", "axis beta0: beta0 [rad] must be"),
+    ("study {d}/s3_phi.toml --out {o}/s", "unknown slip3d parameter 'r'; allowed: ["),
+    ("study {d}/s3_analysis.toml --out {o}/s",
+     "unknown analysis 'robustness'; allowed: ['floquet', 'lateral_robustness']"),
+    ("study {d}/s3_tol.toml --out {o}/s", "unknown study key 'tol'"),
+    ("study {d}/s3_heading.toml --out {o}/s",
+     "heading must be one of ['fixed', 'velocity'], got 'sideways'"),
+    ("study {d}/s3_klat.toml --out {o}/s", "k_lat must be 0 with heading='velocity'"),
+    ("study {d}/s3_kbool.toml --out {o}/s", "k [MgL^-1] must be a number"),
+    ("study {d}/s3_analyses.toml --out {o}/s",
+     "analyses must be a list of names from ['floquet', 'lateral_robustness'], got 3"),
     ("study {d}/missing.toml --out {o}/s", "study file '{d}/missing.toml' does not exist"),
 ]
 

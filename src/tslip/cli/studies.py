@@ -71,7 +71,8 @@ def study_cmd(
         with folder_lock(out_dir, wait=wait):  # refused (or waited for) before the bar is drawn
             check_study_folder(spec, out_dir)  # and a link where its points are saved
         t0 = time.perf_counter()
-        with progress_bar("pt") as bar, announce(bar.console.print, ("simulation",)):
+        planar = ("simulation",) if spec.model == "tslip" else ()  # a 3-D study: no planar
+        with progress_bar("pt") as bar, announce(bar.console.print, planar):
             task = bar.add_task(f"study {spec.name}", total=spec.n_points)
             try:
                 res = run_study(spec, out_dir, workers=workers, scheduler=scheduler, csv=csv,

@@ -54,7 +54,8 @@ def _shade(ax: Axes, x: np.ndarray, mask: np.ndarray, color: str = _STABLE_GREEN
 def _split_trivial(frame) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001
     """|lambda| per point: the non-trivial ones (the ``n_trivial`` values closest to 1
     removed) and the trivial ones (the removed values, NaN elsewhere)."""
-    mags = frame[[f"abs_lambda_{j}" for j in range(1, 6)]].to_numpy(float).copy()
+    n = sum(f"abs_lambda_{j}" in frame for j in range(1, 11))  # planar 5, 3-D 3 or 10
+    mags = frame[[f"abs_lambda_{j}" for j in range(1, n + 1)]].to_numpy(float).copy()
     trivial = np.full_like(mags, np.nan)
     for i, n in enumerate(frame["n_trivial"].to_numpy(int)):
         for _ in range(n):

@@ -1,5 +1,6 @@
 """Parameter studies and design searches: declarative specs, a parallel resumable runner."""
 
+from . import spatial_spec as _spatial_spec  # noqa: F401  (registers the 3-D models)
 from .run import StudyResult, run_study
 from .spec import ANALYSES, Axis, StudySpec
 

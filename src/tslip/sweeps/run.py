@@ -29,6 +29,11 @@ Ctrl-C stops the workers and raises :class:`StudyInterrupted` ("N of M
 points saved"). A point without a periodic gait is a record with
 ``converged = False`` and ``stability = "none"``, not an error. On a Dask
 cluster the points are cached here as their tasks return.
+
+A study of a 3-D model (:mod:`tslip.sweeps.spatial_spec`) runs the same way;
+its points are computed by :mod:`tslip.sweeps.spatial_point` (each from its own
+parameters: its lines are independent), and its key holds the model and that
+module's :func:`~tslip.sweeps.spatial_point.code_version`.
 """
 
 from __future__ import annotations
@@ -51,7 +56,7 @@ from .._results import FrameTable, Result, with_units
 from ..gait.continuation import get_param
 from ..gait.robustness import UNITS as ROBUSTNESS_UNITS
 from ..model.units import COLUMN_UNITS, UNIT, param_unit
-from . import _pool, _store
+from . import _pool, _store, spatial_point, spatial_spec
 from ._lock import folder_lock
 from ._schedule import Task, Timing, choose_workers, own_seconds, run_tasks
 from .point import (
@@ -87,8 +92,23 @@ class StudyInterrupted(KeyboardInterrupt):
         return f"{self.saved} of {self.total} points saved; rerun the same command to resume"
 
 
+def _code(spec: StudySpec) -> str:
+    """The code version of a study's points (:func:`tslip.sweeps.point.code_version`, or
+    :func:`tslip.sweeps.spatial_point.code_version` for a 3-D model)."""
+    if spec.model == "tslip":
+        return code_version(spec.analyses)
+    return spatial_point.code_version(spec.model, spec.analyses)
+
+
 def _key_prefix(spec: StudySpec) -> Any:
     """The hash state shared by a study's points: code, base parameters, analyses."""
+    if spec.model != "tslip":  # a 3-D model: no tolerances in its spec
+        return hashlib.sha256(json.dumps({
+            "model": spec.model, "code": _code(spec), "base": spec.base.to_dict(),
+            "axes": [[a.param, sorted(a.values)] for a in spec.axes],
+            "analyses": sorted(spec.analyses),
+            "n_steps": spec.n_steps if "lateral_robustness" in spec.analyses else None,
+        }, sort_keys=True, default=float).encode())
     payload: dict[str, Any] = {
         "code": code_version(spec.analyses),
         "base": spec.base.to_dict(),
@@ -197,7 +217,9 @@ def _solve_task(spec: StudySpec, assignment: dict[str, float], values: list[floa
             _save(writer, keys[i], rec)
             tick(1)
 
-        return solve_gaits(spec, assignment, values, seeds=seeds, cached=cached, emit=emit)
+        solve = solve_gaits if spec.model == "tslip" else spatial_point.solve_gaits
+        return solve(spec, assignment, values, seeds=seeds, cached=cached,  # type: ignore[return-value]
+                     emit=emit)
 
 
 def _analyse_task(spec: StudySpec, items: list[Pending], keys: list[str], cache: str | None,
@@ -205,9 +227,11 @@ def _analyse_task(spec: StudySpec, items: list[Pending], keys: list[str], cache:
     """Analyse solved points, caching each record as it is final (in workers)."""
     tick = tick or _pool.notify
     out = []
+    analyse: Callable[[StudySpec, Any], dict[str, Any]] = (
+        analyse_point if spec.model == "tslip" else spatial_point.analyse_point)
     with _writer(cache) as writer:
         for item, key in zip(items, keys):
-            rec = analyse_point(spec, item)
+            rec = analyse(spec, item)
             _save(writer, key, rec)
             tick(1)
             out.append(rec)
@@ -245,7 +269,13 @@ class StudyResult(FrameTable, Result):
 
     def to_dataframe(self) -> pd.DataFrame:
         """The table: one row per point, axes first (units of the axes and the results)."""
-        units = {**STUDY_UNITS, **{a.param: param_unit(a.param) or "-" for a in self.spec.axes}}
+        base = self.spec.base
+        if isinstance(base, spatial_spec.SpatialBase):
+            units = {**spatial_point.UNITS, **{a.param: base.unit(a.param)
+                                               for a in self.spec.axes}}
+        else:
+            units = {**STUDY_UNITS, **{a.param: param_unit(a.param) or "-"
+                                       for a in self.spec.axes}}
         return with_units(self.frame.copy(), units)
 
     def plot(self, ax: Axes | None = None) -> Figure:
@@ -324,7 +354,9 @@ def _run(spec: StudySpec, out: Path | None, n_workers: int | None, scheduler: st
     timing: dict[Hashable, tuple[float, float, Hashable]] = {}
     run_tasks(job.start(), job.on_done, workers, tick=job.tick, timing=timing,
               scheduler=scheduler,
-              preload=["tslip.sweeps._prewarm"])  # compiles missing kernels once, pre-fork
+              # compiles the planar kernels missing from numba's cache once, pre-fork (a 3-D
+              # study runs none of them)
+              preload=["tslip.sweeps._prewarm"] if spec.model == "tslip" else [])
     return job.result(workers, scheduler, csv, timing)
 
 
@@ -373,7 +405,9 @@ class StudyJob:
         self.pred, self.succ = _chains(spec)
         self.inner = spec.axes[-1].param
         self.seeds: list[dict[float, dict[str, float]] | None] = [None] * len(self.plan)
-        self.per_point = sum(COST_SECONDS[a] for a in set(spec.analyses))
+        self.costs = (COST_SECONDS if spec.model == "tslip"
+                      else spatial_point.COST_SECONDS[spec.model])
+        self.per_point = sum(self.costs[a] for a in set(spec.analyses))
         self.depth = [0] * len(self.plan)
         for i in sorted(range(len(self.plan)), key=self._chain_index, reverse=True):
             self.depth[i] = 1 + max((self.depth[j] for j in self.succ[i]), default=0)
@@ -394,7 +428,7 @@ class StudyJob:
     @property
     def cost(self) -> float:
         """Estimated seconds of the work left."""
-        return self.missing * (COST_SECONDS["solve"] + self.per_point)
+        return self.missing * (self.costs["solve"] + self.per_point)
 
     def tick(self, n: int) -> None:
         """``n`` more points are final."""
@@ -430,7 +464,7 @@ class StudyJob:
         p = self.pred[i]
         seeds = None if p is None else self.seeds[p]
         n_new = len(values) - len(cached)
-        cost = n_new * COST_SECONDS["solve"]
+        cost = n_new * self.costs["solve"]
         chunk = min(n_new * self.per_point, max(CHUNK_SECONDS, self.per_point))
         return Task((self.spec.name, "solve", i), _solve_task,
                     (self.spec, assignment, values, keys, cached, seeds, self._cache_arg()),
@@ -493,12 +527,13 @@ class StudyJob:
         frame = pd.DataFrame([by_point[pt] for pt in _points(spec)])
         frame = frame.drop(columns=[c for c in frame.columns if c.startswith("_")])
         meta = {
-            "tslip_version": __version__, "code": code_version(spec.analyses), "git": git_hash(),
+            "tslip_version": __version__, "code": _code(spec), "git": git_hash(),
             "study": spec.to_dict(), "points": self.n_total,
             "computed": self.n_total - self.n_cached, "cached": self.n_cached,
             "seconds": self.load_seconds + own_seconds(timing or {}, (spec.name,)),
             "workers": workers,
-            "scheduler": scheduler, "tol": gait_tol(spec),
+            "scheduler": scheduler,
+            **({"tol": gait_tol(spec)} if spec.model == "tslip" else {"model": spec.model}),
         }
         if out is not None:
             write_table(frame, out / "results.parquet")
@@ -519,8 +554,10 @@ def _chains(spec: StudySpec) -> tuple[list[int | None], list[list[int]]]:
     n = len(spec.lines())
     if len(spec.axes) == 1:
         return [None], [[]]
+    if spec.model != "tslip":  # 3-D points are independent: so are the lines
+        return [None] * n, [[] for _ in range(n)]
     outer = np.asarray(spec.axes[0].values)
-    i0 = int(np.argmin(np.abs(outer - get_param(spec.base, spec.axes[0].param))))
+    i0 = int(np.argmin(np.abs(outer - get_param(spec.base, spec.axes[0].param))))  # type: ignore[arg-type]
     pred: list[int | None] = [i + 1 if i < i0 else i - 1 for i in range(n)]
     pred[i0] = None
     succ: list[list[int]] = [[] for _ in range(n)]

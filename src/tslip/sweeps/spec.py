@@ -20,14 +20,19 @@ the last axis per value of the first). Specs come from code or from TOML::
     from = -1.0
     to = 1.0
     points = 50                    # or: values = [0.1, 0.2, 0.5]
+
+``model`` (default ``"tslip"``, the planar model above) names another model: the 3-D
+ones, ``"slip3d"`` and ``"tslip3d"`` (:mod:`tslip.sweeps.spatial_spec`), register
+themselves in :data:`MODELS`; a spec naming one of their presets needs no ``model``.
+Their base is a :class:`ModelBase` instead of :class:`Params`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -36,7 +41,8 @@ from .._io import read_toml
 from ..gait.continuation import get_param, set_param
 from ..model.parameters import Params, preset
 
-__all__ = ["Axis", "StudySpec", "ANALYSES", "name_list", "read_spec", "spec_header"]
+__all__ = ["Axis", "StudySpec", "ANALYSES", "MODELS", "MODEL_PRESETS", "ModelBase",
+           "name_list", "read_spec", "spec_header"]
 
 #: Analyses a study can run at each point. ``floquet`` is always run.
 ANALYSES = ("floquet", "robustness", "stride")
@@ -46,6 +52,40 @@ TOLERANCES: dict[str, tuple[float, float]] = {"tol": (1e-14, 1e-4), "neutral_tol
 #: Memory one study point holds at least: its value and one result row (about 20 numbers
 #: and their labels in a table).
 _POINT_BYTES = 1000.0
+
+
+class ModelBase(Protocol):
+    """The base parameters of a study of a model other than the planar TSLIP.
+
+    ``model`` names it, ``analyses`` are those its studies can run, ``get`` and
+    ``set`` read and change one swept parameter (``set`` checks the value: a
+    one-line ``ValueError`` naming it and its allowed range), ``to_dict`` is
+    every value (the TOML form, and part of the cache key).
+    """
+
+    @property
+    def model(self) -> str: ...
+    @property
+    def analyses(self) -> tuple[str, ...]: ...
+    def get(self, name: str) -> float: ...
+    def set(self, name: str, value: float) -> ModelBase: ...
+    def to_dict(self) -> dict[str, Any]: ...
+
+
+#: The models besides the planar ``"tslip"``: name -> ``reader(preset, overrides)``, the
+#: base of a spec naming that model (``preset`` None: the model's default). Filled by the
+#: models' modules when :mod:`tslip.sweeps` is imported (:mod:`.spatial_spec`).
+MODELS: dict[str, Callable[[str | None, dict[str, Any]], ModelBase]] = {}
+#: Presets of those models -> the model (a spec naming one needs no ``model`` key).
+MODEL_PRESETS: dict[str, str] = {}
+
+
+def _get(base: Params | ModelBase, name: str) -> float:
+    return get_param(base, name) if isinstance(base, Params) else base.get(name)
+
+
+def _set(base: Params | ModelBase, name: str, value: float) -> Any:
+    return set_param(base, name, value) if isinstance(base, Params) else base.set(name, value)
 
 
 def read_spec(path: str | Path, what: str) -> dict[str, Any]:
@@ -62,6 +102,12 @@ def spec_header(data: dict[str, Any], what: str, keys: set[str]) -> tuple[str, P
     ``params``; any other key is a one-line error naming the allowed ones. The base is
     ``preset`` (default ``table2.1``) with the ``[params]`` overrides.
     """
+    name, overrides = _header(data, what, keys)
+    return name, Params.from_dict(overrides, base=preset(data.get("preset", "table2.1")))
+
+
+def _header(data: dict[str, Any], what: str, keys: set[str]) -> tuple[str, dict[str, Any]]:
+    """:func:`spec_header`'s checks: the name and the ``[params]`` overrides."""
     allowed = {"name", "description", "preset", "params", *keys}
     unknown = set(data) - allowed
     if unknown:
@@ -76,7 +122,20 @@ def spec_header(data: dict[str, Any], what: str, keys: set[str]) -> tuple[str, P
         raise ValueError(f"{what} [params] must be a table")
     if "preset" in overrides:
         raise ValueError(f"{what} {name}: give preset at the top level, not in [params]")
-    return name, Params.from_dict(overrides, base=preset(data.get("preset", "table2.1")))
+    return name, overrides
+
+
+def _model(data: dict[str, Any]) -> str:
+    """The model a study's TOML form names (popping ``model``): ``"tslip"`` by default,
+    or the model of a preset in :data:`MODEL_PRESETS`."""
+    allowed = ["tslip", *MODELS]
+    model = data.pop("model", None)
+    if model is not None and not (isinstance(model, str) and model in allowed):
+        raise ValueError(f"study model must be one of {allowed}, got {model!r}")
+    named = data.get("preset")
+    if model is None:
+        return MODEL_PRESETS.get(named, "tslip") if isinstance(named, str) else "tslip"
+    return str(model)
 
 
 def name_list(value: Any, field: str, allowed: Sequence[str]) -> tuple[str, ...]:
@@ -142,12 +201,13 @@ class StudySpec:
     name : str
         Identifier; also the folder name of its results: a letter or digit, then up to 63
         letters, digits, "_", "." or "-" (:data:`tslip._checks.NAME_RULE`).
-    base : Params
-        Parameters at every point except the swept ones.
+    base : Params or ModelBase
+        Parameters at every point except the swept ones: a :class:`Params` (the planar
+        TSLIP) or another model's :class:`ModelBase` (:data:`MODELS`).
     axes : tuple of Axis
         One or two axes. The last is the continuation axis.
     analyses : tuple of str
-        Subset of :data:`ANALYSES`.
+        Subset of :data:`ANALYSES` (another model: of its ``base.analyses``).
     n_steps : int
         Strides a disturbed run must survive (robustness, Section 3.1.3).
     description : str
@@ -155,7 +215,7 @@ class StudySpec:
     """
 
     name: str
-    base: Params
+    base: Params | ModelBase
     axes: tuple[Axis, ...]
     analyses: tuple[str, ...] = ("floquet",)
     n_steps: int = 25
@@ -169,25 +229,35 @@ class StudySpec:
         names = [a.param for a in self.axes]
         if len(set(names)) != len(names):
             raise ValueError(f"study {self.name}: an axis is given twice: {names}")
-        bad = set(self.analyses) - set(ANALYSES)
+        bad = set(self.analyses) - set(self.allowed_analyses)
         if bad:
             raise ValueError(f"study {self.name}: unknown analysis {sorted(bad)[0]!r}; "
-                             f"allowed: {list(ANALYSES)}")
+                             f"allowed: {list(self.allowed_analyses)}")
         check_number(self.n_steps, f"study {self.name}: n_steps", lower=1, integer=True)
         check_fits(self.n_points, _POINT_BYTES, f"study {self.name}: points", "its results")
         for axis in self.axes:
             if not axis.values:
                 raise ValueError(f"axis {axis.param}: empty range")
-            get_param(self.base, axis.param)  # unknown names raise here
+            _get(self.base, axis.param)  # unknown names raise here
         # every value must give valid parameters (e.g. no negative stiffness)
         for axis in self.axes:
             for v in (axis.values[0], axis.values[-1]):
                 try:
-                    set_param(self.base, axis.param, v)
+                    _set(self.base, axis.param, v)
                 except ValueError as exc:
                     raise ValueError(f"axis {axis.param}: {exc}") from None
 
     # -- points -------------------------------------------------------------
+    @property
+    def model(self) -> str:
+        """``"tslip"`` (the planar model, a :class:`Params` base) or another model's name."""
+        return "tslip" if isinstance(self.base, Params) else self.base.model
+
+    @property
+    def allowed_analyses(self) -> tuple[str, ...]:
+        """The analyses a study of this model can run."""
+        return ANALYSES if isinstance(self.base, Params) else self.base.analyses
+
     @property
     def shape(self) -> tuple[int, ...]:
         """Number of values per axis."""
@@ -205,12 +275,13 @@ class StudySpec:
             return [({}, inner)]
         return [({self.axes[0].param: v}, inner) for v in self.axes[0].values]
 
-    def params_at(self, assignment: dict[str, float]) -> Params:
-        """Base parameters with the given axis values applied, in axis order."""
-        p = self.base
+    def params_at(self, assignment: dict[str, float]) -> Any:
+        """Base parameters with the given axis values applied, in axis order (of the
+        base's type: :class:`Params` for the planar model)."""
+        p: Any = self.base
         for axis in self.axes:
             if axis.param in assignment:
-                p = set_param(p, axis.param, assignment[axis.param])
+                p = _set(p, axis.param, assignment[axis.param])
         return p
 
     def with_resolution(self, points: Sequence[int]) -> StudySpec:
@@ -223,8 +294,9 @@ class StudySpec:
     # -- serialisation ----------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         """Plain dict (the TOML form, with the full base parameters)."""
+        model = {} if isinstance(self.base, Params) else {"model": self.base.model}
         return {
-            "name": self.name, "description": self.description,
+            "name": self.name, **model, "description": self.description,
             "analyses": list(self.analyses), "n_steps": self.n_steps,
             **{k: self.meta[k] for k in TOLERANCES if k in self.meta},
             "params": self.base.to_dict(),
@@ -235,7 +307,14 @@ class StudySpec:
     def from_dict(cls, data: dict[str, Any]) -> StudySpec:
         """Build from the TOML form (see the module docstring)."""
         data = dict(data)
-        name, base = spec_header(data, "study", {"axis", "analyses", "n_steps", *TOLERANCES})
+        model = _model(data)
+        base: Params | ModelBase
+        if model == "tslip":
+            name, base = spec_header(data, "study",
+                                     {"axis", "analyses", "n_steps", *TOLERANCES})
+        else:  # the tolerances are the planar gait search's and Floquet's
+            name, overrides = _header(data, "study", {"axis", "analyses", "n_steps"})
+            base = MODELS[model](data.get("preset"), overrides)
         meta = {k: check_number(data[k], f"study {name}: {k}", lower=lo, upper=hi)
                 for k, (lo, hi) in TOLERANCES.items() if k in data}
         axes_data = data.get("axis")
@@ -243,7 +322,7 @@ class StudySpec:
             raise ValueError(f"study {name}: needs at least one [[axis]]")
         axes = tuple(Axis.from_dict(a) for a in axes_data)
         analyses = name_list(data.get("analyses", ["floquet"]), f"study {name}: analyses",
-                             ANALYSES)
+                             ANALYSES if isinstance(base, Params) else base.analyses)
         return cls(name=name, base=base, axes=axes, analyses=analyses,
                    n_steps=data.get("n_steps", 25),
                    description=str(data.get("description", "")), meta=meta)
