@@ -418,7 +418,9 @@ def _end_status(phase, which):
 @njit(**_JIT)
 def _locate(P, method, phase, t, h, y, ynew, K, Rd, R, o, ytmp, gv_old, gv_new, gv_tmp, st):
     """The first event in the accepted step ``y -> ynew`` of size ``h`` at ``t``: its
-    fraction ``theta`` of the step (2 if none) and which; the state there into ``ytmp``."""
+    fraction ``theta`` of the step (2 if none) and which; the state there into ``ytmp``.
+    Each crossing is located by Illinois on the dense output to a bracket of 1e-15 or an
+    exact zero of the event function."""
     n = NSTATE
     ns = _rk.n_stages(method)
     for s in range(ns + 1, ns + 1 + _rk.n_extra(method)):
@@ -434,7 +436,9 @@ def _locate(P, method, phase, t, h, y, ynew, K, Rd, R, o, ytmp, gv_old, gv_new, 
                 c = _rk.root_guess(st)
                 _rk.dense_eval(method, Rd, c, ytmp)
                 events(P, phase, t + c * h, ytmp, gv_tmp, R, o)
-                if _rk.root_update(st, c, gv_tmp[ev], 1e-15):
+                # an exact zero is the root (it closes the bracket at c): stop there, where
+                # Illinois would bisect on (halving a zero end value leaves it 0)
+                if _rk.root_update(st, c, gv_tmp[ev], 1e-15) or gv_tmp[ev] == 0.0:
                     break
             if st[1] < theta_ev - 1e-9:
                 theta_ev = st[1]

@@ -116,9 +116,7 @@ class TrunkTouchdown:
         the ground): the checks and copies of ``__init__`` skipped (they cost more than a
         tenth of a stride)."""
         td = object.__new__(cls)
-        object.__setattr__(td, "y", y)
-        object.__setattr__(td, "foot", foot)
-        object.__setattr__(td, "side", side)
+        td.__dict__.update(y=y, foot=foot, side=side)  # frozen: its fields live in __dict__
         return td
 
 
@@ -147,24 +145,35 @@ def rotation(y: np.ndarray) -> np.ndarray:
 
 
 _DEFAULT_O = IntegratorOptions().packed()
-#: The last parameters packed, for both sides (a stride map calls with the same object).
-_LAST: tuple[TrunkParams | None, np.ndarray, np.ndarray] = (None, _DEFAULT_O, _DEFAULT_O)
+#: The last options and parameters packed (parameters for both sides): the stride's
+#: callers repeat the same objects, and packing cost a tenth of a stride. Both are
+#: frozen; the kernel does not write into the arrays. Each a tuple, read once a call.
+_LAST_O: tuple[IntegratorOptions | None, np.ndarray] = (None, _DEFAULT_O)
+_LAST_P: tuple[TrunkParams | None, np.ndarray, np.ndarray] = (None, _DEFAULT_O, _DEFAULT_O)
 _NO_ROWS = np.empty((0, 1 + kn.NSTATE))
 #: The statuses that come with the next touch-down: a stride, and a leg landing across.
 _LANDED = (TrunkStatus.OK, TrunkStatus.FALL_CROSSED_LEG)
+_STATUS = {int(s): s for s in TrunkStatus}
 
 
 def _options(options: IntegratorOptions | None) -> np.ndarray:
-    return _DEFAULT_O if options is None else options.packed()
+    global _LAST_O
+    if options is None:
+        return _DEFAULT_O
+    last = _LAST_O
+    if last[0] is not options:
+        last = (options, options.packed())
+        _LAST_O = last
+    return last[1]
 
 
 def _packed(params: TrunkParams, side: int) -> np.ndarray:
-    """``params.packed(side)``, kept for the last ``params`` (frozen; the kernel copies it)."""
-    global _LAST
-    last = _LAST  # one read: another thread may replace it
+    """``params.packed(side)``, kept for the last ``params``."""
+    global _LAST_P
+    last = _LAST_P
     if last[0] is not params:
         last = (params, params.packed(1), params.packed(-1))
-        _LAST = last
+        _LAST_P = last
     return last[1] if side == 1 else last[2]
 
 
@@ -182,7 +191,7 @@ def _stride(params: TrunkParams, state: TrunkTouchdown, options: IntegratorOptio
     rec = np.empty((rows, 1 + kn.NSTATE)) if rows else _NO_ROWS
     status = ks.stride(_packed(params, state.side), _options(options), state.y, state.foot,
                        fly, rec, out)
-    return TrunkStatus(status), out, rec
+    return _STATUS[status], out, rec
 
 
 def trunk_stance(params: TrunkParams, state: TrunkTouchdown, *,
