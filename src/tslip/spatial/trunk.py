@@ -144,6 +144,19 @@ def rotation(y: np.ndarray) -> np.ndarray:
     return R
 
 
+def _heading(R: np.ndarray) -> np.ndarray:
+    """The trunk's horizontal heading (unit), for Python callers (the kernel's twin:
+    :func:`tslip.spatial._trunk_stride.heading`)."""
+    h = np.array([R[0, 0], 0.0, R[2, 0]])
+    return h / math.hypot(h[0], h[2])
+
+
+def _crossed(side: int, foot: np.ndarray, c: np.ndarray, h: np.ndarray) -> bool:
+    """The foot on the far side of the mid-plane: ``s (p - c) . n < 0``, ``n = h x e_y``
+    (the kernel's twin: :func:`tslip.spatial._trunk_stride.crossed`)."""
+    return side * (-(foot[0] - c[0]) * h[2] + (foot[2] - c[2]) * h[0]) < 0.0
+
+
 _DEFAULT_O = IntegratorOptions().packed()
 #: The last options and parameters packed (parameters for both sides): the stride's
 #: callers repeat the same objects, and packing cost a tenth of a stride. Both are
