@@ -17,7 +17,8 @@ Part 2, the TSLIP in three dimensions (docs/analyses/spatial_tslip.md):
 * :mod:`.trunk_section`: the 10-D touch-down section (:data:`TRUNK_SECTION_NAMES`), its
   mirror, left-right symmetric gaits (:func:`symmetric_gait`) and the two-step map and
   its Jacobian by central differences;
-* :mod:`._trunk_kernels`: the compiled stance and flight loop on the same core.
+* :mod:`._trunk_kernels`: the compiled stance and flight loop on the same core;
+  :mod:`._trunk_stride`: the whole stride as one compiled kernel on it.
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ State ``y`` (:data:`NSTATE` = 13), in both phases::
 
 ``R(q)`` has the trunk's axes as columns: ``x_b`` forward, ``y_b`` along the
 trunk from the CoM to the hip, ``z_b`` right. The quaternion is renormalised
-wherever ``R`` is formed, and between phases by :mod:`.trunk`.
+wherever ``R`` is formed, and between phases by the stride (:mod:`._trunk_stride`).
 
 Stance (foot fixed at ``p`` on the ground, ``y_p = 0``): hip ``H = c + r y_b``,
 leg ``l u = p - H`` (``u`` hip -> foot), ``ldot = -u . Hdot``. The compressive
