@@ -6,6 +6,7 @@ control, event detection, event location, dense output) instead of one loop of
 cyclomatic complexity 59 and 56. Radon's grade C is a complexity of at most 20.
 Issue 41 extended the check to every module of ``simulation/`` (a glob, so a new
 module is covered without editing this file), closures at any depth included.
+The 3-D TSLIP's phase loop and stride (issue 43) are graded too.
 The files are read from the checkout, as CONTRIBUTING's file-map test does.
 """
 
@@ -16,7 +17,7 @@ from radon.complexity import cc_rank, cc_visit
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "tslip"
 KERNELS = sorted(f.relative_to(SRC).as_posix() for f in (SRC / "simulation").glob("*.py"))
-KERNELS.append("biped/_stride.py")
+KERNELS += ["biped/_stride.py", "spatial/_trunk_kernels.py", "spatial/_trunk_stride.py"]
 
 
 def _closures(block):
@@ -34,7 +35,7 @@ def _blocks(path: Path):
 def test_every_simulation_module_is_graded() -> None:
     """The glob finds the simulator's modules (an empty or wrong folder would pass vacuously)."""
     for name in ("simulation/_stride.py", "simulation/_flight.py", "simulation/integrate.py",
-                 "simulation/_variational.py", "biped/_stride.py"):
+                 "simulation/_variational.py", "biped/_stride.py", "spatial/_trunk_stride.py"):
         assert name in KERNELS
     assert all((SRC / name).is_file() for name in KERNELS)
 

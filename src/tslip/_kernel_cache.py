@@ -44,7 +44,8 @@ SOURCES: tuple[str, ...] = (
     "simulation/_variational.py",
     "biped/_pack.py", "biped/_jit.py", "biped/_tmt.py", "biped/_control.py", "biped/_contact.py",
     "biped/_rhs.py", "biped/_events.py", "biped/_stride.py", "biped/_kernels.py", "_nrt.py",
-    "spatial/_kernels.py", "spatial/_trunk_kernels.py", "spatial/_trunk_variational.py",
+    "spatial/_kernels.py", "spatial/_trunk_kernels.py", "spatial/_trunk_stride.py",
+    "spatial/_trunk_variational.py",
 )
 
 

@@ -21,7 +21,8 @@ Part 2, the TSLIP in three dimensions (docs/analyses/spatial_tslip.md):
   with the event-time corrections; the compiled part in :mod:`._trunk_variational`);
 * :mod:`.trunk_run`: a recorded multi-stride run (:func:`trunk_run`, :class:`TrunkRun`),
   drawn in a front and a side view by :mod:`tslip.plotting.spatial`;
-* :mod:`._trunk_kernels`: the compiled stance and flight loop on the same core.
+* :mod:`._trunk_kernels`: the compiled stance and flight loop on the same core;
+  :mod:`._trunk_stride`: the whole stride as one compiled kernel on it.
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ State ``y`` (:data:`NSTATE` = 13), in both phases::
 
 ``R(q)`` has the trunk's axes as columns: ``x_b`` forward, ``y_b`` along the
 trunk from the CoM to the hip, ``z_b`` right. The quaternion is renormalised
-wherever ``R`` is formed, and between phases by :mod:`.trunk`.
+wherever ``R`` is formed, and between phases by the stride (:mod:`._trunk_stride`).
 
 Stance (foot fixed at ``p`` on the ground, ``y_p = 0``): hip ``H = c + r y_b``,
 leg ``l u = p - H`` (``u`` hip -> foot), ``ldot = -u . Hdot``. The compressive
@@ -69,13 +69,15 @@ from ..simulation._rk import _INLINE, _JIT
 (P_M, P_J, P_JROLL, P_JYAW, P_R, P_K, P_L0, P_G, P_CL, P_NEXP, P_THRUST, P_OMEGA, P_ALPHA,
  P_SPLAY, P_GLOBAL, P_STOP, P_KSPLAY, P_KTRAIL, P_C0) = range(19)
 #: Per-phase slots: side, foot (x, y, z), current rest length, thrust pending (1/0),
-#: retraction clock start after lift-off
+#: retraction clock start after lift-off; then whether the retraction clock starts at the
+#: apex (1/0: ``retraction="apex"``; read by the stride, :mod:`._trunk_stride`)
 P_SIDE = P_C0 + 4
 P_FOOT = P_SIDE + 1
 P_LREST = P_FOOT + 3
 P_PENDING = P_LREST + 1
 P_TA = P_PENDING + 1
-NP = P_TA + 1
+P_APEX = P_TA + 1
+NP = P_APEX + 1
 
 NSTATE = 13
 STANCE, FLIGHT = 0, 1
@@ -145,8 +147,7 @@ def spring_force(P, l):
 def liftoff_on_spring(P):
     """The planar rule: lift-off located as ``l_rest - l`` for ``n != 1``, ``c_l = 0`` and
     no torque."""
-    return (P[P_NEXP] != 1.0 and P[P_CL] == 0.0 and P[P_C0] == 0.0 and P[P_C0 + 1] == 0.0
-            and P[P_C0 + 2] == 0.0 and P[P_C0 + 3] == 0.0)
+    return P[P_NEXP] != 1.0 and P[P_CL] == 0.0 and not has_torque(P)
 
 
 @njit(**_INLINE)
@@ -158,7 +159,8 @@ def _cross(a0, a1, a2, b0, b1, b2):
 def stance_terms(P, y, R, o):
     """The stance's forces at ``y`` into ``o`` (16): foot force ``F`` (3), torque about the
     CoM ``T`` (3), ``u`` (3), ``l``, ``ldot``, ``tau``, ``F_l``, ``alpha``, ``alphad``,
-    ``theta``."""
+    ``theta`` (the last three NaN, and ``tau`` 0, for a controller without torque: the
+    right-hand side skips the angles then)."""
     rotation(y, R)
     r = P[P_R]
     ww0 = R[0, 0] * y[10] + R[0, 1] * y[11] + R[0, 2] * y[12]
@@ -174,7 +176,36 @@ def stance_terms(P, y, R, o):
     hd0, hd1, hd2 = y[3] + c0, y[4] + c1, y[5] + c2
     ld = -(u0 * hd0 + u1 * hd1 + u2 * hd2)
     fl = spring_force(P, l) - P[P_CL] * ld
-    # hip angle in the trunk's sagittal plane and its rate
+    F0, F1, F2 = -fl * u0, -fl * u1, -fl * u2
+    t0, t1, t2 = _cross(ry0, ry1, ry2, F0, F1, F2)
+    tau = 0.0
+    o[13], o[14], o[15] = math.nan, math.nan, math.nan
+    if has_torque(P):
+        tau = _torque(P, R, y, u0, u1, u2, l, ld, hd0, hd1, hd2, ww0, ww1, ww2, o)
+        zu = R[0, 2] * u0 + R[1, 2] * u1 + R[2, 2] * u2
+        tp0, tp1, tp2 = (tau * (R[0, 2] - zu * u0), tau * (R[1, 2] - zu * u1),
+                         tau * (R[2, 2] - zu * u2))
+        m0, m1, m2 = _cross(tp0, tp1, tp2, u0, u1, u2)
+        F0, F1, F2 = F0 + m0 / l, F1 + m1 / l, F2 + m2 / l
+        t0, t1, t2 = _cross(ry0, ry1, ry2, F0, F1, F2)
+        t0, t1, t2 = t0 + tp0, t1 + tp1, t2 + tp2
+    o[0], o[1], o[2] = F0, F1, F2
+    o[3], o[4], o[5] = t0, t1, t2
+    o[6], o[7], o[8] = u0, u1, u2
+    o[9], o[10], o[11], o[12] = l, ld, tau, fl
+
+
+@njit(**_INLINE)
+def has_torque(P):
+    """Whether the hip controller's law (its four coefficients) can give a torque."""
+    return (P[P_C0] != 0.0 or P[P_C0 + 1] != 0.0 or P[P_C0 + 2] != 0.0
+            or P[P_C0 + 3] != 0.0)
+
+
+@njit(**_INLINE)
+def _torque(P, R, y, u0, u1, u2, l, ld, hd0, hd1, hd2, ww0, ww1, ww2, o):
+    """The hip torque ``tau`` of the controllers' law (module docstring); the hip angle
+    ``alpha``, its rate and the pitch into ``o[13:16]``."""
     ub0 = R[0, 0] * u0 + R[1, 0] * u1 + R[2, 0] * u2
     ub1 = R[0, 1] * u0 + R[1, 1] * u1 + R[2, 1] * u2
     ub2 = R[0, 2] * u0 + R[1, 2] * u1 + R[2, 2] * u2
@@ -183,21 +214,10 @@ def stance_terms(P, y, R, o):
     ubd0 = R[0, 0] * ud0 + R[1, 0] * ud1 + R[2, 0] * ud2 - wc0
     ubd1 = R[0, 1] * ud0 + R[1, 1] * ud1 + R[2, 1] * ud2 - wc1
     X, Y, Xd, Yd = ub0, -ub1, ubd0, -ubd1
-    alpha = math.atan2(Y, X)
     alphad = (X * Yd - Y * Xd) / (X * X + Y * Y)
-    ww = (ww0, ww1, ww2)
-    th, thd = pitch(R, ww)
-    tau = P[P_C0] + P[P_C0 + 1] * th + P[P_C0 + 2] * (alphad - thd) + P[P_C0 + 3] * thd
-    zu = R[0, 2] * u0 + R[1, 2] * u1 + R[2, 2] * u2
-    tp0, tp1, tp2 = tau * (R[0, 2] - zu * u0), tau * (R[1, 2] - zu * u1), tau * (R[2, 2] - zu * u2)
-    m0, m1, m2 = _cross(tp0, tp1, tp2, u0, u1, u2)
-    F0, F1, F2 = -fl * u0 + m0 / l, -fl * u1 + m1 / l, -fl * u2 + m2 / l
-    t0, t1, t2 = _cross(ry0, ry1, ry2, F0, F1, F2)
-    o[0], o[1], o[2] = F0, F1, F2
-    o[3], o[4], o[5] = t0 + tp0, t1 + tp1, t2 + tp2
-    o[6], o[7], o[8] = u0, u1, u2
-    o[9], o[10], o[11], o[12] = l, ld, tau, fl
-    o[13], o[14], o[15] = alpha, alphad, th
+    th, thd = pitch(R, (ww0, ww1, ww2))
+    o[13], o[14], o[15] = math.atan2(Y, X), alphad, th
+    return P[P_C0] + P[P_C0 + 1] * th + P[P_C0 + 2] * (alphad - thd) + P[P_C0 + 3] * thd
 
 
 @njit(**_INLINE)
@@ -284,6 +304,16 @@ def events(P, phase, t, y, gv, R, o):
     """The phase's event functions at ``y``, ``t`` into the phase (module docstring)."""
     if phase == STANCE:
         stance_terms(P, y, R, o)
+    else:
+        rotation(y, R)
+    events_at(P, phase, t, y, gv, R, o)
+
+
+@njit(**_INLINE)
+def events_at(P, phase, t, y, gv, R, o):
+    """:func:`events` with ``R`` (and, in stance, ``o`` of :func:`stance_terms`) already
+    computed at ``y``, as :func:`rhs` leaves them: a step's end needs no second pass."""
+    if phase == STANCE:
         l = o[9]
         gv[EV_LIFTOFF] = P[P_LREST] - l if liftoff_on_spring(P) else o[1]
         gv[EV_HIP] = y[1] + P[P_R] * R[1, 1]
@@ -293,7 +323,6 @@ def events(P, phase, t, y, gv, R, o):
         gv[EV_COLLAPSE] = l - L_COLLAPSE * P[P_L0]
         gv[EV_SWITCH] = -o[10] if P[P_PENDING] != 0.0 else 1.0
     else:
-        rotation(y, R)
         hip_y = y[1] + P[P_R] * R[1, 1]
         d = o[0:3]
         leg_direction(P, R, t, d)
@@ -301,6 +330,30 @@ def events(P, phase, t, y, gv, R, o):
         gv[EV_HIP] = hip_y
         for i in range(2, NEV):
             gv[i] = 1.0
+
+
+#: Length of a phase's work array (:func:`work_views`)
+NWORK = (_rk.NK + _rk.NR) * NSTATE + 9 + 16 + 3 * NSTATE + 3 * NEV + 5
+
+
+@njit(**_INLINE)
+def work_views(W):
+    """A phase's work arrays as views of ``W`` (:data:`NWORK`): ``K``, the dense output's
+    ``Rd``, ``R`` (3 x 3), ``o`` (16), ``y``, ``ytmp``, ``ynew``, the event values old, new
+    and trial, and the root bracket ``st`` (5): one allocation a stride, not eleven a phase."""
+    a = _rk.NK * NSTATE
+    b = a + _rk.NR * NSTATE
+    K = W[0:a].reshape((_rk.NK, NSTATE))
+    Rd = W[a:b].reshape((_rk.NR, NSTATE))
+    R = W[b:b + 9].reshape((3, 3))
+    b += 9
+    o = W[b:b + 16]
+    b += 16
+    y, ytmp, ynew = W[b:b + NSTATE], W[b + NSTATE:b + 2 * NSTATE], W[b + 2 * NSTATE:b + 3 * NSTATE]
+    b += 3 * NSTATE
+    gv_old, gv_new, gv_tmp = W[b:b + NEV], W[b + NEV:b + 2 * NEV], W[b + 2 * NEV:b + 3 * NEV]
+    b += 3 * NEV
+    return K, Rd, R, o, y, ytmp, ynew, gv_old, gv_new, gv_tmp, W[b:b + 5]
 
 
 @njit(**_JIT)
@@ -316,58 +369,145 @@ def run_phase(P, O, phase, y0, tmax, out, rec):
     ``ST_OK``, the hip at the ground ``ST_FALL_NO_TOUCHDOWN``. An event searched
     earlier in the order fall, backward, lift-off/touch-down, switch wins a tie.
     """
+    return phase_loop(P, O, phase, y0, tmax, out, rec, 0, 0.0, np.empty(NWORK))
+
+
+@njit(**_INLINE)
+def _phase_start(P, O, method, phase, y, K, Rd, R, o, ytmp, gv_old):
+    """``K`` and ``Rd`` cleared, ``K[0] = f(y)``, the event values at ``y``; returns the
+    first step."""
+    for i in range(K.shape[0]):
+        for j in range(NSTATE):
+            K[i, j] = 0.0
+    for i in range(Rd.shape[0]):
+        for j in range(NSTATE):
+            Rd[i, j] = 0.0
+    rhs(P, phase, y, K[0], R, o)
+    events_at(P, phase, 0.0, y, gv_old, R, o)
+    h = O[O_H0]
+    if h <= 0.0:
+        h0, d1 = _rk.initial_probe(y, K[0], O[O_RTOL], O[O_ATOL], ytmp)
+        rhs(P, phase, ytmp, K[1], R, o)
+        h = _rk.initial_step(int(O[O_METHOD]), y, K[0], K[1], h0, d1, O[O_RTOL], O[O_ATOL])
+    return h
+
+
+@njit(**_INLINE)
+def _record(rec, nrec, t, y):
+    """Row ``nrec`` of ``rec`` is ``(t, y)`` if there is room; returns the rows used."""
+    if nrec < rec.shape[0]:
+        rec[nrec, 0] = t
+        for i in range(NSTATE):
+            rec[nrec, 1 + i] = y[i]
+        return nrec + 1
+    return nrec
+
+
+@njit(**_INLINE)
+def _end_status(phase, which):
+    """How a phase ends at the located event ``which`` (:func:`run_phase`)."""
+    if which == EV_HIP or which == EV_COLLAPSE:
+        return ST_FALL_HIP_GROUND if phase == STANCE else ST_FALL_NO_TOUCHDOWN
+    if which == EV_FORWARD:
+        return ST_FALL_BACKWARD
+    if which == EV_SWITCH:
+        return ST_SWITCH
+    return ST_OK
+
+
+@njit(**_JIT)
+def _locate(P, method, phase, t, h, y, ynew, K, Rd, R, o, ytmp, gv_old, gv_new, gv_tmp, st):
+    """The first event in the accepted step ``y -> ynew`` of size ``h`` at ``t``: its
+    fraction ``theta`` of the step (2 if none) and which; the state there into ``ytmp``.
+    Each crossing is located by Illinois on the dense output to a bracket of 1e-15 or an
+    exact zero of the event function."""
+    n = NSTATE
+    ns = _rk.n_stages(method)
+    for s in range(ns + 1, ns + 1 + _rk.n_extra(method)):
+        _rk.stage_state(method, n, y, h, K, s, ytmp)
+        rhs(P, phase, ytmp, K[s], R, o)
+    _rk.dense_coeffs(method, y, ynew, h, K, Rd)
+    theta_ev = 2.0
+    which = -1
+    for ev in (EV_HIP, EV_COLLAPSE, EV_FORWARD, EV_LIFTOFF, EV_SWITCH):
+        if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
+            _rk.root_start(st, gv_old[ev], gv_new[ev])
+            for _ in range(200):
+                c = _rk.root_guess(st)
+                _rk.dense_eval(method, Rd, c, ytmp)
+                events(P, phase, t + c * h, ytmp, gv_tmp, R, o)
+                # an exact zero is the root (it closes the bracket at c): stop there, where
+                # Illinois would bisect on (halving a zero end value leaves it 0)
+                if _rk.root_update(st, c, gv_tmp[ev], 1e-15) or gv_tmp[ev] == 0.0:
+                    break
+            if st[1] < theta_ev - 1e-9:
+                theta_ev = st[1]
+                which = ev
+    _rk.dense_eval(method, Rd, theta_ev, ytmp)
+    return theta_ev, which
+
+
+@njit(**_INLINE)
+def _guard(O, n_tried, t, tmax, h):
+    """``ST_OK`` if the phase may take another step (``n_tried`` steps taken, accepted
+    or not), else the error that stops it."""
+    if n_tried >= O[O_MAXSTEPS]:
+        return ST_ERR_MAX_STEPS
+    if t > tmax:
+        return ST_ERR_TIMEOUT
+    if h < O[O_HMIN]:
+        return ST_ERR_STEP_UNDERFLOW
+    return ST_OK
+
+
+@njit(**_INLINE)
+def _fired(gv_old, gv_new):
+    """Whether an event function crossed from > 0 to <= 0 over the step."""
+    for ev in range(NEV):
+        if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
+            return True
+    return False
+
+
+@njit(**_INLINE)
+def _probe(P, phase, y, K, d, ytmp, gv_tmp, R, o):
+    """The lift-off function at the probe ``y + d f(y)`` (``K[0] = f(y)``, the start's
+    until a first step is accepted), time ``d``: :func:`_rk.jumped_hump`'s ``g_probe``."""
+    for i in range(NSTATE):
+        ytmp[i] = y[i] + d * K[0, i]
+    events(P, phase, d, ytmp, gv_tmp, R, o)
+    return gv_tmp[0]
+
+
+@njit(**_JIT)
+def phase_loop(P, O, phase, y0, tmax, out, rec, nrec0, t0, W):
+    """:func:`run_phase` on the work array ``W`` (:data:`NWORK`), its rows into ``rec`` from
+    row ``nrec0`` on at times ``t0 + t`` (a stance continued after the thrust's switch);
+    ``out[OUT_NREC]`` counts this phase's rows."""
     n = NSTATE
     method = int(O[O_METHOD])
     rtol, atol = O[O_RTOL], O[O_ATOL]
-    ns = _rk.n_stages(method)
-    K = np.zeros((_rk.NK, n))
-    Rd = np.zeros((_rk.NR, n))
-    R = np.empty((3, 3))
-    o = np.empty(16)
-    y = y0.copy()
-    ytmp = np.empty(n)
-    ynew = np.empty(n)
-    gv_old = np.empty(NEV)
-    gv_new = np.empty(NEV)
-    gv_tmp = np.empty(NEV)
-    st = np.empty(5)
+    K, Rd, R, o, y, ytmp, ynew, gv_old, gv_new, gv_tmp, st = work_views(W)
     for i in range(out.shape[0]):
         out[i] = np.nan
-    rhs(P, phase, y, K[0], R, o)
-    h = O[O_H0]
-    if h <= 0.0:
-        h0, d1 = _rk.initial_probe(y, K[0], rtol, atol, ytmp)
-        rhs(P, phase, ytmp, K[1], R, o)
-        h = _rk.initial_step(method, y, K[0], K[1], h0, d1, rtol, atol)
-    events(P, phase, 0.0, y, gv_old, R, o)
-    d = _rk.ZERO_PROBE * h
     for i in range(n):
-        ytmp[i] = y[i] + d * K[0, i]
-    events(P, phase, d, ytmp, gv_tmp, R, o)
-    g_start, g_probe = gv_old[0], gv_tmp[0]
-    nrec = 0
-    if rec.shape[0] > 0:
-        rec[0, 0] = 0.0
-        for i in range(n):
-            rec[0, 1 + i] = y[i]
-        nrec = 1
-    first = True
+        y[i] = y0[i]
+    h = _phase_start(P, O, method, phase, y, K, Rd, R, o, ytmp, gv_old)
+    # the probe of a lift-off function starting at its zero (a ZERO_PROBE of the first
+    # step), read once if a first stance step ends at or below zero (_rk.jumped_hump)
+    g_start, g_probe, d_probe = gv_old[0], math.nan, _rk.ZERO_PROBE * h
+    hump = phase == STANCE
+    nrec = _record(rec, nrec0, t0, y)
     last_rejected = False
     t = 0.0
     nstep = 0
     nrej = 0
-    status = ST_OK
     which = -1
     while True:
-        if nstep + nrej >= O[O_MAXSTEPS]:
-            status = ST_ERR_MAX_STEPS
+        status = _guard(O, nstep + nrej, t, tmax, h)
+        if status != ST_OK:
             break
-        if t > tmax:
-            status = ST_ERR_TIMEOUT
-            break
-        if h < O[O_HMIN]:
-            status = ST_ERR_STEP_UNDERFLOW
-            break
+        ns = _rk.n_stages(method)
         for s in range(1, ns):
             _rk.stage_state(method, n, y, h, K, s, ytmp)
             rhs(P, phase, ytmp, K[s], R, o)
@@ -379,66 +519,44 @@ def run_phase(P, O, phase, y0, tmax, out, rec):
             last_rejected = True
             h *= 0.1 if not math.isfinite(err) else _rk.step_factor(method, err, 10.0)
             continue
-        events(P, phase, t + h, ynew, gv_new, R, o)
-        if phase == STANCE and first and _rk.jumped_hump(g_start, gv_new[0], g_probe):
-            nrej += 1
-            h *= _rk.HUMP_SHRINK
-            continue
-        first = False
+        events_at(P, phase, t + h, ynew, gv_new, R, o)  # R, o: the last stage's, at ynew
+        if hump and gv_new[0] <= 0.0:
+            if g_probe != g_probe:
+                g_probe = _probe(P, phase, y, K, d_probe, ytmp, gv_tmp, R, o)
+            if _rk.jumped_hump(g_start, gv_new[0], g_probe):
+                nrej += 1
+                h *= _rk.HUMP_SHRINK
+                continue
+        hump = False
         nstep += 1
-        fired = False
-        for ev in range(NEV):
-            fired = fired or (gv_old[ev] > 0.0 and gv_new[ev] <= 0.0)
-        if fired:
-            for s in range(ns + 1, ns + 1 + _rk.n_extra(method)):
-                _rk.stage_state(method, n, y, h, K, s, ytmp)
-                rhs(P, phase, ytmp, K[s], R, o)
-            _rk.dense_coeffs(method, y, ynew, h, K, Rd)
-            theta_ev = 2.0
-            for ev in (EV_HIP, EV_COLLAPSE, EV_FORWARD, EV_LIFTOFF, EV_SWITCH):
-                if gv_old[ev] > 0.0 and gv_new[ev] <= 0.0:
-                    _rk.root_start(st, gv_old[ev], gv_new[ev])
-                    for _ in range(200):
-                        c = _rk.root_guess(st)
-                        _rk.dense_eval(method, Rd, c, ytmp)
-                        events(P, phase, t + c * h, ytmp, gv_tmp, R, o)
-                        if _rk.root_update(st, c, gv_tmp[ev], 1e-15):
-                            break
-                    if st[1] < theta_ev - 1e-9:
-                        theta_ev = st[1]
-                        which = ev
-            _rk.dense_eval(method, Rd, theta_ev, ytmp)
+        if _fired(gv_old, gv_new):
+            theta_ev, which = _locate(P, method, phase, t, h, y, ynew, K, Rd, R, o, ytmp,
+                                      gv_old, gv_new, gv_tmp, st)
             for i in range(n):
                 out[OUT_Y + i] = ytmp[i]
             out[OUT_T] = t + theta_ev * h
-            if which == EV_HIP or which == EV_COLLAPSE:
-                status = ST_FALL_HIP_GROUND if phase == STANCE else ST_FALL_NO_TOUCHDOWN
-            elif which == EV_FORWARD:
-                status = ST_FALL_BACKWARD
-            elif which == EV_SWITCH:
-                status = ST_SWITCH
-            else:
-                status = ST_OK
+            status = _end_status(phase, which)
             break
         if not _rk.all_finite(n, ynew):
             status = ST_ERR_NONFINITE
             break
         t += h
         _rk.accept_step(method, n, y, ynew, K)
-        if nrec < rec.shape[0]:
-            rec[nrec, 0] = t
-            for i in range(n):
-                rec[nrec, 1 + i] = y[i]
-            nrec += 1
+        nrec = _record(rec, nrec, t0 + t, y)
         for ev in range(NEV):
             gv_old[ev] = gv_new[ev]
         fac = _rk.step_factor(method, err, 10.0)
-        if last_rejected:
-            fac = min(1.0, fac)
+        h *= min(1.0, fac) if last_rejected else fac
         last_rejected = False
-        h *= fac
+    _phase_end(status, t, y, nstep, nrej, which, nrec - nrec0, out)
+    return status
+
+
+@njit(**_INLINE)
+def _phase_end(status, t, y, nstep, nrej, which, nrec, out):
+    """``out`` of a phase (:func:`run_phase`); after an error, the last accepted state."""
     if status >= 10:
-        for i in range(n):
+        for i in range(NSTATE):
             out[OUT_Y + i] = y[i]
         out[OUT_T] = t
     out[OUT_STATUS] = status
@@ -446,7 +564,6 @@ def run_phase(P, O, phase, y0, tmax, out, rec):
     out[OUT_NREJ] = nrej
     out[OUT_EVENT] = which
     out[OUT_NREC] = nrec
-    return status
 
 
 # numba does not notice when a kernel called from another file changes; drop

@@ -42,10 +42,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model._pack import O_TMAX_FLIGHT, O_TMAX_STANCE
 from ..model.state import TouchdownState
 from ..simulation.options import IntegratorOptions
 from . import _trunk_kernels as kn
+from . import _trunk_stride as ks
 from .trunk_parameters import TrunkParams
 
 __all__ = ["TrunkStatus", "TrunkTouchdown", "TrunkStep", "trunk_step", "trunk_stance",
@@ -110,6 +110,15 @@ class TrunkTouchdown:
         """The trunk's rotation matrix (columns ``x_b, y_b, z_b`` in the world)."""
         return rotation(self.y)
 
+    @classmethod
+    def _unchecked(cls, y: np.ndarray, foot: np.ndarray, side: int) -> TrunkTouchdown:
+        """A touch-down the stride kernel computed (finite, unit quaternion, the foot on
+        the ground): the checks and copies of ``__init__`` skipped (they cost more than a
+        tenth of a stride)."""
+        td = object.__new__(cls)
+        td.__dict__.update(y=y, foot=foot, side=side)  # frozen: its fields live in __dict__
+        return td
+
 
 @dataclass(frozen=True)
 class TrunkStep:
@@ -136,45 +145,66 @@ def rotation(y: np.ndarray) -> np.ndarray:
 
 
 def _heading(R: np.ndarray) -> np.ndarray:
+    """The trunk's horizontal heading (unit), for Python callers (the kernel's twin:
+    :func:`tslip.spatial._trunk_stride.heading`)."""
     h = np.array([R[0, 0], 0.0, R[2, 0]])
     return h / math.hypot(h[0], h[2])
 
 
-_DEFAULT_O = IntegratorOptions().packed()
-
-
-def _options(options: IntegratorOptions | None) -> np.ndarray:
-    return _DEFAULT_O if options is None else options.packed()
-
-
 def _crossed(side: int, foot: np.ndarray, c: np.ndarray, h: np.ndarray) -> bool:
-    """The foot on the far side of the mid-plane: ``s (p - c) . n < 0``, ``n = h x e_y``."""
+    """The foot on the far side of the mid-plane: ``s (p - c) . n < 0``, ``n = h x e_y``
+    (the kernel's twin: :func:`tslip.spatial._trunk_stride.crossed`)."""
     return side * (-(foot[0] - c[0]) * h[2] + (foot[2] - c[2]) * h[0]) < 0.0
 
 
+_DEFAULT_O = IntegratorOptions().packed()
+#: The last options and parameters packed (parameters for both sides): the stride's
+#: callers repeat the same objects, and packing cost a tenth of a stride. Both are
+#: frozen; the kernel does not write into the arrays. Each a tuple, read once a call.
+_LAST_O: tuple[IntegratorOptions | None, np.ndarray] = (None, _DEFAULT_O)
+_LAST_P: tuple[TrunkParams | None, np.ndarray, np.ndarray] = (None, _DEFAULT_O, _DEFAULT_O)
+_NO_ROWS = np.empty((0, 1 + kn.NSTATE))
+#: The statuses that come with the next touch-down: a stride, and a leg landing across.
+_LANDED = (TrunkStatus.OK, TrunkStatus.FALL_CROSSED_LEG)
+_STATUS = {int(s): s for s in TrunkStatus}
+
+
+def _options(options: IntegratorOptions | None) -> np.ndarray:
+    global _LAST_O
+    if options is None:
+        return _DEFAULT_O
+    last = _LAST_O
+    if last[0] is not options:
+        last = (options, options.packed())
+        _LAST_O = last
+    return last[1]
+
+
+def _packed(params: TrunkParams, side: int) -> np.ndarray:
+    """``params.packed(side)``, kept for the last ``params``."""
+    global _LAST_P
+    last = _LAST_P
+    if last[0] is not params:
+        last = (params, params.packed(1), params.packed(-1))
+        _LAST_P = last
+    return last[1] if side == 1 else last[2]
+
+
 def touchdown_fall(params: TrunkParams, state: TrunkTouchdown) -> TrunkStatus:
-    """The fall a stance starts in (module docstring), else ``OK``."""
-    y, p = state.y, state.foot
-    R = rotation(y)
-    h = _heading(R)
-    if _crossed(state.side, p, y, h):
-        return TrunkStatus.FALL_CROSSED_LEG
-    if y[1] + params.r * R[1, 1] <= 0.0:
-        return TrunkStatus.FALL_HIP_GROUND
-    if float(np.dot(y[3:6], h)) < 0.0:
-        return TrunkStatus.FALL_BACKWARD
-    P = _stance_params(params, state)
-    o = np.empty(16)
-    kn.stance_terms(P, y, np.empty((3, 3)), o)
-    if o[10] > 0.0:
-        return TrunkStatus.FALL_LENGTHENING
-    return TrunkStatus.OK
-
-
-def _stance_params(params: TrunkParams, state: TrunkTouchdown) -> np.ndarray:
+    """The fall a stance starts in (module docstring), else ``OK``: the kernel's rule
+    (:func:`tslip.spatial._trunk_stride.touchdown_fall`)."""
     P = params.packed(state.side)
     P[kn.P_FOOT:kn.P_FOOT + 3] = state.foot
-    return P
+    return TrunkStatus(ks.touchdown_fall(P, state.y, np.empty((3, 3)), np.empty(16)))
+
+
+def _stride(params: TrunkParams, state: TrunkTouchdown, options: IntegratorOptions | None,
+            fly: bool, rows: int) -> tuple[TrunkStatus, np.ndarray, np.ndarray]:
+    out = np.empty(ks.NSOUT)
+    rec = np.empty((rows, 1 + kn.NSTATE)) if rows else _NO_ROWS
+    status = ks.stride(_packed(params, state.side), _options(options), state.y, state.foot,
+                       fly, rec, out)
+    return _STATUS[status], out, rec
 
 
 def trunk_stance(params: TrunkParams, state: TrunkTouchdown, *,
@@ -187,68 +217,26 @@ def trunk_stance(params: TrunkParams, state: TrunkTouchdown, *,
     rows continue in time). The touch-down's own falls are not checked here
     (:func:`trunk_step` does).
     """
-    O = _options(options)
-    P = _stance_params(params, state)
-    y = state.y.copy()
-    out = np.empty(kn.NOUT)
-    t = 0.0
-    nsteps = 0
-    recs = []
-    while True:
-        rec = np.empty((rows, 1 + kn.NSTATE))
-        status = kn.run_phase(P, O, kn.STANCE, y, O[O_TMAX_STANCE] - t, out, rec)
-        nrec = int(out[kn.OUT_NREC])
-        rec = rec[:nrec]
-        rec[:, 0] += t
-        recs.append(rec)
-        rows = max(rows - nrec, 0)
-        t += out[kn.OUT_T]
-        nsteps += int(out[kn.OUT_NSTEP])
-        y = out[kn.OUT_Y:kn.OUT_Y + kn.NSTATE].copy()
-        if status != kn.ST_SWITCH:
-            break
-        P[kn.P_LREST] = params.l0 * (1.0 + params.leg_thrust)
-        P[kn.P_PENDING] = 0.0
-    y[6:10] /= np.linalg.norm(y[6:10])
-    return TrunkStatus(status), t, y, np.concatenate(recs), nsteps
+    status, out, rec = _stride(params, state, options, False, rows)
+    y = out[ks.S_LO:ks.S_LO + kn.NSTATE].copy()
+    return status, float(out[ks.S_TS]), y, rec[:int(out[ks.S_NREC])], int(out[ks.S_NSTEP])
 
 
 def trunk_step(params: TrunkParams, state: TrunkTouchdown, *,
                options: IntegratorOptions | None = None) -> TrunkStep:
-    """One stride from the touch-down ``state`` to the other leg's touch-down."""
+    """One stride from the touch-down ``state`` to the other leg's touch-down: one call
+    of the compiled stride (:func:`tslip.spatial._trunk_stride.stride`)."""
     if not isinstance(params, TrunkParams):
         raise TypeError(f"params must be TrunkParams, got {type(params).__name__}")
-    nan = np.full(kn.NSTATE, np.nan)
-    fall = touchdown_fall(params, state)
-    if fall != TrunkStatus.OK:
-        return TrunkStep(fall, None, 0.0, 0.0, nan, 0)
-    status, ts, ylo, _, nsteps = trunk_stance(params, state, options=options)
-    if status != TrunkStatus.OK:
-        return TrunkStep(status, None, ts, 0.0, nan, nsteps)
-    if float(np.dot(ylo[3:6], _heading(rotation(ylo)))) < 0.0:
-        return TrunkStep(TrunkStatus.FALL_BACKWARD, None, ts, 0.0, ylo, nsteps)
-    side = -state.side
-    O = _options(options)
-    P = params.packed(side)
-    vy = ylo[4]
-    P[kn.P_TA] = vy / params.g if (params.retraction == "apex" and vy > 0.0) else 0.0
-    out = np.empty(kn.NOUT)
-    fst = kn.run_phase(P, O, kn.FLIGHT, ylo, O[O_TMAX_FLIGHT], out, np.empty((0, 1 + kn.NSTATE)))
-    tf = float(out[kn.OUT_T])
-    nsteps += int(out[kn.OUT_NSTEP])
-    if fst != kn.ST_OK:
-        return TrunkStep(TrunkStatus(fst), None, ts, tf, ylo, nsteps)
-    y = out[kn.OUT_Y:kn.OUT_Y + kn.NSTATE].copy()
-    y[6:10] /= np.linalg.norm(y[6:10])
-    R = rotation(y)
-    d = np.empty(3)
-    kn.leg_direction(P, R, tf, d)
-    foot = y[0:3] + params.r * R[:, 1] + params.l0 * (R @ d)
-    foot[1] = 0.0  # on the ground: the event located it there to the root's tolerance
-    td = TrunkTouchdown(y, foot, side)
-    if _crossed(side, foot, y, _heading(R)):
-        return TrunkStep(TrunkStatus.FALL_CROSSED_LEG, td, ts, tf, ylo, nsteps)
-    return TrunkStep(TrunkStatus.OK, td, ts, tf, ylo, nsteps)
+    status, out, _ = _stride(params, state, options, True, 0)
+    td = None
+    if math.isfinite(out[ks.S_TD]):  # the flight reached the next touch-down
+        td = TrunkTouchdown._unchecked(out[ks.S_TD:ks.S_TD + kn.NSTATE],
+                                       out[ks.S_FOOT:ks.S_FOOT + 3], -state.side)
+    return TrunkStep(status, td if status in _LANDED else None, float(out[ks.S_TS]),
+                     float(out[ks.S_TF]), out[ks.S_LO:ks.S_LO + kn.NSTATE],
+                     int(out[ks.S_NSTEP]))
+
 
 
 def from_planar(params: TrunkParams, td: TouchdownState, side: int = 1) -> TrunkTouchdown:

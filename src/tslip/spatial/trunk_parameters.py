@@ -124,4 +124,5 @@ class TrunkParams:
         P[kn.P_SIDE] = float(side)
         P[kn.P_LREST] = self.l0
         P[kn.P_PENDING] = 1.0 if self.leg_thrust > 0.0 else 0.0
+        P[kn.P_APEX] = 1.0 if self.retraction == "apex" else 0.0
         return P
