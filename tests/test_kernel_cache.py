@@ -102,7 +102,7 @@ def _fabricate(dirs, families, digest, skip=()):
 
 
 def test_missing_families_read_from_the_cache_folders(tmp_path):
-    dirs = {"simulation": tmp_path / "sim", "biped": tmp_path / "biped"}
+    dirs = {"simulation": tmp_path / "sim", "biped": tmp_path / "biped", "spatial": tmp_path / "3d"}
     for d in dirs.values():
         d.mkdir()
     assert kc.missing_families(dirs, "h") == list(kc.FAMILIES)  # empty: every family

@@ -100,6 +100,8 @@ FAMILIES: dict[str, tuple[str, tuple[str, ...]]] = {
     "TSLIP recorded runs": ("simulation", (
         "_record.record_run", "_stride.run_batch_serial", "_flight.flight_state")),
     "biped": ("biped", ("_stride._integrate", "_tmt.kinematics", "_control.references")),
+    "3-D spring-mass runner": ("spatial", ("_kernels.stance",)),
+    "3-D TSLIP": ("spatial", ("_trunk_stride.stride", "_trunk_variational.run_phase_var")),
 }
 
 

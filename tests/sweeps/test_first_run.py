@@ -34,12 +34,13 @@ def _run(cache: Path, mode: str) -> list[str]:
 def test_a_cold_cache_is_announced_and_a_warm_one_is_not(tmp_path):
     cold = _run(tmp_path, "announce")
     said = [s for s in cold if s.startswith("SAID ")]
-    assert len(said) == 1 and "compiling 3 kernel families" in said[0]
+    planar = {k: v for k, v in kc.FAMILIES.items() if v[0] in ("simulation", "biped")}
+    assert len(said) == 1 and f"compiling {len(planar)} kernel families" in said[0]
     for name in kc.FAMILIES:
-        assert name in said[0]
+        assert (name in said[0]) == (name in planar)  # the 3-D ones: only for 3-D studies
     # the same folders, as a warm cache (index files of every family's kernels)
     dirs = {k: Path(v) for k, v in json.loads(_run(tmp_path, "fabricate")[0]).items()}
-    for package, kernels in kc.FAMILIES.values():
+    for package, kernels in planar.values():
         dirs[package].mkdir(parents=True, exist_ok=True)
         for kernel in kernels:
             stem = kernel.split(".")[0]
@@ -259,3 +260,45 @@ def test_a_link_at_the_claim_file_is_not_followed(claims, tmp_path):
     with warmup.claim("fake") as ok:
         assert ok  # unclaimed, as when the folder cannot be written
     assert not target.exists()
+
+
+_RUN_3D = textwrap.dedent("""
+    import os
+    from tslip.sweeps.run import run_study
+    from tslip.sweeps.spec import StudySpec
+
+    if __name__ == "__main__":
+        spec = StudySpec.from_dict({
+            "name": "s3", "model": "slip3d", "analyses": ["floquet"], "params": {},
+            "axis": [{"param": "k", "values": [18.0, 20.0]},
+                     {"param": "k_lat", "values": [0.0, 1.0]}]})
+        res = run_study(spec, None, workers=2)
+        print("MAIN", os.getpid(), len(res.frame))
+""")
+
+
+@pytest.mark.slow
+def test_a_3d_study_compiles_its_kernels_once_before_its_workers(tmp_path):
+    """A 3-D study on 2 workers from an empty cache (two independent lines, one a worker):
+    its model's kernels compile in this process only, before the pool; the workers load
+    them. Without the ``ensure`` in ``run._run``, both workers compile the 3-D stance."""
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "sitecustomize.py").write_text(_RECORDER)
+    (tmp_path / "run.py").write_text(_RUN_3D)
+    log = tmp_path / "compiles.tsv"
+    src = str(Path(kc.__file__).parents[1])
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
+           "TSLIP_TEST_COMPILE_LOG": str(log),
+           "PYTHONPATH": os.pathsep.join([str(site), src])}
+    out = subprocess.run([sys.executable, str(tmp_path / "run.py")], env=env, check=True,
+                         timeout=1200, cwd=tmp_path, capture_output=True, text=True).stdout
+    main, rows = out.split("MAIN ")[1].split()
+    assert int(rows) == 4
+    where: dict[str, set[str]] = {}
+    for line in log.read_text().splitlines():
+        pid, fn, _ = line.split("\t")
+        if fn.startswith("tslip."):
+            where.setdefault(fn, set()).add(pid)
+    assert where["tslip.spatial._kernels.stance"] == {main}
+    assert all(pids == {main} for pids in where.values()), where

@@ -56,7 +56,7 @@ def study_cmd(
     command resumes with the missing points.
     """
     from ..sweeps import StudySpec, run_study
-    from ..sweeps._warmup import announce
+    from ..sweeps._warmup import MODEL_FAMILIES, announce
     from ..sweeps.run import StudyInterrupted
 
     console = make_console()
@@ -71,8 +71,11 @@ def study_cmd(
         with folder_lock(out_dir, wait=wait):  # refused (or waited for) before the bar is drawn
             check_study_folder(spec, out_dir)  # and a link where its points are saved
         t0 = time.perf_counter()
-        planar = ("simulation",) if spec.model == "tslip" else ()  # a 3-D study: no planar
-        with progress_bar("pt") as bar, announce(bar.console.print, planar):
+        if spec.model == "tslip":  # the fork server compiles both TSLIP families
+            packages, only = ("simulation",), None
+        else:  # a 3-D study: its model's family, compiled before the pool starts
+            packages, only = ("spatial",), MODEL_FAMILIES[spec.model]
+        with progress_bar("pt") as bar, announce(bar.console.print, packages, only=only):
             task = bar.add_task(f"study {spec.name}", total=spec.n_points)
             try:
                 res = run_study(spec, out_dir, workers=workers, scheduler=scheduler, csv=csv,

@@ -25,6 +25,7 @@ minute compiling. Two things make that bearable:
 
 from __future__ import annotations
 
+import copy
 import os
 import threading
 import time
@@ -96,6 +97,33 @@ def _biped() -> None:
     controller_references(params, 0.5)
 
 
+def _spatial_study(model: str) -> Callable[[], None]:
+    """A tiny 3-D study's tasks (``model`` "slip3d" or "tslip3d"), here: its gait solves and
+    multipliers, in this process."""
+
+    def run() -> None:
+        from .run import StudyJob
+        from .spec import StudySpec
+
+        spec = StudySpec.from_dict(copy.deepcopy(_SPATIAL_SPECS[model]))
+        job = StudyJob(spec, None, writes=False)
+        ready = job.start()
+        while ready:
+            task = ready.pop()
+            ready.extend(job.on_done(task, task.fn(*task.args, None)))
+
+    return run
+
+
+#: The tiny 3-D studies of :func:`_spatial_study` (one point each).
+_SPATIAL_SPECS: dict[str, dict[str, object]] = {
+    "slip3d": {"name": "warm", "model": "slip3d", "analyses": ["floquet"], "params": {},
+               "axis": [{"param": "k_lat", "values": [0.0]}]},
+    "tslip3d": {"name": "warm", "model": "tslip3d", "analyses": ["floquet"],
+                "params": {"splay": 0.05}, "axis": [{"param": "k_splay", "values": [0.0]}]},
+}
+
+
 def cache_dirs(packages: tuple[str, ...] = ("simulation", "biped")) -> dict[str, Path]:
     """numba's cache folder of the kernels of ``packages`` (imports them; compiles nothing).
 
@@ -112,6 +140,10 @@ def cache_dirs(packages: tuple[str, ...] = ("simulation", "biped")) -> dict[str,
         from ..biped import _stride as biped_stride
 
         dirs["biped"] = Path(biped_stride._integrate._cache.cache_path)
+    if "spatial" in packages:
+        from ..spatial import _trunk_stride
+
+        dirs["spatial"] = Path(_trunk_stride.stride._cache.cache_path)
     return dirs
 
 
@@ -134,7 +166,12 @@ WORKLOADS: dict[str, Callable[[], None]] = {
     "TSLIP gait search and analyses": _study_point,
     "TSLIP recorded runs": _recorded,
     "biped": _biped,
+    "3-D spring-mass runner": _spatial_study("slip3d"),
+    "3-D TSLIP": _spatial_study("tslip3d"),
 }
+#: The kernel families a 3-D study of each model runs (:func:`ensure`\ d before its pool).
+MODEL_FAMILIES: dict[str, tuple[str, ...]] = {"slip3d": ("3-D spring-mass runner",),
+                                              "tslip3d": ("3-D TSLIP",)}
 
 
 #: The families ``tslip reproduce``'s own process warms (:func:`warm_in_background`), in
@@ -296,20 +333,25 @@ def warm_in_background(families: tuple[str, ...] = MAIN_PROCESS_FAMILIES) -> thr
 
 @contextmanager
 def announce(echo: Callable[[str], None], packages: tuple[str, ...] = ("simulation", "biped"),
-             terminal: Console | None = None) -> Iterator[list[str]]:
+             terminal: Console | None = None, only: tuple[str, ...] | None = None,
+             ) -> Iterator[list[str]]:
     """Say which kernel families of ``packages`` are not compiled yet, and each as it gets cached.
 
     Prints nothing when every family is cached. Yields the missing families.
     With ``terminal`` (the console ``echo`` prints to) a terminal, one updating
     line below the others shows the seconds spent compiling, renewed every
     :data:`STATUS_SECONDS`, until the last family is cached; on anything else
-    (a pipe, a file, a log) nothing is added.
+    (a pipe, a file, a log) nothing is added. ``only``: of those families, these
+    (the ones a run will compile).
     """
     dirs, digest, missing = _missing(packages)
+    if only is not None:
+        missing = [f for f in missing if f in only]
     if not missing:
         yield []
         return
-    echo(f"first run: compiling {len(missing)} kernel families not in numba's cache yet "
+    what = "kernel family" if len(missing) == 1 else "kernel families"
+    echo(f"first run: compiling {len(missing)} {what} not in numba's cache yet "
          f"({', '.join(missing)}); later runs load them")
     t0 = time.perf_counter()
     stop = threading.Event()

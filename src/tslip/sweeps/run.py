@@ -56,7 +56,7 @@ from .._results import FrameTable, Result, with_units
 from ..gait.continuation import get_param
 from ..gait.robustness import UNITS as ROBUSTNESS_UNITS
 from ..model.units import COLUMN_UNITS, UNIT, param_unit
-from . import _pool, _store, spatial_point, spatial_spec
+from . import _pool, _store, _warmup, spatial_point, spatial_spec
 from ._lock import folder_lock
 from ._schedule import Task, Timing, choose_workers, own_seconds, run_tasks
 from .point import (
@@ -352,6 +352,8 @@ def _run(spec: StudySpec, out: Path | None, n_workers: int | None, scheduler: st
     job = StudyJob(spec, out, progress, writes=scheduler is None)
     workers = 1 if scheduler is not None else choose_workers(job.cost, n_workers)
     timing: dict[Hashable, tuple[float, float, Hashable]] = {}
+    if spec.model != "tslip" and job.missing and scheduler is None:  # 3-D: compiled here
+        _warmup.ensure(_warmup.MODEL_FAMILIES[spec.model])  # once, before any worker needs them
     run_tasks(job.start(), job.on_done, workers, tick=job.tick, timing=timing,
               scheduler=scheduler,
               # compiles the planar kernels missing from numba's cache once, pre-fork (a 3-D
