@@ -24,11 +24,17 @@ from tslip.spatial.lateral import (
     markdown,
     table21_params,
 )
+from tslip.spatial.trunk import TrunkStatus, TrunkTouchdown, trunk_step
 from tslip.spatial.trunk_robustness import lateral_limit
 from tslip.spatial.trunk_run import trunk_run
 from tslip.spatial.trunk_section import from_section
 
 P3 = table21_params()
+
+
+_td = from_section(P3, TABLE21_3D_SECTION)
+# thrown down hard enough to find no touch-down after its first stance (no next state)
+_pushed = TrunkTouchdown(_td.y - np.eye(13)[4] * 3.0, _td.foot, _td.side)
 
 
 @pytest.fixture(scope="module")
@@ -51,12 +57,17 @@ def objects():
         "LateralLimit": lateral_limit(P3, TABLE21_3D_SECTION, "yaw_rate", n_steps=4,
                                       h=0.02, max_magnitude=0.5),
         "TrunkRun": trunk_run(P3, from_section(P3, TABLE21_3D_SECTION), 3),
+        "TrunkTouchdown": _td,
+        "TrunkStep": trunk_step(P3, _td),
+        "TrunkStep, fall": trunk_step(P3, _pushed),
     }
 
 
 NAMES = ["SpatialApex", "SymmetricGait", "Multipliers", "Multipliers, fd", "LateralPoint",
-         "LateralTable, r", "LateralTable, gains", "LateralLimit", "TrunkRun"]
-NO_PLOT = {"SpatialApex", "SymmetricGait", "LateralLimit"}
+         "LateralTable, r", "LateralTable, gains", "LateralLimit", "TrunkRun", "TrunkTouchdown",
+         "TrunkStep", "TrunkStep, fall"]
+NO_PLOT = {"SpatialApex", "SymmetricGait", "LateralLimit", "TrunkTouchdown", "TrunkStep",
+           "TrunkStep, fall"}
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -184,6 +195,10 @@ def test_lateral_limit_table(objects):
     ("SpatialApex", "side", 0, "SpatialApex.side"),
     ("SymmetricGait", "params", None, "SpatialParams.k"),
     ("LateralPoint", "params", None, "TrunkParams.splay"),
+    ("TrunkTouchdown", "side", 0, "TrunkTouchdown.side"),
+    ("TrunkTouchdown", "y", [1.0, 2.0], "TrunkTouchdown.y"),
+    ("TrunkTouchdown", "y", [0.0, 1.0, 0.0, 3.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+     "not a unit quaternion"),
 ])
 def test_a_tampered_file_is_refused_in_one_line(objects, tmp_path, name, field, value, why):
     path = objects[name].save(tmp_path / "r.json")
@@ -229,3 +244,32 @@ def test_every_spatial_result_class_is_covered(objects):
 
     classes = {c.__name__ for c in subclasses(Result) if c.__module__.startswith("tslip.spatial")}
     assert classes and classes <= {type(o).__name__ for o in objects.values()}
+
+
+def test_touchdown_and_stride_tables_hold_their_fields(objects):
+    td, st, fall = objects["TrunkTouchdown"], objects["TrunkStep"], objects["TrunkStep, fall"]
+    row = td.to_dataframe().iloc[0]
+    assert [row[k] for k in ("x", "y", "z", "qw", "w_pitch")] == [td.y[0], td.y[1], td.y[2],
+                                                                 td.y[6], td.y[12]]
+    assert row["foot_x"] == td.foot[0] and row["side"] == td.side
+    assert td.to_dataframe().attrs["units"]["vz"] == "g^1/2 L^1/2"
+    srow = st.to_dataframe().iloc[0]
+    assert srow["status"] == "OK" and srow["stance_time"] == st.stance_time
+    assert srow["x"] == st.state.y[0] and srow["side"] == -td.side  # the other leg lands
+    assert srow["lo_vy"] == st.liftoff[4]
+    frow = fall.to_dataframe().iloc[0]
+    assert fall.status == TrunkStatus.FALL_NO_TOUCHDOWN and fall.state is None
+    assert frow["status"] == "FALL_NO_TOUCHDOWN"
+    assert np.isnan(frow["x"]) and np.isnan(frow["foot_z"])
+
+
+def test_a_touchdown_loads_with_its_stored_bits(tmp_path):
+    """A kernel's touch-down keeps its quaternion as computed (a unit quaternion to
+    rounding, not renormalised): the file gives it back bit for bit, though the
+    constructor would renormalise it."""
+    y = _td.y.copy()
+    y[6:10] *= 1.0 + 2.0**-50  # a unit quaternion to 1e-15, as a stride leaves it
+    td = TrunkTouchdown._unchecked(y, _td.foot.copy(), _td.side)
+    assert not np.array_equal(TrunkTouchdown(y, td.foot, td.side).y, y)  # the test's point
+    back = tslip.load(td.save(tmp_path / "td.json"))
+    assert back.y.tobytes() == y.tobytes() and back.side == td.side

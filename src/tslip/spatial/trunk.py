@@ -39,21 +39,39 @@ from __future__ import annotations
 import enum
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._results import Result, frame
 from ..model.state import TouchdownState
 from ..simulation.options import IntegratorOptions
 from . import _trunk_kernels as kn
 from . import _trunk_stride as ks
 from .trunk_parameters import TrunkParams
 
+if TYPE_CHECKING:
+    import pandas as pd
+
 __all__ = ["TrunkStatus", "TrunkTouchdown", "TrunkStep", "trunk_step", "trunk_stance",
-           "from_planar", "to_planar", "trunk_energy", "STATE_NAMES"]
+           "from_planar", "to_planar", "trunk_energy", "STATE_NAMES", "STATE_UNITS"]
 
 #: Names of the 13 state components (:mod:`tslip.spatial._trunk_kernels`).
 STATE_NAMES: tuple[str, ...] = ("x", "y", "z", "vx", "vy", "vz", "qw", "qx", "qy", "qz",
                                 "w_roll", "w_yaw", "w_pitch")
+#: Their units (thesis Table 3.1).
+STATE_UNITS: dict[str, str] = {
+    **dict.fromkeys(("x", "y", "z"), "L"), **dict.fromkeys(("vx", "vy", "vz"), "g^1/2 L^1/2"),
+    **dict.fromkeys(("qw", "qx", "qy", "qz"), "-"),
+    **dict.fromkeys(("w_roll", "w_yaw", "w_pitch"), "rad g^1/2 L^-1/2")}
+#: A touch-down's one-row table: the state, the foot, the side.
+_TD_UNITS: dict[str, str] = {**STATE_UNITS, **dict.fromkeys(("foot_x", "foot_y", "foot_z"), "L"),
+                             "side": "-"}
+#: A stride's one-row table: outcome, durations, the next touch-down (NaN after a fall) and
+#: the lift-off state (``lo_`` + a state name).
+_STEP_UNITS: dict[str, str] = {
+    "status": "-", "stance_time": "g^-1/2 L^1/2", "flight_time": "g^-1/2 L^1/2",
+    "n_steps": "-", **_TD_UNITS, **{f"lo_{k}": u for k, u in STATE_UNITS.items()}}
 
 
 class TrunkStatus(enum.IntEnum):
@@ -79,10 +97,14 @@ class TrunkStatus(enum.IntEnum):
         return self.value >= 10
 
 
-@dataclass(frozen=True)
-class TrunkTouchdown:
+@dataclass(frozen=True, repr=False)
+class TrunkTouchdown(Result):
     """The state at a touch-down: ``y`` (13, :data:`STATE_NAMES`), the foot ``p`` (3, on
-    the ground) and the ``side`` of the leg that has landed (+1 right, -1 left)."""
+    the ground) and the ``side`` of the leg that has landed (+1 right, -1 left).
+
+    A :class:`~tslip._results.Result`: it saves, loads (bit for bit) and tabulates (one
+    row, :meth:`to_dataframe`) like the planar results.
+    """
 
     y: np.ndarray
     foot: np.ndarray
@@ -110,6 +132,26 @@ class TrunkTouchdown:
         """The trunk's rotation matrix (columns ``x_b, y_b, z_b`` in the world)."""
         return rotation(self.y)
 
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row: the state (:data:`STATE_NAMES`), ``foot_x..z`` and ``side``, with units."""
+        return frame([self._row()], _TD_UNITS)
+
+    def _row(self) -> dict[str, float]:
+        return {**dict(zip(STATE_NAMES, self.y.tolist())),
+                **dict(zip(("foot_x", "foot_y", "foot_z"), self.foot.tolist())),
+                "side": self.side}
+
+    @classmethod
+    def _from_fields(cls, fields: dict[str, Any]) -> TrunkTouchdown:
+        """Checked as a new touch-down, then with the stored bits: the constructor
+        renormalises the quaternion, which may move its last bit."""
+        checked = cls(**fields)
+        y = np.array(fields["y"], dtype=float)
+        if abs(float(np.linalg.norm(y[6:10])) - 1.0) > 1e-9:
+            raise ValueError("TrunkTouchdown.y: the stored quaternion y[6:10] is not a unit "
+                             "quaternion")
+        return cls._unchecked(y, checked.foot, checked.side)
+
     @classmethod
     def _unchecked(cls, y: np.ndarray, foot: np.ndarray, side: int) -> TrunkTouchdown:
         """A touch-down the stride kernel computed (finite, unit quaternion, the foot on
@@ -120,10 +162,12 @@ class TrunkTouchdown:
         return td
 
 
-@dataclass(frozen=True)
-class TrunkStep:
+@dataclass(frozen=True, repr=False)
+class TrunkStep(Result):
     """One stride: the next touch-down (``None`` after a fall or error), the durations,
-    the lift-off state (13; NaN if none) and the integrator's accepted steps."""
+    the lift-off state (13; NaN if none) and the integrator's accepted steps.
+
+    A :class:`~tslip._results.Result` (one row, :meth:`to_dataframe`)."""
 
     status: TrunkStatus
     state: TrunkTouchdown | None
@@ -135,6 +179,16 @@ class TrunkStep:
     @property
     def ok(self) -> bool:
         return self.status == TrunkStatus.OK
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row: ``status`` (its name), the durations, ``n_steps``, the next touch-down
+        (NaN after a fall) and the lift-off state as ``lo_<name>``, with units."""
+        td = (self.state._row() if self.state is not None
+              else dict.fromkeys(_TD_UNITS, math.nan))
+        row = {"status": self.status.name, "stance_time": self.stance_time,
+               "flight_time": self.flight_time, "n_steps": self.n_steps, **td,
+               **{f"lo_{k}": v for k, v in zip(STATE_NAMES, np.asarray(self.liftoff).tolist())}}
+        return frame([row], _STEP_UNITS)
 
 
 def rotation(y: np.ndarray) -> np.ndarray:

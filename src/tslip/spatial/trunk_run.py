@@ -40,6 +40,7 @@ from ..simulation.options import IntegratorOptions
 from . import _trunk_kernels as kn
 from .trunk import (
     STATE_NAMES,
+    STATE_UNITS,
     TrunkStatus,
     TrunkTouchdown,
     rotation,
@@ -56,19 +57,14 @@ if TYPE_CHECKING:
 
 __all__ = ["RUN_COLUMNS", "RUN_UNITS", "TrunkRun", "trunk_run", "attitude"]
 
-_V = "g^1/2 L^1/2"
-_W = "rad g^1/2 L^-1/2"
 #: The columns of :attr:`TrunkRun.data` (module docstring).
 RUN_COLUMNS: tuple[str, ...] = ("t", "stride", "stance", "side", *STATE_NAMES, "yaw", "pitch",
                                 "roll", "hip_x", "hip_y", "hip_z", "foot_x", "foot_y",
                                 "foot_z", "energy")
 #: Their units (thesis Table 3.1).
 RUN_UNITS: dict[str, str] = {
-    "t": "g^-1/2 L^1/2", "stride": "-", "stance": "-", "side": "-",
-    **dict.fromkeys(("x", "y", "z", "hip_x", "hip_y", "hip_z", "foot_x", "foot_y", "foot_z"),
-                    "L"),
-    **dict.fromkeys(("vx", "vy", "vz"), _V), **dict.fromkeys(("qw", "qx", "qy", "qz"), "-"),
-    **dict.fromkeys(("w_roll", "w_yaw", "w_pitch"), _W),
+    "t": "g^-1/2 L^1/2", "stride": "-", "stance": "-", "side": "-", **STATE_UNITS,
+    **dict.fromkeys(("hip_x", "hip_y", "hip_z", "foot_x", "foot_y", "foot_z"), "L"),
     **dict.fromkeys(("yaw", "pitch", "roll"), "rad"), "energy": "MgL"}
 _C = {name: i for i, name in enumerate(RUN_COLUMNS)}
 _Y = slice(_C["x"], _C["x"] + kn.NSTATE)  # the 13 state components
