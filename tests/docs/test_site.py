@@ -62,9 +62,9 @@ def test_every_page_is_built(site: Path) -> None:
 
 def _figures_made(script: Path) -> int:
     """The figures an example makes, read from its source: each ``plt.figure`` or
-    ``plt.subplots`` call, and each call of a ``tslip.plotting`` function whose result
-    (a Figure) is bound to a name; a plotting function given ``ax=`` draws into a figure
-    already counted."""
+    ``plt.subplots`` call, and each call of a ``tslip.plotting`` function or of a
+    result's ``.plot()`` whose result (a Figure) is bound to a name; a plotting function
+    given ``ax=`` draws into a figure already counted."""
     import ast
 
     tree = ast.parse(script.read_text())
@@ -78,6 +78,11 @@ def _figures_made(script: Path) -> int:
         elif isinstance(node, ast.Assign) and isinstance(node.value, ast.Call) \
                 and isinstance(node.value.func, ast.Name):
             n += node.value.func.id in plotting
+        elif isinstance(node, ast.Assign) and isinstance(node.value, ast.Call) \
+                and isinstance(node.value.func, ast.Attribute) \
+                and node.value.func.attr == "plot" \
+                and not any(k.arg == "ax" for k in node.value.keywords):
+            n += 1  # a result's .plot() (a new Figure) bound to a name
     return n
 
 
