@@ -11,7 +11,10 @@ Each tableau is padded into one row of the ``*_TAB`` arrays below (index =
 method code of :mod:`tslip.model._pack`), so every routine here is written
 once for both methods and takes the method as a value: the TSLIP's kernels pass
 it at run time (``O[O_METHOD]``: each compiles once for both pairs), the biped's
-as a constant of each per-method copy.
+as a constant of each per-method copy. The error norm and the dense output branch
+once on the pair to a copy with its sizes and coefficients constants, which the
+compiler unrolls with the coefficients folded in (a TSLIP stride's instructions: see
+:mod:`tslip.simulation._stride`).
 
 Numba cannot cache a kernel that receives its right-hand side as a function
 argument (the cache key is the dispatcher type, which differs per process), so
@@ -204,6 +207,9 @@ NDENSE = np.array([5, 8], dtype=np.int64)
 ORDER = np.array([5.0, 8.0])
 #: step-size exponent -1/(q+1), q the order of the error estimator (4 and 7)
 ERR_EXP = np.array([-0.2, -0.125])
+# the sizes error_norm, dense_coeffs and dense_eval write out as constants, per pair
+assert (tuple(NSTAGES), tuple(NEXTRA), tuple(NDENSE)) == ((6, 12), (0, 3), (5, 8))
+assert (M_DOPRI5, M_DOP853) == (0, 1)
 #: The safety factor on the step the error estimate asks for: aims below it, so that the
 #: next step is rarely rejected (Hairer's dopri5.f and dop853.f, ``safe``)
 SAFETY = 0.9
@@ -257,25 +263,41 @@ def error_norm(method, n, y, ynew, h, K, rtol, atol):
     combined estimate of dop853.f, ``|h| err5^2 / sqrt(n (err5^2 + 0.01 err3^2))``
     with RMS-free sums ``err5``, ``err3`` of the 5th- and 3rd-order estimates.
     Scales ``atol + rtol max(|y|, |ynew|)``. ``K`` holds the FSAL row.
+
+    One branch on the pair, then each pair's sums with its weights and stage count
+    as constants (:func:`_error_dopri5`, :func:`_error_dop853`), so the compiler unrolls
+    them with the weights folded in even where ``method`` is a run-time value.
     """
-    nk = NSTAGES[method] + 1
-    e = E_TAB[method]
     if method == M_DOPRI5:
-        s = 0.0
-        for i in range(n):
-            acc = 0.0
-            for j in range(nk):
-                acc += e[j] * K[j, i]
-            sk = atol + rtol * max(abs(y[i]), abs(ynew[i]))
-            s += (h * acc / sk) ** 2
-        return math.sqrt(s / n)
-    e3 = E3_TAB[method]
+        return _error_dopri5(n, y, ynew, h, K, rtol, atol)
+    return _error_dop853(n, y, ynew, h, K, rtol, atol)
+
+
+@njit(**_INLINE)
+def _error_dopri5(n, y, ynew, h, K, rtol, atol):
+    """:func:`error_norm` of dopri5 (its 7 weights ``b - bhat`` constants)."""
+    e = E_TAB[M_DOPRI5]
+    s = 0.0
+    for i in range(n):
+        acc = 0.0
+        for j in range(7):
+            acc += e[j] * K[j, i]
+        sk = atol + rtol * max(abs(y[i]), abs(ynew[i]))
+        s += (h * acc / sk) ** 2
+    return math.sqrt(s / n)
+
+
+@njit(**_INLINE)
+def _error_dop853(n, y, ynew, h, K, rtol, atol):
+    """:func:`error_norm` of dop853 (its 13 weights of each estimate constants)."""
+    e = E_TAB[M_DOP853]
+    e3 = E3_TAB[M_DOP853]
     s5 = 0.0
     s3 = 0.0
     for i in range(n):
         a5 = 0.0
         a3 = 0.0
-        for j in range(nk):
+        for j in range(13):
             a5 += e[j] * K[j, i]
             a3 += e3[j] * K[j, i]
         sk = atol + rtol * max(abs(y[i]), abs(ynew[i]))
@@ -337,11 +359,20 @@ def dense_coeffs(method, y, ynew, h, K, R):
 
     ``K`` must hold the FSAL row and, for dop853, the ``n_extra`` stages after
     it. Rows: ``y``, ``dy``, ``h f0 - dy``, ``dy - h f1 - (h f0 - dy)``, then
-    ``h sum_j d_kj K[j]`` (dopri5 ``contd5``: one row; dop853: four).
+    ``h sum_j d_kj K[j]`` (dopri5 ``contd5``: one row; dop853: four). One branch
+    on the pair, each pair's sizes and rows constants (:func:`_dense_coeffs_of`).
     """
-    ns = NSTAGES[method]
-    nd = NDENSE[method]
-    nk = ns + 1 + NEXTRA[method]
+    if method == M_DOPRI5:
+        _dense_coeffs_of(M_DOPRI5, 6, 5, 7, y, ynew, h, K, R)
+    else:
+        _dense_coeffs_of(M_DOP853, 12, 8, 16, y, ynew, h, K, R)
+
+
+@njit(**_INLINE)
+def _dense_coeffs_of(method, ns, nd, nk, y, ynew, h, K, R):
+    """:func:`dense_coeffs` of the pair ``method`` with ``ns`` stages, ``nd`` dense rows,
+    ``nk`` stages in its sums: called with constants, so that its loops unroll with the
+    coefficients folded in (and their zero tests gone)."""
     for i in range(y.shape[0]):
         ydiff = ynew[i] - y[i]
         bspl = h * K[0, i] - ydiff
@@ -362,9 +393,18 @@ def dense_coeffs(method, y, ynew, h, K, R):
 def dense_eval(method, R, theta, out):
     """The continuous extension at ``theta`` in [0, 1] of the step.
 
-    ``R0 + th (R1 + (1 - th) (R2 + th (R3 + (1 - th) (R4 + ...))))``.
+    ``R0 + th (R1 + (1 - th) (R2 + th (R3 + (1 - th) (R4 + ...))))``. One branch on
+    the pair, its number of rows a constant (:func:`_dense_eval_of`).
     """
-    nd = NDENSE[method]
+    if method == M_DOPRI5:
+        _dense_eval_of(5, R, theta, out)
+    else:
+        _dense_eval_of(8, R, theta, out)
+
+
+@njit(**_INLINE)
+def _dense_eval_of(nd, R, theta, out):
+    """:func:`dense_eval` with ``nd`` rows (a constant: the loop over them unrolls)."""
     t1 = 1.0 - theta
     for i in range(out.shape[0]):
         acc = R[nd - 1, i]

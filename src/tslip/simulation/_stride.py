@@ -10,14 +10,17 @@ closed-form flight. The Runge-Kutta pair is a run-time argument, read from the o
 per pair, the pair a compile-time constant, compiled everything twice for a process
 using both: a first ``step_map``, ``step_jacobian`` and ``simulate`` with each pair took
 42 s of CPU from an empty cache, not 63 s (one pair alone, 36 s before: 15 % more, the
-branches on the pair now compiled in; a loaded machine, two runs side by side). The
-cost at run time: a Table 6.1 dopri5 stride executes 111,100 instructions, not 102,400
-(+8.6 %; dop853 98,400, not 94,600, +4.0 %; callgrind, ``NUMBA_CPU_NAME=generic``),
-though :func:`._stepper.stage_input` keeps the stage sums in registers; what remains is
-the tableau read at run time (loads and zero tests of its coefficients, loops of
-run-time length) in the error norm, the dense output and the step control: a copy of
-the stage loop per pair inside the one kernel (the pair a constant in each) ran no
-fewer instructions (112,300).
+branches on the pair now compiled in; a loaded machine, two runs side by side). At run
+time the one kernel costs nothing: a Table 6.1 stride executes 132,100 instructions
+with dopri5 (one pair per kernel: 132,400) and 118,300 with dop853 (122,500; callgrind,
+``NUMBA_CPU_NAME=generic``, per call from Python, the dispatcher's ~30,000 included).
+It cost 141,100 and 125,000 while the error norm and the dense output read the pair's
+tableau at run time (loads and zero tests of its coefficients, loops of run-time
+length): they now branch once on the pair to code with its sizes and coefficients
+constants (:func:`._rk.error_norm`, :func:`._rk.dense_coeffs`, :func:`._rk.dense_eval`),
+which the compiler unrolls; :func:`._stepper.stage_input` keeps the stage sums in
+registers. A copy of the stage loop per pair inside the one kernel (the pair a
+constant in each) ran no fewer instructions: its rows are read at a run-time stage.
 
 Only what a call uses compiles: a first :func:`tslip.step_map` compiles
 :func:`section_map`, the stride kernel and the functions it calls
