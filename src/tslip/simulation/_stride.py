@@ -11,10 +11,11 @@ per pair, the pair a compile-time constant, compiled everything twice for a proc
 using both: a first ``step_map``, ``step_jacobian`` and ``simulate`` with each pair took
 42 s of CPU from an empty cache, not 63 s (one pair alone, 36 s before: 15 % more, the
 branches on the pair now compiled in; a loaded machine, two runs side by side). At run
-time the one kernel costs nothing: a Table 6.1 stride executes 132,100 instructions
-with dopri5 (one pair per kernel: 132,400) and 118,300 with dop853 (122,500; callgrind,
-``NUMBA_CPU_NAME=generic``, per call from Python, the dispatcher's ~30,000 included).
-It cost 141,100 and 125,000 while the error norm and the dense output read the pair's
+time the one kernel costs about what one per pair did: a Table 6.1 stride executes
+101,800 instructions with dopri5 (one kernel per pair: 101,400) and 88,000 with dop853
+(91,500; callgrind, ``NUMBA_CPU_NAME=generic``, a call from Python and its dispatch, the
+difference of runs of 200 and 100 calls).
+It cost 109,900 and 93,800 while the error norm and the dense output read the pair's
 tableau at run time (loads and zero tests of its coefficients, loops of run-time
 length): they now branch once on the pair to code with its sizes and coefficients
 constants (:func:`._rk.error_norm`, :func:`._rk.dense_coeffs`, :func:`._rk.dense_eval`),
