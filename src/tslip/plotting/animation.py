@@ -304,6 +304,24 @@ def render_frames(
         yield frame
 
 
+def checked_output(path: str | os.PathLike[str], fps: float, size: tuple[int, int]
+                   ) -> tuple[Path, float]:
+    """The animation file and its frame rate, checked (one-line ``ValueError``): a ``.gif``
+    or ``.mp4`` suffix, ``fps`` finite and > 0 (a ``.gif``'s as :func:`gif_fps` rounds it),
+    an ``.mp4``'s ``size`` in multiples of 8 pixels. Shared by every animation writer."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in _SUFFIXES:
+        raise ValueError(f"animation file must end in .gif or .mp4, got {str(path)!r}")
+    if not (math.isfinite(fps) and fps > 0):
+        raise ValueError(f"fps must be a finite number > 0, got {fps!r}")
+    if suffix == ".gif":
+        fps = gif_fps(fps)
+    elif size[0] % 8 or size[1] % 8:
+        raise ValueError(f"size must be multiples of 8 pixels for .mp4, got {size!r}")
+    return path, fps
+
+
 def animate(
     traj: Trajectory,
     path: str | os.PathLike[str],
@@ -361,16 +379,7 @@ def animate(
         For a bad suffix, a non-positive ``fps``/``speed``/``dpi``, or an
         empty trajectory.
     """
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in _SUFFIXES:
-        raise ValueError(f"animation file must end in .gif or .mp4, got {str(path)!r}")
-    if not (math.isfinite(fps) and fps > 0):
-        raise ValueError(f"fps must be a finite number > 0, got {fps!r}")
-    if suffix == ".gif":
-        fps = gif_fps(fps)
-    elif size[0] % 8 or size[1] % 8:
-        raise ValueError(f"size must be multiples of 8 pixels for .mp4, got {size!r}")
+    path, fps = checked_output(path, fps, size)
     t_frames = frame_times(traj, fps, speed, time_unit)
     frames = render_frames(
         traj, t_frames, size=size, dpi=dpi, terrain=terrain, view_width=view_width

@@ -35,7 +35,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ..spatial.trunk_run import RUN_COLUMNS
-from .animation import TIME_UNIT_1M, TRUNK_WIDTH, frame_times, gif_fps, write_frames
+from .animation import TIME_UNIT_1M, TRUNK_WIDTH, checked_output, frame_times, write_frames
 from .results import _axes
 
 if TYPE_CHECKING:
@@ -52,7 +52,6 @@ _C = {name: i for i, name in enumerate(RUN_COLUMNS)}
 VIEWS: tuple[tuple[str, str, str], ...] = (
     ("front", "z", "z [L] (right +, seen from ahead)"),
     ("side", "x", "x [L]"))
-_SUFFIXES = (".gif", ".mp4")
 
 
 def plot_multipliers(nontrivial: Sequence[complex] | np.ndarray,
@@ -298,16 +297,7 @@ def animate_run(run: TrunkRun, path: str | os.PathLike[str], fps: float = 30.0,
     line for a bad suffix, a non-positive ``fps``/``speed``/``dpi`` or a run without
     samples.
     """
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in _SUFFIXES:
-        raise ValueError(f"animation file must end in .gif or .mp4, got {str(path)!r}")
-    if not (math.isfinite(fps) and fps > 0):
-        raise ValueError(f"fps must be a finite number > 0, got {fps!r}")
-    if suffix == ".gif":
-        fps = gif_fps(fps)
-    elif size[0] % 8 or size[1] % 8:
-        raise ValueError(f"size must be multiples of 8 pixels for .mp4, got {size!r}")
+    path, fps = checked_output(path, fps, size)
     t_frames = frame_times(run, fps, speed, time_unit)  # type: ignore[arg-type]
     frames = render_run_frames(run, t_frames, size=size, dpi=dpi, view_width=view_width)
     return write_frames(path, frames, fps, total=len(t_frames), progress=progress)
