@@ -69,6 +69,7 @@ from .problem import (
     Fix,
     GaitProblem,
     Section,
+    _finite,
     gait_residual,
     nominal_energy,
 )
@@ -298,7 +299,7 @@ def _newton(residual: Callable[[np.ndarray], np.ndarray],
     z = z0
     nrm = _norm(r)
     for it in range(_NEWTON_MAX_ITER + 1):
-        if not (math.isfinite(nrm) and np.isfinite(J).all()):
+        if not (math.isfinite(nrm) and _finite(J)):
             return None, math.inf
         err = max(map(abs, r.tolist()))  # r is finite here (its norm is)
         if err <= 1e-2 * tol:  # done (the map's Jacobian at z is kept for floquet)

@@ -162,8 +162,16 @@ _ALLOWED_NAMES = frozenset(("delta", *mid, "alpha_r", *ext)
 #: What a stride's output vector and Jacobian hold before the kernel fills them.
 _NAN_OUT = np.full(pk.NOUT, math.nan)
 _NAN_J = np.full((5, 5), math.nan)
-_ZEROS_J = np.zeros(25)
 _F64 = np.dtype(np.float64)
+
+
+def _finite(a: np.ndarray) -> bool:
+    """``np.isfinite(a).all()`` of a float array, at a quarter of its cost on a 5 x 5.
+
+    ``0 * x`` is 0 for every finite ``x`` and NaN for a NaN or an inf, so a dot
+    with zeros is 0 exactly when every entry is finite.
+    """
+    return bool(a.ravel().dot(np.zeros(a.size)) == 0.0)
 
 
 def nominal_energy(params: Params) -> float:
@@ -482,8 +490,7 @@ class GaitProblem:
         P, q, st, out, Jq, v = self._stride(x, jacobian=True)
         r, _, _ = _section_residual(q, st, out, self.params, v)
         n = self.size
-        # 0 * x is 0 for every finite x, NaN for a NaN or an inf: a dot with zeros finds them
-        if st != Status.OK or Jq is None or not Jq.ravel().dot(_ZEROS_J) == 0.0:
+        if st != Status.OK or Jq is None or not _finite(Jq):
             return r, np.full((5, n), math.nan)
         delta, phi, phid, _, ref = x
         i_delta, i_phi, i_phid, i_alpha, i_ref = self._at

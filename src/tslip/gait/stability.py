@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
+from scipy.linalg import lapack
 
 from .._results import Result, frame
 from ..model import _pack as pk
@@ -147,8 +148,6 @@ def eigvals(A: np.ndarray) -> np.ndarray:
     :func:`floquet` once the Jacobian is known. Raises
     ``np.linalg.LinAlgError`` for infs or NaNs, as numpy does.
     """
-    from scipy.linalg import lapack
-
     A = np.asarray(A, dtype=float)
     if not np.isfinite(A).all():
         raise np.linalg.LinAlgError("Array must not contain infs or NaNs")
