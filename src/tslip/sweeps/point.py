@@ -49,7 +49,7 @@ from ..gait.continuation import _solve_point, get_param, set_param
 from ..gait.fixed_point import Gait, GaitProblem, _search, find_gait
 from ..gait.problem import thrust_solved
 from ..gait.robustness import KINDS, robustness_report
-from ..gait.stability import floquet
+from ..gait.stability import Floquet, floquet
 from ..gait.stride import stride_properties
 from ..model.parameters import Params
 from .spec import StudySpec
@@ -186,10 +186,10 @@ class _Line:
     def attempt_from(self, i: int, z: dict[str, float], message: str) -> bool:
         """Attempt point ``i`` from a neighbour's unknowns ``z``."""
         prob = GaitProblem.from_params(self.point_params(i))
-        guess = np.array([z.get(n, math.nan) for n in prob.names], dtype=float)
-        if not np.all(np.isfinite(guess)):
+        guess = [_num(z.get(n)) for n in prob.names]
+        if not all(map(math.isfinite, guess)):
             return False
-        return self.attempt(i, lambda: (_search(prob, guess, self.tol), message),
+        return self.attempt(i, lambda: (_search(prob, np.array(guess), self.tol), message),
                             keep_failure=False) is not None
 
     # -- strategies -------------------------------------------------------------
@@ -356,6 +356,23 @@ def analyse_point(spec: StudySpec, item: Pending, neutral_tol: float | None = No
     return rec
 
 
+#: The multiplier columns of a point without them (no gait, or its multipliers failed).
+_NO_MULTIPLIERS: dict[str, Any] = {
+    **{f"abs_lambda_{j + 1}": math.nan for j in range(5)},
+    "max_nontrivial": math.nan, "n_trivial": 0, "min_nontrivial": math.nan}
+
+
+def _multipliers(fl: Floquet) -> dict[str, Any]:
+    """The multiplier columns of a record: magnitudes in descending order, the largest and
+    smallest non-trivial one, how many are trivial."""
+    mags = np.abs(fl.multipliers)
+    nt = mags[~fl.trivial]
+    desc = np.sort(mags)[::-1].tolist()
+    return {**{f"abs_lambda_{j + 1}": desc[j] for j in range(5)},
+            "max_nontrivial": _num(fl.max_nontrivial), "n_trivial": int(fl.trivial.sum()),
+            "min_nontrivial": float(nt.min()) if nt.size else math.nan}
+
+
 def _analyse(spec: StudySpec, point: dict[str, float], g: Gait | None, residual: float,
              message: str, neutral_tol: float) -> dict[str, Any]:
     """The record of one point: multipliers, stride, robustness (as the spec asks)."""
@@ -370,14 +387,7 @@ def _analyse(spec: StudySpec, point: dict[str, float], g: Gait | None, residual:
             fl = None
     rec["stability"] = fl.stability if fl is not None else ("unknown" if g is not None
                                                             else "none")
-    mags = np.abs(fl.multipliers) if fl is not None else np.full(5, np.nan)
-    desc = np.sort(mags)[::-1].tolist()
-    for j in range(5):
-        rec[f"abs_lambda_{j + 1}"] = desc[j]
-    rec["max_nontrivial"] = _num(fl.max_nontrivial) if fl is not None else math.nan
-    rec["n_trivial"] = int(fl.trivial.sum()) if fl is not None else 0
-    nt = mags[~fl.trivial] if fl is not None else mags[:0]
-    rec["min_nontrivial"] = float(nt.min()) if nt.size else math.nan
+    rec.update(_multipliers(fl) if fl is not None else _NO_MULTIPLIERS)
     rec["stance_time"] = _num(g.stance_time) if g is not None else math.nan
     rec["flight_time"] = _num(g.flight_time) if g is not None else math.nan
     if g is not None:
