@@ -46,6 +46,17 @@ def test_missing_gait_is_recorded_not_raised(tmp_path):
     df = res.frame.set_index("v0")
     assert not df.loc[1.0, "converged"] and df.loc[1.0, "stability"] == "none"
     assert df.loc[5.0, "converged"]
+    # the multiplier columns: none without a gait; with one, Floquet's magnitudes, descending
+    mags = [f"abs_lambda_{j}" for j in range(1, 6)]
+    assert df.loc[1.0, mags + ["max_nontrivial", "min_nontrivial"]].isna().all()
+    assert df.loc[1.0, "n_trivial"] == 0
+    fl = tslip.floquet(tslip.find_gait(dataclasses.replace(tslip.preset("table2.1"), v0=5.0)))
+    ref = sorted(abs(fl.multipliers), reverse=True)
+    assert df.loc[5.0, mags].to_numpy(float) == pytest.approx(ref, abs=1e-8)
+    assert df.loc[5.0, "n_trivial"] == fl.trivial.sum() > 0  # the energy's at least (passive)
+    nontrivial = abs(fl.multipliers[~fl.trivial])
+    assert df.loc[5.0, "max_nontrivial"] == pytest.approx(nontrivial.max(), abs=1e-8)
+    assert df.loc[5.0, "min_nontrivial"] == pytest.approx(nontrivial.min(), abs=1e-8)
 
 
 @pytest.mark.parametrize(
