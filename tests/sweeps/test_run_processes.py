@@ -20,12 +20,13 @@ from tslip.sweeps.run import saved_points
 
 # a 2-D study of 5 lines of 13 points: the line at the base value v0 = 5 first, then
 # two continuation chains (v0 = 4.5; v0 = 5.5, 6, 6.5) in two workers, one soon idle
-# Robustness over 200 strides makes each point about 0.15 s: the study must still be
-# running when the tests below signal it (with Floquet alone, 65 points now take 0.2 s).
+# Robustness over 100 strides makes each point about 0.3 s (one worker, load 4; 0.58 s over
+# 200 strides, 0.14 s over 50): the study must still be running when the tests below signal
+# it (with Floquet alone, 65 points take 0.2 s), and the sigkill test runs it twice more.
 _TOML = """name = "grid"
 preset = "table2.1-local-velocity"
 analyses = ["floquet", "robustness"]
-n_steps = 200
+n_steps = 100
 [[axis]]
 param = "v0"
 values = [4.5, 5.0, 5.5, 6.0, 6.5]
@@ -174,7 +175,11 @@ def test_lock_of_a_killed_run_is_stale_and_taken_over(tmp_path, caplog):
 
 def test_the_stale_locks_of_a_killed_run_of_many_studies_are_one_line(tmp_path, caplog):
     folders = [tmp_path / "studies" / f"s{i}" for i in range(18)]
-    code = ("import os, sys\nfrom tslip.sweeps._lock import folder_locks\n"
+    # every reading of the clock a second later than the last: a run that takes a second to
+    # lock its folders is one holder, with one start time
+    code = ("import itertools, os, sys, time\nfrom tslip.sweeps._lock import folder_locks\n"
+            "tick, fmt = itertools.count(), time.strftime\n"
+            "time.strftime = lambda f, *a: fmt(f, time.localtime(1e9 + next(tick)))\n"
             "with folder_locks(sys.argv[1:]):\n    os.kill(os.getpid(), 9)\n")
     proc = subprocess.run([sys.executable, "-c", code, *map(str, folders)], env=_env(),
                           timeout=60)

@@ -92,10 +92,14 @@ def folder_locks(folders: Iterable[str | Path], *, wait: bool = False,
     ``root``, the output folder the folders lie in (default: each folder itself):
     no folder below it is followed if it is a link."""
     stale: list[tuple[Path, str]] = []
+    # one holder record for every folder: a run that locks many names one start time in all
+    # (the clock read per folder named a run that crossed a second as two holders)
+    me = {"pid": os.getpid(), "host": socket.gethostname(),
+          "started": time.strftime("%Y-%m-%d %H:%M:%S")}
     with ExitStack() as stack:
         for folder in folders:
             stack.enter_context(_lock(Path(folder), wait, stale,
-                                      Path(folder) if root is None else Path(root)))
+                                      Path(folder) if root is None else Path(root), me))
         if stale:
             holders = sorted({who for _, who in stale})
             where = (str(stale[0][0]) if len(stale) == 1 else
@@ -106,8 +110,10 @@ def folder_locks(folders: Iterable[str | Path], *, wait: bool = False,
 
 
 @contextmanager
-def _lock(folder: Path, wait: bool, stale: list[tuple[Path, str]], root: Path) -> Iterator[None]:
-    """Hold ``folder/.lock``; a stale holder is added to ``stale``."""
+def _lock(folder: Path, wait: bool, stale: list[tuple[Path, str]], root: Path,
+          me: dict) -> Iterator[None]:
+    """Hold ``folder/.lock``, recording the holder ``me`` in it; a stale holder is added to
+    ``stale``."""
     fd = open_below(root, folder / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
     try:
         if fcntl is not None:
@@ -123,10 +129,8 @@ def _lock(folder: Path, wait: bool, stale: list[tuple[Path, str]], root: Path) -
         old = _holder(fd)
         if old:  # the last holder ended without releasing: crashed or killed
             stale.append((folder, _describe(old)))
-        info = {"pid": os.getpid(), "host": socket.gethostname(),
-                "started": time.strftime("%Y-%m-%d %H:%M:%S")}
         os.ftruncate(fd, 0)
-        os.pwrite(fd, json.dumps(info).encode(), 0)
+        os.pwrite(fd, json.dumps(me).encode(), 0)
         try:
             yield
         finally:
