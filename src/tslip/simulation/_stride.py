@@ -467,7 +467,7 @@ def _make_stride(fly: bool) -> Callable:
                 if on_grid:
                     nrec, t_next_rec, ovf = record_grid(method, R, rec, nrec, t, h,
                                                         t + h * min(theta_ev, 1.0),
-                                                        t_next_rec, rec_dt, ytmp)
+                                                        t_next_rec, rec_dt)
                     overflow = max(overflow, ovf)
                 if ev >= 0:
                     h *= theta_ev  # the next pass steps to the event
