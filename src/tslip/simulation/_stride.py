@@ -107,7 +107,7 @@ from ._stance import (
 from ._stepper import (
     append_row,
     crossed,
-    dense_output,
+    extra_stages,
     first_event,
     grow_step,
     initial_step,
@@ -460,8 +460,10 @@ def _make_stride(fly: bool) -> Callable:
                 n_acc += 1
                 # event detection, dense output, event location (and grid samples)
                 event = crossed(gv_old, gv_new)
-                if event or on_grid:
-                    dense_output(P, method, y, ynew, h, K, R, ytmp)
+                if event or on_grid:  # the dense output (see _stepper.extra_stages)
+                    if _rk.n_extra(method) > 0:
+                        extra_stages(P, method, y, h, K, ytmp)
+                    _rk.dense_coeffs_inline(method, y, ynew, h, K, R)
                 theta_ev, ev = (first_event(P, method, R, gv_old, gv_new, ytmp, gv_tmp, st)
                                 if event else (2.0, -1))
                 if on_grid:
