@@ -10,7 +10,6 @@ is the loop; its named steps are here, in the order a step takes them:
 * :func:`crossed`: event detection, a sign change of an event function
   (thesis Section 2.3) over the accepted step; :func:`rising_from_zero`: no first
   step of a stance jumps a whole hump of an event function that starts at its zero;
-* :func:`extra_stages`: the continuous extension's extra stages (dop853);
 * :func:`first_event`: event location, the earliest root on the dense output;
 * :func:`record_row`, :func:`append_row`, :func:`record_grid`: the stance record.
 
@@ -118,25 +117,6 @@ def rk_step(P, method, y, h, K, ytmp, ynew, gv):
         rhs_inline(P, ytmp, K[s])
     stage_input(method, y, h, K, ns, ynew)
     rhs_events_inline(P, ynew, K[ns], gv)
-
-
-@njit(**_JIT)
-def extra_stages(P, method, y, h, K, ytmp):
-    """The stages the continuous extension of the step just taken needs beyond the step's
-    own (dop853's three; none for dopri5), into ``K``; the stride then computes the
-    dense output's coefficients (:func:`._rk.dense_coeffs`).
-
-    The stride calls the two in its own body, this one only for a pair that has extra
-    stages. Inlined as one function (``dense_output(P, method, y, ynew, h, K, R, ytmp)``,
-    with this loop of a run-time length inside) they cost numba's reference counts of its
-    six array arguments, an atomic increment and decrement each, at every step of a
-    recorded stance: recording a Table 6.1 stride cost 13,500 instructions more than an
-    unrecorded one, 11,700 now (the unrecorded stride 99,340 then, 99,570 now; callgrind
-    as in :func:`record_grid`)."""
-    ns = _rk.n_stages(method)
-    for s in range(ns + 1, ns + 1 + _rk.n_extra(method)):
-        stage_input(method, y, h, K, s, ytmp)
-        rhs(P, ytmp, K[s])
 
 
 @njit(**_JIT)
@@ -287,10 +267,10 @@ def record_grid(method, R, rec, row, t, h, t_stop, t_next, dt):
     (:func:`_record_grid_of`). Recording cost a Table 6.1 stride (dopri5, ``dt = 0.01``:
     59 grid rows over 23 steps) 16,970 instructions more than a stride not recorded
     while this compiled on its own, its dense output read through ``dense_eval`` into
-    ``ytmp`` and copied row by row; 14,250 inlined, 13,500 as now (callgrind,
+    ``ytmp`` and copied row by row; 14,250 inlined, 13,500 written straight into ``rec``,
+    11,600 since the stride writes its dense output out itself (callgrind,
     ``NUMBA_CPU_NAME=generic``, ``record_run`` against ``run_batch``, the difference of
-    runs of 1000 and 500 strides; 07e68e4, one kernel per pair: 11,190; 11,700 since
-    :func:`extra_stages`). Inlined, a
+    runs of 1000 and 500 strides; 07e68e4, one kernel per pair: 11,190). Inlined, a
     first ``simulate`` from an empty cache took 29.1 s of CPU, not 28.4 (one run each,
     a loaded machine)."""
     if method == _rk.M_DOPRI5:
