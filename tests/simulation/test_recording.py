@@ -246,3 +246,17 @@ def test_recording_runs_as_plain_python(gaits):
     pure = np.array(json.loads(proc.stdout.strip().splitlines()[-1]))
     p, s = gaits["table6.1"]
     np.testing.assert_allclose(pure, tslip.simulate(p, s, 2, dt=0.05).data, rtol=0, atol=1e-12)
+
+
+def test_a_run_holds_few_rows_beyond_its_samples(gaits):
+    """The rows a run allocated ahead are given back when it stops early (here a fall at
+    stride 23 of 400: rows were allocated for all 400); a run that goes its length keeps
+    at most an eighth of its rows spare (``integrate.TRIM_SPARE``)."""
+    p, s = gaits["table6.1"]
+    for dist in (tslip.Disturbance(at_step=20, dxd=-1.0), None):
+        traj = tslip.simulate(p, s, 400, disturbance=dist)
+        assert (len(traj.steps) < 30) == (dist is not None)
+        rec = traj.steps._rec  # the rows of the trajectory's samples
+        assert len(rec) == len(traj["t"])
+        held = rec if rec.base is None else rec.base
+        assert len(held) <= len(rec) * 8 / 7

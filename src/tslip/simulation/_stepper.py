@@ -10,7 +10,6 @@ is the loop; its named steps are here, in the order a step takes them:
 * :func:`crossed`: event detection, a sign change of an event function
   (thesis Section 2.3) over the accepted step; :func:`rising_from_zero`: no first
   step of a stance jumps a whole hump of an event function that starts at its zero;
-* :func:`dense_output`: the continuous extension of that step;
 * :func:`first_event`: event location, the earliest root on the dense output;
 * :func:`record_row`, :func:`append_row`, :func:`record_grid`: the stance record.
 
@@ -18,11 +17,12 @@ The per-step functions are small and ``inline="always"``, taking the
 Runge-Kutta pair ``method`` as a run-time argument (the stride reads it from its
 options), so the one compiled stride serves both pairs; :func:`stage_input` keeps the
 stage sums in registers. Those called once a stride or so (:func:`initial_step`,
-:func:`first_event`) or only when recording (:func:`append_row`, :func:`record_grid`)
-compile on their own instead: numba's type inference of the stride's body, most of a
-cold start, shrinks by their copies. The step-control constants (:data:`FAC_MAX`,
-:data:`NONFINITE_SHRINK`, the root's :data:`ROOT_TOL`, ...) are named below, the
-safety factor and smallest factor in :mod:`._rk`.
+:func:`first_event`, :func:`append_row`) compile on their own instead: numba's type
+inference of the stride's body, most of a cold start, shrinks by their copies.
+:func:`record_grid`, called at every accepted step of a recorded stance, is inlined
+(its call cost more than its copy's compilation: see there). The step-control
+constants (:data:`FAC_MAX`, :data:`NONFINITE_SHRINK`, the root's :data:`ROOT_TOL`, ...)
+are named below, the safety factor and smallest factor in :mod:`._rk`.
 """
 
 from __future__ import annotations
@@ -117,16 +117,6 @@ def rk_step(P, method, y, h, K, ytmp, ynew, gv):
         rhs_inline(P, ytmp, K[s])
     stage_input(method, y, h, K, ns, ynew)
     rhs_events_inline(P, ynew, K[ns], gv)
-
-
-@njit(**_INLINE)
-def dense_output(P, method, y, ynew, h, K, R, ytmp):
-    """Continuous extension of the step just taken (extra stages for dop853)."""
-    ns = _rk.n_stages(method)
-    for s in range(ns + 1, ns + 1 + _rk.n_extra(method)):
-        stage_input(method, y, h, K, s, ytmp)
-        rhs(P, ytmp, K[s])
-    _rk.dense_coeffs_inline(method, y, ynew, h, K, R)
 
 
 @njit(**_JIT)
@@ -252,8 +242,8 @@ def record_row(rec, row, t, y):
     """Stance record row ``row``: ``t, y`` (the forces are derived from it when read:
     :func:`._record.fill_table`, :func:`._record.stance_forces`).
 
-    Inlined into :func:`append_row` and :func:`record_grid` (seven stores: a call per
-    sample cost more than the row)."""
+    Inlined into :func:`append_row` (seven stores: a call per sample cost more than the
+    row); :func:`record_grid` writes its rows itself."""
     rec[row, 0] = t
     for i in range(NSTATE):
         rec[row, 1 + i] = y[i]
@@ -268,15 +258,43 @@ def append_row(rec, row, t, y):
     return row, 1.0
 
 
-@njit(**_JIT)
-def record_grid(method, R, rec, row, t, h, t_stop, t_next, dt, ytmp):
+@njit(**_INLINE)
+def record_grid(method, R, rec, row, t, h, t_stop, t_next, dt):
     """Record the grid times ``t_next, t_next + dt, ...`` up to ``t_stop`` of the step
-    ``[t, t + h]`` from its dense output ``R``: ``(rows used, next grid time, overflow)``."""
+    ``[t, t + h]`` from its dense output ``R``: ``(rows used, next grid time, overflow)``.
+
+    Inlined into the stride, with one branch on the pair outside the loop over the rows
+    (:func:`_record_grid_of`). Recording cost a Table 6.1 stride (dopri5, ``dt = 0.01``:
+    59 grid rows over 23 steps) 16,970 instructions more than a stride not recorded
+    while this compiled on its own, its dense output read through ``dense_eval`` into
+    ``ytmp`` and copied row by row; 14,250 inlined, 13,500 written straight into ``rec``,
+    11,600 since the stride writes its dense output out itself (callgrind,
+    ``NUMBA_CPU_NAME=generic``, ``record_run`` against ``run_batch``, the difference of
+    runs of 1000 and 500 strides; 07e68e4, one kernel per pair: 11,190). Inlined, a
+    first ``simulate`` from an empty cache took 29.1 s of CPU, not 28.4 (one run each,
+    a loaded machine)."""
+    if method == _rk.M_DOPRI5:
+        return _record_grid_of(5, R, rec, row, t, h, t_stop, t_next, dt)
+    return _record_grid_of(8, R, rec, row, t, h, t_stop, t_next, dt)
+
+
+@njit(**_INLINE)
+def _record_grid_of(nd, R, rec, row, t, h, t_stop, t_next, dt):
+    """:func:`record_grid` with ``nd`` dense rows (a constant: the loop over them unrolls).
+
+    Each row is :func:`._rk.dense_eval`'s sum (the same operations in the same order),
+    written straight into ``rec``, not through ``ytmp`` and a copy of it."""
     while t_next <= t_stop:
         if row >= rec.shape[0]:
             return row, t_next, 1.0
-        _rk.dense_eval_inline(method, R, (t_next - t) / h, ytmp)
-        record_row(rec, row, t_next, ytmp)
+        theta = (t_next - t) / h
+        t1 = 1.0 - theta
+        rec[row, 0] = t_next
+        for i in range(NSTATE):
+            acc = R[nd - 1, i]
+            for k in range(nd - 2, -1, -1):
+                acc = R[k, i] + (theta if k % 2 == 0 else t1) * acc
+            rec[row, 1 + i] = acc
         row += 1
         t_next += dt
     return row, t_next, 0.0

@@ -346,14 +346,27 @@ def simulate(
     return run.trajectory(status, terrain, meta)
 
 
+#: The rows :class:`_Recording` allocates beyond those a run fills are trimmed off at its end
+#: only if they are more than ``1 / TRIM_SPARE`` of the allocation (a run that stopped
+#: early); the few spare rows of a run that went its length (5 % and 64) are kept, the
+#: trajectory's rows a view of them. Trimmed, a large array went back to the C allocator
+#: smaller than the next run's request, which glibc then maps afresh (its threshold for
+#: mapping follows the size last freed), so that a loop of runs faulted in every page of
+#: its rows anew: 474 minor page faults per 1000 Table 6.1 strides at ``dt = 0.01``
+#: (4 MB), none kept; about 1.5 ms (those rows filled afresh 2.1 ms, reused 0.6 ms), 0.08
+#: of the time of the strides unrecorded (``benchmarks/bench_limit.py``; 2026-12-06).
+TRIM_SPARE = 8
+
+
 class _Recording:
     """The buffers of one :func:`simulate` run, which :func:`_kernels.record_run` fills.
 
     Compact rows (the stance record rows, a time for each flight sample) are
     allocated for a few strides first, then, once the kernel reports them full,
     for the rest of the run at the rows per stride seen so far (geometric growth
-    if that falls short); they are trimmed at the end. The trajectory's columns
-    are derived from them when first read (:class:`~.result.RunTable`).
+    if that falls short); many unused rows are trimmed at the end
+    (:data:`TRIM_SPARE`). The trajectory's columns are derived from them when
+    first read (:class:`~.result.RunTable`).
     """
 
     def __init__(self, params: Params, options: IntegratorOptions | None, n_steps: int,
@@ -396,7 +409,10 @@ class _Recording:
 
     def trajectory(self, status: Status, terrain: Terrain, meta: dict) -> Trajectory:
         rows, n = int(self.pos[0]), int(self.pos[2])
-        self.rows.resize((rows, pk.NREC), refcheck=False)  # trim in place, no copy
+        if len(self.rows) - rows > len(self.rows) // TRIM_SPARE:
+            self.rows.resize((rows, pk.NREC), refcheck=False)  # trim in place, no copy
+        else:  # a few spare rows: kept (see TRIM_SPARE)
+            self.rows = self.rows[:rows]
         starts, outs, info = self.starts[:n], self.outs[:n], self.info[:n]
         steps = StepList(self.params, starts, outs, info, self.rows)
         last = None
