@@ -27,35 +27,80 @@ Part 2, the TSLIP in three dimensions (docs/analyses/spatial_tslip.md):
 
 from __future__ import annotations
 
-from .gait import Multipliers, SymmetricGait, floquet, symmetric_gaits
-from .parameters import HEADINGS, SpatialParams, preset, preset_description, presets
-from .stride import (
-    SECTION_NAMES,
-    SpatialApex,
-    SpatialStatus,
-    SpatialStep,
-    apex_step,
-    apex_steps,
-    energy,
-    mirror,
-    section_map,
-    step_jacobian,
-)
-from .trunk import TrunkStatus, TrunkStep, TrunkTouchdown, trunk_energy, trunk_step
-from .trunk_parameters import TrunkParams
-from .trunk_run import TrunkRun, trunk_run
-from .trunk_section import MIRROR as TRUNK_MIRROR
-from .trunk_section import SECTION_NAMES as TRUNK_SECTION_NAMES
-from .trunk_section import (
-    from_section,
-    mirror_section,
-    one_step_map,
-    section,
-    symmetric_gait,
-    two_step_jacobian,
-    two_step_map,
-    yaw_rotated,
-)
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the names as the type checker sees them
+    from .gait import Multipliers, SymmetricGait, floquet, symmetric_gaits
+    from .parameters import HEADINGS, SpatialParams, preset, preset_description, presets
+    from .stride import (
+        SECTION_NAMES,
+        SpatialApex,
+        SpatialStatus,
+        SpatialStep,
+        apex_step,
+        apex_steps,
+        energy,
+        mirror,
+        section_map,
+        step_jacobian,
+    )
+    from .trunk import TrunkStatus, TrunkStep, TrunkTouchdown, trunk_energy, trunk_step
+    from .trunk_parameters import TrunkParams
+    from .trunk_run import TrunkRun, trunk_run
+    from .trunk_section import MIRROR as TRUNK_MIRROR
+    from .trunk_section import SECTION_NAMES as TRUNK_SECTION_NAMES
+    from .trunk_section import (
+        from_section,
+        mirror_section,
+        one_step_map,
+        section,
+        symmetric_gait,
+        two_step_jacobian,
+        two_step_map,
+        yaw_rotated,
+    )
+
+#: Each public name: (its module, its name there); loaded on first use (PEP 562), so that
+#: importing a submodule (the 3-D parameters, for a study's spec) does not load them all
+_LAZY = {
+    'Multipliers': ('gait', 'Multipliers'),
+    'SymmetricGait': ('gait', 'SymmetricGait'),
+    'floquet': ('gait', 'floquet'),
+    'symmetric_gaits': ('gait', 'symmetric_gaits'),
+    'HEADINGS': ('parameters', 'HEADINGS'),
+    'SpatialParams': ('parameters', 'SpatialParams'),
+    'preset': ('parameters', 'preset'),
+    'preset_description': ('parameters', 'preset_description'),
+    'presets': ('parameters', 'presets'),
+    'SECTION_NAMES': ('stride', 'SECTION_NAMES'),
+    'SpatialApex': ('stride', 'SpatialApex'),
+    'SpatialStatus': ('stride', 'SpatialStatus'),
+    'SpatialStep': ('stride', 'SpatialStep'),
+    'apex_step': ('stride', 'apex_step'),
+    'apex_steps': ('stride', 'apex_steps'),
+    'energy': ('stride', 'energy'),
+    'mirror': ('stride', 'mirror'),
+    'section_map': ('stride', 'section_map'),
+    'step_jacobian': ('stride', 'step_jacobian'),
+    'TrunkStatus': ('trunk', 'TrunkStatus'),
+    'TrunkStep': ('trunk', 'TrunkStep'),
+    'TrunkTouchdown': ('trunk', 'TrunkTouchdown'),
+    'trunk_energy': ('trunk', 'trunk_energy'),
+    'trunk_step': ('trunk', 'trunk_step'),
+    'TrunkParams': ('trunk_parameters', 'TrunkParams'),
+    'TrunkRun': ('trunk_run', 'TrunkRun'),
+    'trunk_run': ('trunk_run', 'trunk_run'),
+    'TRUNK_MIRROR': ('trunk_section', 'MIRROR'),
+    'TRUNK_SECTION_NAMES': ('trunk_section', 'SECTION_NAMES'),
+    'from_section': ('trunk_section', 'from_section'),
+    'mirror_section': ('trunk_section', 'mirror_section'),
+    'one_step_map': ('trunk_section', 'one_step_map'),
+    'section': ('trunk_section', 'section'),
+    'symmetric_gait': ('trunk_section', 'symmetric_gait'),
+    'two_step_jacobian': ('trunk_section', 'two_step_jacobian'),
+    'two_step_map': ('trunk_section', 'two_step_map'),
+    'yaw_rotated': ('trunk_section', 'yaw_rotated'),
+}
 
 __all__ = ["HEADINGS", "SpatialParams", "preset", "preset_description", "presets",
            "SECTION_NAMES", "SpatialApex", "SpatialStatus", "SpatialStep", "apex_step",
@@ -66,3 +111,18 @@ __all__ = ["HEADINGS", "SpatialParams", "preset", "preset_description", "presets
            "trunk_step", "TRUNK_MIRROR", "TRUNK_SECTION_NAMES", "from_section",
            "mirror_section", "one_step_map", "section", "symmetric_gait", "two_step_jacobian",
            "two_step_map", "yaw_rotated", "TrunkRun", "trunk_run"]
+
+
+def __getattr__(name: str) -> object:
+    if name not in _LAZY:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
+
+    module, attr = _LAZY[name]
+    value = getattr(importlib.import_module(f".{module}", __name__), attr)
+    globals()[name] = value  # later look-ups find it directly
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

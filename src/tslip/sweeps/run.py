@@ -45,6 +45,7 @@ import time
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -56,7 +57,7 @@ from .._results import FrameTable, Result, with_units
 from ..gait.continuation import get_param
 from ..gait.robustness import UNITS as ROBUSTNESS_UNITS
 from ..model.units import COLUMN_UNITS, UNIT, param_unit
-from . import _pool, _store, _warmup, spatial_point, spatial_spec
+from . import _pool, _store, _warmup, spatial_spec
 from ._lock import folder_lock
 from ._schedule import Task, Timing, choose_workers, own_seconds, run_tasks
 from .point import (
@@ -81,6 +82,14 @@ __all__ = ["StudyInterrupted", "StudyJob", "StudyResult", "run_study", "point_ke
 Progress = Callable[[int, int], None]
 
 
+def _spatial_point() -> ModuleType:
+    """:mod:`.spatial_point`, imported on first use: it loads the 3-D models' gait searches
+    (1.4 s), which a planar study never needs."""
+    from . import spatial_point
+
+    return spatial_point
+
+
 class StudyInterrupted(KeyboardInterrupt):
     """Ctrl-C during a study: how many of its points are saved."""
 
@@ -97,7 +106,7 @@ def _code(spec: StudySpec) -> str:
     :func:`tslip.sweeps.spatial_point.code_version` for a 3-D model)."""
     if spec.model == "tslip":
         return code_version(spec.analyses)
-    return spatial_point.code_version(spec.model, spec.analyses)
+    return _spatial_point().code_version(spec.model, spec.analyses)
 
 
 def _key_prefix(spec: StudySpec) -> Any:
@@ -217,8 +226,8 @@ def _solve_task(spec: StudySpec, assignment: dict[str, float], values: list[floa
             _save(writer, keys[i], rec)
             tick(1)
 
-        solve = solve_gaits if spec.model == "tslip" else spatial_point.solve_gaits
-        return solve(spec, assignment, values, seeds=seeds, cached=cached,  # type: ignore[return-value]
+        solve = solve_gaits if spec.model == "tslip" else _spatial_point().solve_gaits
+        return solve(spec, assignment, values, seeds=seeds, cached=cached,
                      emit=emit)
 
 
@@ -228,7 +237,7 @@ def _analyse_task(spec: StudySpec, items: list[Pending], keys: list[str], cache:
     tick = tick or _pool.notify
     out = []
     analyse: Callable[[StudySpec, Any], dict[str, Any]] = (
-        analyse_point if spec.model == "tslip" else spatial_point.analyse_point)
+        analyse_point if spec.model == "tslip" else _spatial_point().analyse_point)
     with _writer(cache) as writer:
         for item, key in zip(items, keys):
             rec = analyse(spec, item)
@@ -271,7 +280,7 @@ class StudyResult(FrameTable, Result):
         """The table: one row per point, axes first (units of the axes and the results)."""
         base = self.spec.base
         if isinstance(base, spatial_spec.SpatialBase):
-            units = {**spatial_point.UNITS, **{a.param: base.unit(a.param)
+            units = {**_spatial_point().UNITS, **{a.param: base.unit(a.param)
                                                for a in self.spec.axes}}
         else:
             units = {**STUDY_UNITS, **{a.param: param_unit(a.param) or "-"
@@ -408,7 +417,7 @@ class StudyJob:
         self.inner = spec.axes[-1].param
         self.seeds: list[dict[float, dict[str, float]] | None] = [None] * len(self.plan)
         self.costs = (COST_SECONDS if spec.model == "tslip"
-                      else spatial_point.COST_SECONDS[spec.model])
+                      else _spatial_point().COST_SECONDS[spec.model])
         self.per_point = sum(self.costs[a] for a in set(spec.analyses))
         self.depth = [0] * len(self.plan)
         for i in sorted(range(len(self.plan)), key=self._chain_index, reverse=True):

@@ -40,7 +40,6 @@ from dataclasses import dataclass
 from typing import Any
 
 from .._checks import check_number
-from ..spatial.lateral import TABLE21_VX, table21_params
 from ..spatial.parameters import HEADINGS, SpatialParams
 from ..spatial.parameters import preset as spatial_preset
 from ..spatial.trunk_parameters import TrunkParams
@@ -145,7 +144,9 @@ def read(model: str, preset: str | None, overrides: dict[str, Any]) -> SpatialBa
     if name not in allowed:
         raise ValueError(f"study preset must be one of {list(allowed)} for model {model!r}, "
                          f"got {name!r}")
-    if model == "tslip3d":
+    if model == "tslip3d":  # (the gait search's modules load only for a 3-D study)
+        from ..spatial.lateral import TABLE21_VX, table21_params
+
         base = SpatialBase(model, table21_params(), TABLE21_VX)
     else:
         base = SpatialBase(model, spatial_preset(name), SLIP3D_ENERGY)
