@@ -2,6 +2,9 @@
 
 This module validates inputs, calls the compiled kernels in :mod:`._kernels`,
 and turns their flat arrays into typed results.
+
+Over 600 lines: one concept, the simulation's public API (a stride, the map and its
+Jacobian, a recorded run, batches), each a checked wrapper of one kernel call.
 """
 
 from __future__ import annotations
