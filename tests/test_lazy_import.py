@@ -70,3 +70,13 @@ def test_unknown_attribute_is_an_attribute_error():
         assert "no_such_name" in str(e)
     else:
         raise AssertionError("tslip.no_such_name did not raise")
+
+
+def test_a_planar_study_loads_no_3d_gait_search():
+    """``import tslip.sweeps`` (every command and worker imports it) registers the 3-D
+    models without loading their gait searches: those load for a 3-D study only."""
+    loaded = _loaded_after("import tslip.sweeps")
+    assert "tslip.sweeps.run" in loaded  # the check above can see the study code
+    heavy = {"tslip.spatial.gait", "tslip.spatial.lateral", "tslip.spatial.trunk_section",
+             "tslip.sweeps.spatial_point"}
+    assert not loaded & heavy, loaded & heavy
