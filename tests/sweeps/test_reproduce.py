@@ -108,6 +108,25 @@ def test_reproduce_end_to_end_tiny(tmp_path, monkeypatch) -> None:
     assert appendix_e_cached(tmp_path, "tiny")["e2"]["strides_perturbed"] == \
         e2["strides_perturbed"]
 
+    # a rerun into the same folder takes every figure from the folder (none computed),
+    # starts no worker process even when asked for two, and judges every claim as the
+    # first run did
+    from _same import same
+    from tslip.sweeps import _pool, reproduce
+
+    def never(*args: object, **kwargs: object) -> None:
+        pytest.fail(f"computed again or a pool started: {args}")
+
+    monkeypatch.setattr(reproduce, "_figure_task", never)
+    monkeypatch.setattr(reproduce, "_table61_task", never)
+    monkeypatch.setattr(_pool, "prestart", never)
+    monkeypatch.setattr(_pool, "process_pool", never)
+    again, claims_again, _ = run_all(tmp_path, resolution="tiny", workers=2)
+    for key in [*reproduce._figure_jobs("tiny"), "table6.1", "E"]:
+        same(data[key], again[key], key)
+    assert [(c.verdict, repr(c.numbers), repr(c.evidence)) for c in claims_again] == \
+        [(c.verdict, repr(c.numbers), repr(c.evidence)) for c in claims]
+
     doc = json.loads((tmp_path / "claims.json").read_text())
     assert doc["schema"] == 2
     rows = doc["claims"]

@@ -22,6 +22,7 @@ import functools
 import hashlib
 import html
 import io
+import json
 import pickle
 from collections.abc import Callable, Mapping, Sequence
 from datetime import UTC, datetime
@@ -35,6 +36,7 @@ from matplotlib.figure import Figure
 from .. import __version__
 from .._codehash import code_hash
 from .._io import atomic_write, write_json
+from .._results import encode
 from ..model.units import UNIT
 from ..sweeps.claims import Verdict, count_verdicts
 from .notation import axis_label, key_html, tex_html, unit_html, value
@@ -125,17 +127,30 @@ class _Canonical(pickle.Pickler):
 
 
 def _data_digest(v: Any) -> str:
-    """SHA-256 of one figure input as the plotting task receives it (pickled, :class:`_Canonical`).
+    """SHA-256 of one figure input.
 
-    A study result by its spec and columns only: its run record and its
-    ``seconds`` column are timings, which no figure draws. Pickling the same
-    data twice may give other bytes (e.g. a table read from disk and one
-    computed): that draws the figure again, never keeps a stale one.
+    A study result by its spec and columns only (pickled, :class:`_Canonical`):
+    its run record and its ``seconds`` column are timings, which no figure
+    draws. Anything else by its saved form (:func:`tslip._results.encode`, as
+    JSON with sorted keys), which depends on the values only: a figure's data
+    computed and the same data read back from the report folder
+    (:func:`tslip.sweeps.reproduce.figure_load`) give one key, where their
+    pickles differ (objects shared or not, arrays in either memory order, a
+    run's table derived or not). Data that cannot be saved so is pickled. Two
+    digests of the same data that differ draw the figure again, never keep a
+    stale one.
     """
     if hasattr(v, "frame") and hasattr(v, "spec") and hasattr(v, "meta"):
         f = v.frame.drop(columns=["seconds"], errors="ignore")
         v = ("study", v.spec, list(f.columns), [str(t) for t in f.dtypes], list(f.index),
              f.to_numpy(dtype=object))
+    else:
+        try:
+            text = json.dumps(encode(v), sort_keys=True, allow_nan=False)
+        except (TypeError, ValueError):
+            pass
+        else:
+            return hashlib.sha256(text.encode()).hexdigest()
     buf = io.BytesIO()
     _Canonical(buf, protocol=5).dump(v)
     return hashlib.sha256(buf.getvalue()).hexdigest()

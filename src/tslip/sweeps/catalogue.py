@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 
@@ -53,6 +53,7 @@ __all__ = [
     "studies", "study",
     "fig_impulse_linearisation", "fig_pitch_disturbance", "fig_height_change",
     "fig_step_down", "fig_velocity_angle", "fig_friction", "fig_mass_offset_boundary",
+    "MassOffsetBoundary",
 ]
 
 #: Max-norm residual accepted for the global PD gaits (no exact fixed point).
@@ -248,8 +249,16 @@ def fig_friction() -> dict[str, Any]:
 BOUNDARY_TOL = 1e-3
 
 
+class MassOffsetBoundary(TypedDict):
+    """Figure 4.16's stability boundary (:func:`fig_mass_offset_boundary`)."""
+
+    boundary: float
+    bracket: tuple[float, float]
+    tol: float
+
+
 def fig_mass_offset_boundary(step: float = 0.025, stop: float = 1.0,
-                             tol: float = BOUNDARY_TOL) -> dict[str, Any]:
+                             tol: float = BOUNDARY_TOL) -> MassOffsetBoundary:
     """Figure 4.16: the largest r with a stable passive Table 2.1 gait, located by bisection.
 
     Continues the gait from Table 2.1's r upwards in steps of ``step`` to the

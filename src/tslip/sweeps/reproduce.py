@@ -4,9 +4,11 @@
 cached under ``out_dir/studies/<name>/``, so a rerun is instant and an
 interrupted one resumes), computes the single-gait figures, evaluates
 :data:`tslip.sweeps.claims.CLAIMS`; :func:`tslip.plotting.report.reproduce`
-then writes ``out_dir/index.html``. Appendix E (the biped, the slowest
-figure) is cached too, in ``out_dir/figures/``, keyed by the hash of the
-code that computes it (:func:`appendix_e_cached`).
+then writes ``out_dir/index.html``. Every single-gait figure's data, Table
+6.1's and Appendix E's are kept too, in ``out_dir/figures/``, keyed by the
+hash of the code that computes them (:mod:`._figstore`,
+:func:`appendix_e_cached`), so a rerun into the same folder computes nothing
+that is kept and starts no worker.
 
 Where a thesis number does not reproduce, the data carry the evidence the
 package computes: Table 6.1's pitch-rate limit under every placement and
@@ -32,16 +34,13 @@ from __future__ import annotations
 import dataclasses
 import functools
 import itertools
-import json
-import logging
 import math
 import time
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any, Protocol, cast
 
 from .._codehash import code_hash
-from .._io import atomic_write
 from .._safefile import folder
 from ..gait import find_gait, floquet, robustness_report, stride_properties
 from ..gait.fixed_point import Gait, GaitProblem, newton_solve
@@ -49,7 +48,8 @@ from ..gait.robustness import robustness
 from ..model.controllers import LocalVelocity
 from ..model.parameters import preset
 from ..simulation.options import IntegratorOptions
-from . import _pool, catalogue
+from . import _figstore, _pool, catalogue
+from ._figstore import HeightChange, Table61, figure_load, figure_store, kept
 from ._lock import folder_locks
 from ._schedule import Task, Timing, choose_workers, own_seconds, run_tasks
 from ._warmup import ensure, warm_in_background
@@ -199,14 +199,14 @@ def _table61_gait() -> Gait:
     return find_gait(preset("table6.1"))
 
 
-def _table61_assemble(parts: dict[str, Any]) -> dict[str, Any]:
-    return {**parts["core"],
+def _table61_assemble(parts: dict[str, Any]) -> Table61:
+    return {**parts["core"],  # type: ignore[typeddict-item]  # core: Table61's first keys
             "pitch_rate_variants": {label: parts[f"pitch_rate/{label}"]
                                     for label in PITCH_RATE_VARIANTS},
             "alphad_ref_forced": parts["alphad_ref_forced"]}
 
 
-def table61() -> dict[str, Any]:
+def table61() -> Table61:
     """Table 6.1 gait: multipliers, robustness (Section 6.1), stride (Table 6.2).
 
     Also the evidence for the two numbers that do not reproduce: the
@@ -236,28 +236,15 @@ def _appendix_e_load(path: Path, key: str) -> dict[str, Any] | None:
     """
     from .appendix_e import from_json
 
-    if not path.exists():
-        return None
-    try:
-        record = json.loads(path.read_text(encoding="utf-8"))
-        if not (isinstance(record, dict) and set(record) == {"format", "key", "data"}
-                and record["format"] == APPENDIX_E_FORMAT):
-            raise ValueError("not an Appendix E cache of this format")
-        return from_json(record["data"]) if record["key"] == key else None
-    except (OSError, ValueError, TypeError, KeyError, IndexError, AttributeError,
-            OverflowError, RecursionError) as exc:
-        why = " ".join(str(exc).split()) or type(exc).__name__
-        logging.getLogger("tslip").warning("ignoring %s (%s); recomputing Appendix E",
-                                           path, why[:200])
-        return None
+    data: dict[str, Any] | None = _figstore.load(path, key, APPENDIX_E_FORMAT, from_json,
+                                                 "Appendix E")
+    return data
 
 
 def _appendix_e_store(path: Path, key: str, data: dict[str, Any]) -> None:
     from .appendix_e import to_json
 
-    text = json.dumps({"format": APPENDIX_E_FORMAT, "key": key, "data": to_json(data)},
-                      allow_nan=False)
-    atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+    _figstore.store(path, key, APPENDIX_E_FORMAT, to_json(data))
 
 
 def appendix_e_cached(out_dir: str | Path, resolution: str = "full") -> dict[str, Any]:
@@ -284,14 +271,14 @@ def appendix_e_cached(out_dir: str | Path, resolution: str = "full") -> dict[str
 HEIGHT_CHANGE_PRESETS = {"passive": "table2.1", "local_velocity": "table2.1-local-velocity"}
 
 
-def height_change(coarse: bool = False) -> dict[str, Any]:
+def height_change(coarse: bool = False) -> HeightChange:
     """Figure 4.4's speed changes and each gait's own step-down limit.
 
     ``step_down_limit`` maps ``"passive"`` and ``"local_velocity"`` to the
     largest step down [L] the gait survives (:func:`tslip.gait.robustness.robustness`):
     the claim judges convergence at the steps within it and shows the falls beyond.
     """
-    out = catalogue.fig_height_change(coarse)
+    out = cast(HeightChange, catalogue.fig_height_change(coarse))
     out["step_down_limit"] = {key: robustness(catalogue._gait(name), "step_down", check=False)
                               for key, name in HEIGHT_CHANGE_PRESETS.items()}
     return out
@@ -323,8 +310,8 @@ def single_figures(quick: bool | str = False, progress: Progress | None = None,
     """The single-gait analyses (Figures 4.1-4.7, 6.2, C.1, E.2-E.4) and Table 6.1's numbers.
 
     ``quick`` is True/False or a :data:`tslip.sweeps.catalogue.RESOLUTIONS`
-    name; with ``out_dir`` Appendix E's data is cached there
-    (:func:`appendix_e_cached`). Runs here, one after the other
+    name; with ``out_dir`` every figure's data is kept there (:func:`._figstore.figure_load`,
+    :func:`appendix_e_cached`) and read back when still valid. Runs here, one after the other
     (:func:`run_all` runs the same work as parallel tasks).
     """
     res = catalogue.resolution_name(quick)
@@ -335,7 +322,7 @@ def single_figures(quick: bool | str = False, progress: Progress | None = None,
     out = {}
     for key, job in jobs.items():
         t0 = time.perf_counter()
-        out[key] = job()
+        out[key] = job() if key == "E" else kept(out_dir, res, key, job)
         if progress:
             progress("figure", key, time.perf_counter() - t0)
     return out
@@ -367,21 +354,28 @@ def _piece_task(fn: Callable[..., Any], args: tuple[Any, ...], tick: Any = None)
 class _Figures:
     """The single-gait figures, Table 6.1 and Appendix E as scheduler tasks.
 
-    A figure made of pieces is assembled when its last piece arrives;
-    Appendix E is taken from its cache when valid and cached when computed.
+    A figure made of pieces is assembled when its last piece arrives; each is
+    taken from the report folder when kept there and still valid
+    (:func:`._figstore.figure_load`, :func:`appendix_e_cached`), and kept there when computed.
     """
 
     def __init__(self, res: str, out: Path, progress: Progress | None,
                  arrived: Callable[[], None], timing: Timing) -> None:
         from . import appendix_e
 
-        self.res, self.progress, self.timing = res, progress, timing
+        self.res, self.out, self.progress, self.timing = res, out, progress, timing
         self.arrived: Callable[[], None] = lambda: None
         self.data: dict[str, Any] = {}
-        self.tasks = [Task(("figure", k), _figure_task, (res, k), FIGURE_SECONDS[k])
-                      for k in _figure_jobs(res)]
-        self.tasks += [Task(("figure", "table6.1", k), _table61_task, (k,), sec)
-                       for k, (_, sec) in TABLE61_PIECES.items()]
+        self.tasks = []
+        for k in [*_figure_jobs(res), "table6.1"]:
+            stored = figure_load(out, res, k)
+            if stored is not None:
+                self._done(k, stored)
+            elif k == "table6.1":
+                self.tasks += [Task(("figure", k, piece), _table61_task, (piece,), sec)
+                               for piece, (_, sec) in TABLE61_PIECES.items()]
+            else:
+                self.tasks.append(Task(("figure", k), _figure_task, (res, k), FIGURE_SECONDS[k]))
         self.t61: dict[str, Any] = {}
         self.e_path, self.e_key = _appendix_e_entry(out, res)
         cached = _appendix_e_load(self.e_path, self.e_key)
@@ -414,7 +408,9 @@ class _Figures:
         if key == "table6.1":
             self.t61[task.key[2]] = result
             if len(self.t61) == len(TABLE61_PIECES):
-                self._done(key, _table61_assemble(self.t61))
+                table = _table61_assemble(self.t61)
+                figure_store(self.out, self.res, key, table)
+                self._done(key, table)
         elif key == "E":
             self.e_parts[task.key[2]] = result
             if len(self.e_parts) == len(self.e_pieces):
@@ -422,6 +418,7 @@ class _Figures:
                 _appendix_e_store(self.e_path, self.e_key, data)
                 self._done(key, data)
         else:
+            figure_store(self.out, self.res, key, result)
             self._done(key, result)
         return []
 
@@ -512,9 +509,6 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
     timing = {} if timing is None else timing
     preload = ["tslip.sweeps.run", __name__, *(extra.modules if extra is not None else ()),
                "tslip.sweeps._prewarm"]  # last: compiles what the modules above use, once
-    if scheduler is None and workers != 1:  # likely parallel: the workers' imports start now
-        warm_in_background()  # biped, recorded runs: here (claimed before the fork server
-        _pool.prestart(preload)  # starts), while the fork server warms the gait search
     with folder_locks((out / "studies" / name for name in specs), root=out):
         folder(out, out / "figures")  # the report's figures: a link there is refused
         jobs = {name: StudyJob(spec, out / "studies" / name, writes=scheduler is None)
@@ -539,6 +533,9 @@ def run_catalogue(out_dir: str | Path, resolution: bool | str = False, *,
         cost = sum(j.cost for j in jobs.values()) + figures.cost
         cost += extra.cost if extra is not None else 0.0
         n = 1 if scheduler is not None else choose_workers(cost, workers)
+        if scheduler is None and n > 1 and cost > 0:  # parallel: the workers' imports start
+            warm_in_background()  # now; biped, recorded runs: here (claimed before the fork
+            _pool.prestart(preload)  # server starts), while it warms the gait search
         if info is not None:
             info["workers"] = n
         if progress:
