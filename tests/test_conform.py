@@ -65,7 +65,8 @@ def test_other_values_fail_naming_the_field(value, tp, where) -> None:
 
 def test_a_recorded_run_checks_through_its_descriptor_and_lazy_steps() -> None:
     """``Trajectory.data`` is a descriptor (checked as the array it returns) and its
-    ``steps`` a sequence built on first read (checked item by item)."""
+    ``steps`` a sequence the run builds from its arrays on first read (not a list or
+    tuple: its items are not checked, which would build them)."""
     from tslip.simulation.result import Trajectory
 
     p = preset("table2.1")

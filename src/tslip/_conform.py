@@ -12,8 +12,10 @@ What each annotation accepts:
   ``bool``, ``str``, ``None``: that type (NumPy scalars count as their kind);
 * ``np.ndarray``: an array of numbers or booleans (never of objects);
 * ``tuple[X, ...]``, ``tuple[X, Y]``, ``list[X]``, ``dict[K, V]``,
-  ``Mapping[K, V]``: that container, every item checked; ``Sequence[X]``: any
-  sequence but text, every item checked;
+  ``Mapping[K, V]``: that container, every item checked; ``Sequence[X]``: a list
+  or tuple, every item checked, or another sequence but text, unchecked (a class's
+  own view of its checked fields, e.g. a recorded run's ``steps``, built from its
+  arrays on first read: checking its items would build them);
 * a ``TypedDict``: a dict with exactly its keys, each value checked;
 * a dataclass: an instance of it, every field checked against the class's
   own annotations (resolved with :func:`typing.get_type_hints`; a field whose
@@ -119,6 +121,8 @@ def _why(v: Any, tp: Any, where: str) -> str | None:  # noqa: C901 - one case pe
         if not isinstance(v, list if origin is list else collections.abc.Sequence) or \
                 isinstance(v, (str, bytes)):
             return bad
+        if not isinstance(v, (list, tuple)):  # built by its owner from its checked fields
+            return None
         item = args[0] if args else Any
         return _first((f"{where}[{i}]", x, item) for i, x in enumerate(v))
     if origin in (dict, collections.abc.Mapping):
