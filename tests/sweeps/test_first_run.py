@@ -126,6 +126,31 @@ def test_no_kernel_is_compiled_in_two_processes(tmp_path):
     assert not twice, twice
 
 
+def test_the_stored_gaits_are_gaits_of_their_presets():
+    """The recorded runs' workload runs from stored gaits instead of searching them (so it
+    needs none of the gait search's kernels): each is its preset but the unknowns the
+    search solves, and one stride maps its touch-down state to itself (Section 2.8's
+    periodicity; the search stopped at a residual below 1e-12, integrating to 1e-12 as
+    here)."""
+    import dataclasses
+
+    import numpy as np
+
+    import tslip
+    from tslip.sweeps._warmup import STORED_GAITS, stored_gait
+
+    assert set(STORED_GAITS) == {"table2.1", "table6.1"}  # the figures' and Table 6.1's
+    for name in STORED_GAITS:
+        g = stored_gait(name)
+        base = tslip.preset(name)
+        assert dataclasses.replace(g.params, alpha_r=base.alpha_r,
+                                   controller=base.controller) == base
+        q = g.state.section()
+        res = tslip.step_map(g.params, q, options=tslip.IntegratorOptions.tight("dop853"))
+        assert res.status == tslip.Status.OK
+        assert np.max(np.abs(res.q - q)) < 1e-11, name
+
+
 def test_study_and_reproduce_pools_warm_their_kernels_before_forking(monkeypatch, tmp_path):
     """The wiring: both pools' fork servers import ``_prewarm``, last (after the task modules)."""
     from tslip.sweeps import _pool, catalogue, reproduce, run
