@@ -92,12 +92,15 @@ _RUN = textwrap.dedent("""
 def test_no_kernel_is_compiled_in_two_processes(tmp_path):
     """Two gait searches at once on 2 workers from an empty cache, as a study's pool runs
     them, while this process warms the recorded runs (as ``tslip reproduce`` does): every
-    kernel signature compiles in one process (the gait search's in the fork server, the
-    recorded runs' here, after the gait search's are cached).
+    kernel signature compiles in one process (the strides' and the gait search's in the
+    fork server, the recorded runs' here, after the strides are cached, while the fork
+    server compiles the gait search).
 
     Without ``tslip.sweeps._prewarm`` in the preload, both workers compile the
-    stride kernels at the same moment; without the wait for the gait search
-    (``_warmup.NEEDS``), this process compiles them too (the break checks).
+    stride kernels at the same moment; without the wait for the strides
+    (``_warmup.NEEDS``), this process compiles them too; with a recorded runs' workload
+    that searches its gaits (``catalogue._gait``), this process compiles the gait
+    search's Jacobian kernel too (the break checks).
     """
     site = tmp_path / "site"
     site.mkdir()
