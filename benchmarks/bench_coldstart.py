@@ -117,10 +117,10 @@ class _Log(event.Listener):
     def on_start(self, e):
         if not hasattr(_local, "stack"):
             _local.stack = []
-        _local.stack.append([time.thread_time(), 0.0])
+        _local.stack.append([time.thread_time(), 0.0, time.time()])
 
     def on_end(self, e):
-        c0, inner = _local.stack.pop()
+        c0, inner, t0 = _local.stack.pop()
         incl = time.thread_time() - c0
         if _local.stack:
             _local.stack[-1][1] += incl
@@ -128,7 +128,7 @@ class _Log(event.Listener):
         rec = {"pid": os.getpid(), "thread": threading.current_thread().name,
                "fn": d.py_func.__module__ + "." + d.py_func.__qualname__,
                "args": str(e.data["args"]), "cpu": incl - inner, "incl": incl,
-               "depth": len(_local.stack), "t": time.time()}
+               "depth": len(_local.stack), "t0": t0, "t": time.time()}
         with open(os.environ["TSLIP_BENCH_COMPILE_LOG"], "a") as f:
             f.write(json.dumps(rec) + "\\n")
 
@@ -169,6 +169,7 @@ def timed_run(cmd: list[str], env: dict[str, str], cwd: Path, log: Path,
     load = os.getloadavg()[0]
     t0 = time.perf_counter()
     first = float("nan")
+    start = time.time()
     with log.open("w") as out:
         p = subprocess.Popen(cmd, env=env, cwd=cwd, stdout=subprocess.PIPE,
                              stderr=subprocess.STDOUT, text=True)
@@ -185,7 +186,8 @@ def timed_run(cmd: list[str], env: dict[str, str], cwd: Path, log: Path,
     cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
     if p.returncode:
         raise SystemExit(f"{shlex.join(cmd)} failed ({p.returncode}); see {log}")
-    return {"wall": wall, "cpu": cpu, "first": first, "load": load}
+    return {"wall": wall, "cpu": cpu, "first": first, "load": load, "start": start,
+            "pid": p.pid}
 
 
 def same_results(a: Path, b: Path) -> list[str]:
@@ -210,14 +212,42 @@ def _family_of(fn: str) -> str:
     """A compiled function's kernel family (by its top-level kernel's package and method)."""
     if ".biped." in fn:
         return "biped"
+    if fn.endswith(("_stride.stride", "_stride.run_row")):
+        return "TSLIP strides"
     if "_record." in fn or "run_batch" in fn or "flight_state" in fn:
         return "TSLIP recorded runs"
     return "TSLIP gait search and analyses"
 
 
-def compile_breakdown(log: Path) -> float:
-    """Print the compile CPU seconds of ``log`` per process, family and top-level kernel;
-    return their sum."""
+def compile_timeline(recs: list[dict], start: float, main_pid: int) -> None:
+    """Print when each process compiled which family: its top-level tslip kernels, runs of
+    one family merged, as ``[from - to s] family (CPU s)`` from the run's start; the
+    gaps between them are where that process compiled nothing of tslip."""
+    print("compile timeline (wall seconds from the start of the run; top-level kernels):")
+    spans: dict[tuple[int, str], list[list]] = defaultdict(list)
+    cpu: dict[tuple[int, str], float] = defaultdict(float)
+    for r in recs:
+        cpu[(r["pid"], r["thread"])] += r["cpu"]
+        if r["depth"] or not r["fn"].startswith("tslip.") or "t0" not in r:
+            continue
+        fam, t0, t1 = _family_of(r["fn"]), r["t0"] - start, r["t"] - start
+        runs = spans[(r["pid"], r["thread"])]
+        if runs and runs[-1][0] == fam:
+            runs[-1][2] = t1
+            runs[-1][3] += r["incl"]
+        else:
+            runs.append([fam, t0, t1, r["incl"]])
+    for (pid, thread), runs in sorted(spans.items(), key=lambda kv: kv[1][0][1]):
+        who = "tslip's own process" if pid == main_pid else "another process"
+        print(f"  {who} {pid} {thread}:")
+        for fam, t0, t1, c in runs:
+            print(f"    [{t0:6.1f} - {t1:6.1f} s] {fam} ({c:.1f} s CPU)")
+
+
+def compile_breakdown(log: Path, start: float | None = None, main_pid: int = 0) -> float:
+    """Print the compile CPU seconds of ``log`` per process, family and top-level kernel
+    (with ``start``, the run's epoch seconds, also :func:`compile_timeline`); return their
+    sum."""
     recs = [json.loads(line) for line in log.read_text().splitlines()]
     if not recs:
         print("no compiles recorded")
@@ -235,6 +265,8 @@ def compile_breakdown(log: Path) -> float:
             per_top[(_family_of(r["fn"]), top)] += sum(
                 x["cpu"] for x in stack_top.pop((r["pid"], r["thread"])))
     print(f"compile CPU: {sum(r['cpu'] for r in recs):.1f} s in {len(recs)} compiles")
+    if start is not None:
+        compile_timeline(recs, start, main_pid)
     for (pid, thread), c in sorted(per_proc.items(), key=lambda kv: -kv[1]):
         print(f"  process {pid} {thread:12s} {c:6.1f} s")
     fam: dict[str, float] = defaultdict(float)
@@ -311,7 +343,11 @@ def first_run(reuse_venv: str | None, compile_log: bool, keep: bool,
           f"{not re.search('compil', (tmp / 'warm.log').read_text())}")
     diffs = same_results(clone / "report-cold", clone / "report-warm")
     print("results identical to the warm run's" if not diffs else f"results DIFFER: {diffs}")
-    compiled = compile_breakdown(tmp / "compiles.jsonl") if compile_log else float("nan")
+    for line in (tmp / "cold.log").read_text().splitlines():
+        if "compiled " in line or "first run:" in line:
+            print(f"said {line}")
+    compiled = (compile_breakdown(tmp / "compiles.jsonl", cold["start"], int(cold["pid"]))
+                if compile_log else float("nan"))
     if keep:
         print(f"kept {tmp}")
     else:

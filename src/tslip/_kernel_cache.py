@@ -89,14 +89,17 @@ def check(dispatcher: object, module_file: str) -> None:
 #: its subpackage and the kernels (``module.function`` as numba names their
 #: index files ``module.function-LINE.pyXY.nbi``) that must all be cached.
 #: Measured: the kernels each workload of :mod:`tslip.sweeps._warmup` compiles
-#: that no other family compiles (their callees are cached with them); the
+#: that no other family compiles (their callees are cached with them). The TSLIP's
+#: strides (the stride kernel and a run of strides) are the one part both the gait
+#: search and the recorded runs call: a family of their own, compiled first, so that
+#: neither waits for the other whole (numba's compile events, 2026-12-06). The
 #: biped's family (one stride loop for both Runge-Kutta pairs) also holds the
 #: helpers Appendix E calls from Python
 #: (body kinematics, controller references), which workers compiled otherwise.
 FAMILIES: dict[str, tuple[str, tuple[str, ...]]] = {
+    "TSLIP strides": ("simulation", ("_stride.stride", "_stride.run_row")),
     "TSLIP gait search and analyses": ("simulation", (
-        "_stride.stride", "_stride.section_map", "_variational.stride_jacobian",
-        "_stride.run_row", "_flight.alpha_r_column")),
+        "_stride.section_map", "_variational.stride_jacobian", "_flight.alpha_r_column")),
     "TSLIP recorded runs": ("simulation", (
         "_record.record_run", "_stride.run_batch_serial", "_flight.flight_state")),
     "biped": ("biped", ("_stride._integrate", "_tmt.kinematics", "_control.references")),

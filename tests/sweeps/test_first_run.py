@@ -92,12 +92,15 @@ _RUN = textwrap.dedent("""
 def test_no_kernel_is_compiled_in_two_processes(tmp_path):
     """Two gait searches at once on 2 workers from an empty cache, as a study's pool runs
     them, while this process warms the recorded runs (as ``tslip reproduce`` does): every
-    kernel signature compiles in one process (the gait search's in the fork server, the
-    recorded runs' here, after the gait search's are cached).
+    kernel signature compiles in one process (the strides' and the gait search's in the
+    fork server, the recorded runs' here, after the strides are cached, while the fork
+    server compiles the gait search).
 
     Without ``tslip.sweeps._prewarm`` in the preload, both workers compile the
-    stride kernels at the same moment; without the wait for the gait search
-    (``_warmup.NEEDS``), this process compiles them too (the break checks).
+    stride kernels at the same moment; without the wait for the strides
+    (``_warmup.NEEDS``), this process compiles them too; with a recorded runs' workload
+    that searches its gaits (``catalogue._gait``), this process compiles the gait
+    search's Jacobian kernel too (the break checks).
     """
     site = tmp_path / "site"
     site.mkdir()
@@ -124,6 +127,31 @@ def test_no_kernel_is_compiled_in_two_processes(tmp_path):
     # anything and are never cached: only the package's kernels count
     twice = {k: v for k, v in where.items() if len(v) > 1 and k[0].startswith("tslip.")}
     assert not twice, twice
+
+
+def test_the_stored_gaits_are_gaits_of_their_presets():
+    """The recorded runs' workload runs from stored gaits instead of searching them (so it
+    needs none of the gait search's kernels): each is its preset but the unknowns the
+    search solves, and one stride maps its touch-down state to itself (Section 2.8's
+    periodicity; the search stopped at a residual below 1e-12, integrating to 1e-12 as
+    here)."""
+    import dataclasses
+
+    import numpy as np
+
+    import tslip
+    from tslip.sweeps._warmup import STORED_GAITS, stored_gait
+
+    assert set(STORED_GAITS) == {"table2.1", "table6.1"}  # the figures' and Table 6.1's
+    for name in STORED_GAITS:
+        g = stored_gait(name)
+        base = tslip.preset(name)
+        assert dataclasses.replace(g.params, alpha_r=base.alpha_r,
+                                   controller=base.controller) == base
+        q = g.state.section()
+        res = tslip.step_map(g.params, q, options=tslip.IntegratorOptions.tight("dop853"))
+        assert res.status == tslip.Status.OK
+        assert np.max(np.abs(res.q - q)) < 1e-11, name
 
 
 def test_study_and_reproduce_pools_warm_their_kernels_before_forking(monkeypatch, tmp_path):

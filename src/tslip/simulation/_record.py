@@ -422,7 +422,10 @@ def fill_table(P, rows, starts, outs, info, n, table, step, stance):
         most = max(most, int(info[s, RI_ROW1] - info[s, RI_ROW0]))
     # sin beta, cos beta, sin phi, cos phi, leg force, spring energy of a group's rows
     trig = np.empty((6, GROUP_ROWS + most))
-    s0 = 0
+    # not the literal 0: typing the loop's first pass with Literal[int](0) compiled
+    # _record_columns and _flight_rows a second time, for that literal (a fifth of this
+    # kernel's compile time; the calls run the int64 ones either way)
+    s0 = np.int64(0)
     while s0 < n:
         a = int(info[s0, RI_ROW0])
         s1 = s0 + 1

@@ -39,6 +39,8 @@ from .. import _kernel_cache
 if TYPE_CHECKING:
     from rich.console import Console
 
+    from ..gait import Gait
+
 __all__ = ["MAIN_PROCESS_FAMILIES", "WORKLOADS", "announce", "claim", "ensure", "warm",
            "warm_in_background",
            "warm_missing"]
@@ -71,18 +73,77 @@ def _study_point() -> None:
         ready.extend(job.on_done(task, task.fn(*task.args, None)))
 
 
+def _strides() -> None:
+    """A run of strides as the gait search's analyses and the recorded runs' batches run
+    one (:func:`tslip.simulation._packed.run`: the run-of-strides kernel and the stride
+    kernel it calls, with the signatures every caller uses: float64 arrays, an int)."""
+    import numpy as np
+
+    from ..model import preset
+    from ..model._pack import pack_params
+    from ..simulation import IntegratorOptions, _packed
+
+    td = _packed.touchdown(np.array([1.05, 0.0, 5.0, -0.3, 0.0]), 0.0)
+    _packed.run(pack_params(preset("table2.1")), IntegratorOptions().packed(), td, 2,
+                np.empty(0), np.zeros(1))
+
+
+#: The Table 2.1 and Table 6.1 gaits as :func:`tslip.find_gait` found them (2026-12-06):
+#: each preset's changes (the solved ``alpha_r``, and Table 6.1's ``alphad_ref``) and the
+#: touch-down state ``(beta, phi, xd, yd, phid)``. The recorded runs' workload
+#: (:func:`_recorded`) runs from these instead of searching the gaits, so that it needs
+#: none of the gait search's kernels: only the strides, which the other process compiles
+#: first (:data:`NEEDS`). Only the kernels' signatures matter here; a test checks that
+#: these are still gaits (one stride maps each to itself).
+STORED_GAITS: dict[str, tuple[dict[str, float], tuple[float, ...]]] = {
+    "table2.1": ({"alpha_r": 0.7934842721906721},
+                 (1.05, -0.00418810169145456, 4.99840801578607, -0.12616381305893787,
+                  -0.033195744405056904)),
+    "table6.1": ({"alpha_r": 1.0329949767502447, "alphad_ref": 2.3201709832486657},
+                 (0.93, 0.2895262019971058, 1.8983614664924113, -0.07889069993846931,
+                  -0.11983685057850357)),
+}
+
+
+def stored_gait(name: str) -> Gait:
+    """The gait of preset ``name`` from :data:`STORED_GAITS`, without a search."""
+    import dataclasses
+
+    from ..gait import Gait
+    from ..model import TouchdownState, preset
+
+    changes, (beta, phi, xd, yd, phid) = STORED_GAITS[name]
+    p = preset(name)
+    if "alphad_ref" in changes:
+        p = dataclasses.replace(p, controller=dataclasses.replace(  # type: ignore[call-arg]
+            p.controller, alphad_ref=changes["alphad_ref"]))
+    p = dataclasses.replace(p, alpha_r=changes["alpha_r"])
+    state = TouchdownState(beta=beta, phi=phi, xd=xd, yd=yd, phid=phid)
+    return Gait(state=state, params=p, residual=0.0, stance_time=float("nan"),
+                flight_time=float("nan"), converged=True, message="stored (no search)")
+
+
 def _recorded() -> None:
-    """The single-gait figures' and Table 6.1's computations (recorded runs, disturbances)."""
-    from . import catalogue
+    """The single-gait figures' and Table 6.1's recorded runs and disturbances (as
+    :mod:`.catalogue`'s figures and :func:`.reproduce.pitch_rate_variants` run them), from
+    the stored gaits: no gait search."""
+    from ..gait import (
+        friction_ratio,
+        impulse_linearisation,
+        pitch_disturbance_response,
+        step_down_response,
+        velocity_angle_effect,
+    )
+    from .reproduce import pitch_rate_variants
 
-    catalogue.fig_impulse_linearisation()
-    catalogue.fig_pitch_disturbance("table2.1")
-    catalogue.fig_step_down()
-    catalogue.fig_velocity_angle()
-    catalogue.fig_friction()
-    from .reproduce import _table61_gait, pitch_rate_variants
-
-    pitch_rate_variants(_table61_gait())  # disturbances in flight: batches of runs
+    g21, g61 = stored_gait("table2.1"), stored_gait("table6.1")
+    impulse_linearisation(g21)  # Figure 4.1
+    pitch_disturbance_response(g21, (-0.5, 0.0, 0.5))  # Figures 4.2, 4.3, 6.2
+    step_down_response(g21, -0.2, 30)  # Figures 4.5, 4.6
+    velocity_angle_effect(g21, (-0.05, 0.0, 0.05))  # Figure 4.7
+    for g in (g21, g61):  # Figure C.1
+        friction_ratio(g.params, g.state, 1.0)
+    pitch_rate_variants(g61)  # Table 6.1: disturbances in flight, batches of runs
 
 
 def _biped() -> None:
@@ -163,6 +224,7 @@ def _missing(packages: tuple[str, ...]) -> tuple[dict[str, Path], str, list[str]
 
 #: How to compile each family of :data:`tslip._kernel_cache.FAMILIES`: a tiny run of it.
 WORKLOADS: dict[str, Callable[[], None]] = {
+    "TSLIP strides": _strides,
     "TSLIP gait search and analyses": _study_point,
     "TSLIP recorded runs": _recorded,
     "biped": _biped,
@@ -175,16 +237,19 @@ MODEL_FAMILIES: dict[str, tuple[str, ...]] = {"slip3d": ("3-D spring-mass runner
 
 
 #: The families ``tslip reproduce``'s own process warms (:func:`warm_in_background`), in
-#: this order, while its fork server warms the others (the TSLIP's gait search): the
-#: fork server forks the workers once its own families are warm, and the tasks that need
-#: these wait for them (:func:`ensure`). The recorded runs' workload finds gaits, so it
-#: waits for the gait search's kernels to be cached first and loads them: compiled
-#: alone from an empty cache, it compiles 34 of the 35 signatures the gait search's
-#: workload compiles (numba's compile events, 2026-12-06).
+#: this order, while its fork server warms the others (the TSLIP's strides, then its gait
+#: search): the fork server forks the workers once its own families are warm, and the
+#: tasks that need these wait for them (:func:`ensure`). The recorded runs call the stride
+#: kernels too (a recorded run is strides; a batch, runs of strides), so their workload
+#: waits for those to be cached and loads them, but not for the gait search: it runs
+#: from :data:`STORED_GAITS` and compiles none of the gait search's kernels. The biped
+#: compiles meanwhile. Measured with numba's compile events (2026-12-06): the strides
+#: are 11 of the 16 signatures the gait search's workload compiles alone, and the
+#: recorded runs' workload compiles those 11 and none of the other 5.
 MAIN_PROCESS_FAMILIES: tuple[str, ...] = ("biped", "TSLIP recorded runs")
 #: What a family's workload needs cached before it starts without compiling another
 #: family's kernels (see :data:`MAIN_PROCESS_FAMILIES`).
-NEEDS: dict[str, tuple[str, ...]] = {"TSLIP recorded runs": ("TSLIP gait search and analyses",)}
+NEEDS: dict[str, tuple[str, ...]] = {"TSLIP recorded runs": ("TSLIP strides",)}
 #: Seconds :func:`warm_in_background` waits at most for a family it needs, and at least
 #: (the fork server may not have claimed it yet) before it stops waiting for one nobody warms.
 NEEDS_TIMEOUT = 600.0
@@ -307,7 +372,8 @@ def warm_in_background(families: tuple[str, ...] = MAIN_PROCESS_FAMILIES) -> thr
     """Warm the missing ones of ``families``, in order, in a daemon thread of this process.
 
     ``tslip reproduce`` calls it right after starting its fork server, which
-    warms the gait search meanwhile (:mod:`._prewarm`, :func:`warm_missing`):
+    warms the strides and the gait search meanwhile (:mod:`._prewarm`,
+    :func:`warm_missing`):
     the compiling is split over the two processes. Every claim of
     ``families`` is taken at once, so the fork server finds them held and
     leaves them; each family then waits for what it :data:`NEEDS`, so no

@@ -330,7 +330,7 @@ def single_figures(quick: bool | str = False, progress: Progress | None = None,
 
 #: The kernel families the single-gait figures and Table 6.1 use (the workers may start
 #: before ``tslip reproduce``'s own process has them cached: :func:`._warmup.ensure`).
-_TSLIP_FAMILIES = ("TSLIP gait search and analyses", "TSLIP recorded runs")
+_TSLIP_FAMILIES = ("TSLIP strides", "TSLIP gait search and analyses", "TSLIP recorded runs")
 
 
 def _figure_task(res: str, key: str, tick: Any = None) -> Any:
