@@ -311,6 +311,7 @@ class GaitProblem:
     # copies, read only)
     _dq0: np.ndarray = field(init=False, repr=False, compare=False)
     _dr0: np.ndarray = field(init=False, repr=False, compare=False)
+    _moving_speed: bool = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not self.names:
@@ -356,6 +357,8 @@ class GaitProblem:
         dr0[3, i_delta] = 1.0
         object.__setattr__(self, "_dq0", dq0)
         object.__setattr__(self, "_dr0", dr0)
+        object.__setattr__(self, "_moving_speed",
+                           not (self.fix == "speed" and self.section == "touchdown"))
 
     @classmethod
     def from_params(cls, params: Params, options: IntegratorOptions | None = None, *,
@@ -527,7 +530,8 @@ class GaitProblem:
             return r, np.full((5, n), math.nan)
         delta, phi, phid, _, ref = x
         i_delta, i_phi, i_phid, i_alpha, i_ref = self._at
-        dv = self._speed_gradient(delta, phi, phid, v)
+        # the touch-down speed held (the usual search) has no gradient
+        dv = self._speed_gradient(delta, phi, phid, v) if self._moving_speed else ()
         cd, sd = math.cos(delta), math.sin(delta)
         # dq/dz, q = (beta0, phi, v cos delta, v sin delta, phid): dq/dphi and dq/dphid
         # are ones (self._dq0)
