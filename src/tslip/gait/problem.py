@@ -311,6 +311,7 @@ class GaitProblem:
     # copies, read only)
     _dq0: np.ndarray = field(init=False, repr=False, compare=False)
     _dr0: np.ndarray = field(init=False, repr=False, compare=False)
+    # whether the touch-down speed moves with z (else it is params.v0: :meth:`speed`)
     _moving_speed: bool = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -497,7 +498,7 @@ class GaitProblem:
         P[pk.P_ALPHA] = alpha_r
         if self._at[4] >= 0:
             P[self._ref_slot] = self._ref_gain * ref
-        v = self.speed(delta, phi, phid)
+        v = self.speed(delta, phi, phid) if self._moving_speed else self.params.v0
         q = (self.params.beta0, phi, v * math.cos(delta), v * math.sin(delta), phid)
         out = _NAN_OUT.copy()
         J = _NAN_J.copy() if jacobian else None
