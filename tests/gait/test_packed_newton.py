@@ -8,6 +8,7 @@ residual, and a plain bisection over ``tslip.simulate``.
 
 import dataclasses
 import itertools
+import warnings
 
 import numpy as np
 import pytest
@@ -105,6 +106,51 @@ def test_residual_jacobian_agrees_with_central_differences(name):
     Jfd = np.column_stack([(prob.residual(z + h * e) - prob.residual(z - h * e)) / (2 * h)
                            for e in np.eye(prob.size)])
     np.testing.assert_allclose(J, Jfd, rtol=0, atol=2e-7 * max(1.0, np.abs(Jfd).max()))
+
+
+@pytest.mark.parametrize(("name", "kw"), [
+    ("table2.1", {"fix": "energy"}), ("table2.1", {"section": "apex"}),
+    ("table2.1-local-velocity", {"fix": "energy"}),
+    ("table2.1-constant-torque", {"section": "apex"}), ("leg-thrust", {})])
+def test_residual_jacobian_of_every_held_quantity_agrees_with_central_differences(name, kw):
+    """The energy or the apex speed held moves the touch-down speed with ``z`` (its
+    gradient enters ``dq/dz`` and ``r``'s last row); with leg damping the passive hip's
+    search solves the leg thrust (its column by the reference's central difference)."""
+    if name == "leg-thrust":
+        p = dataclasses.replace(tslip.preset("table2.1"), c_l=0.3)
+    else:
+        p = tslip.preset(name)
+    g = tslip.find_gait(p, **kw)
+    assert g.converged
+    prob = GaitProblem.from_params(g.params, fix=g.fix, section=g.section,
+                                   energy=g.energy if g.fix == "energy" else None)
+    assert name != "leg-thrust" or prob.names[-1] == "leg_thrust"
+    z = prob.encode(g) + 2e-3
+    r, J = prob.residual_jacobian(z)
+    np.testing.assert_array_equal(r, prob.residual(z))
+    h = 1e-6
+    Jfd = np.column_stack([(prob.residual(z + h * e) - prob.residual(z - h * e)) / (2 * h)
+                           for e in np.eye(prob.size)])
+    np.testing.assert_allclose(J, Jfd, rtol=0, atol=2e-7 * max(1.0, np.abs(Jfd).max()))
+
+
+def test_finite_is_numpys_isfinite_all():
+    """``problem._finite`` against ``np.isfinite(a).all()``, on the Jacobians' shapes, huge
+    finite entries included, and each kind of non-finite entry, with every floating-point
+    warning an error: a non-finite Jacobian is an answer (False), not a warning."""
+    from tslip.gait.problem import _finite
+
+    rng = np.random.default_rng(5)
+    for shape in [(5, 5), (5, 3), (5, 4), (5, 6), (5,)]:
+        a = rng.standard_normal(shape) * 1e307  # finite, and 0 * a is 0
+        assert _finite(a) is True and np.isfinite(a).all()
+        for bad in (np.nan, np.inf, -np.inf):
+            for i in (0, a.size - 1):
+                b = a.copy()
+                b.flat[i] = bad
+                with np.errstate(all="raise"), warnings.catch_warnings():
+                    warnings.simplefilter("error")
+                    assert _finite(b) is False
 
 
 # ---------------------------------------------------------------------------

@@ -359,7 +359,7 @@ def _lstsq(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _norm(r: np.ndarray) -> float:
     """``np.linalg.norm(r)`` of a float vector, without its generality (the same bits)."""
-    return math.sqrt(float(r.dot(r)))
+    return math.sqrt(r.dot(r))  # (a NumPy float is a float: no conversion)
 
 
 # ---------------------------------------------------------------------------

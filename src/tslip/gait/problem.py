@@ -53,7 +53,7 @@ C1_OFFSET = 25.0
 #: tolerance 1e-12 with DOP853.
 TIGHT = IntegratorOptions.tight("dop853")
 
-_FALL_PENALTY = 10.0
+_FALL_PENALTY = 10.0  # each entry of the residual after a fall (_PENALTY)
 _TWO_PI = 2.0 * math.pi
 
 _T = TypeVar("_T")
@@ -162,16 +162,22 @@ _ALLOWED_NAMES = frozenset(("delta", *mid, "alpha_r", *ext)
 #: What a stride's output vector and Jacobian hold before the kernel fills them.
 _NAN_OUT = np.full(pk.NOUT, math.nan)
 _NAN_J = np.full((5, 5), math.nan)
+_NAN_OUT2 = np.full((2, pk.NOUT), math.nan)
+#: ``dr/dq'`` but for the entries of the next touch-down's velocity (residual_jacobian).
+_D0 = np.zeros((5, 5))
+_D0[0, 0] = _D0[1, 1] = _D0[2, 4] = 1.0
+#: The residual after a fall (copied: ``np.full`` costs four copies on a 5-vector).
+_PENALTY = np.full(5, _FALL_PENALTY)
 _F64 = np.dtype(np.float64)
-
-
+_OK = int(Status.OK)
 def _finite(a: np.ndarray) -> bool:
-    """``np.isfinite(a).all()`` of a float array, at a quarter of its cost on a 5 x 5.
+    """``np.isfinite(a).all()`` of a float array, at about half its cost on a 5 x 5.
 
-    ``0 * x`` is 0 for every finite ``x`` and NaN for a NaN or an inf, so a dot
-    with zeros is 0 exactly when every entry is finite.
+    Each entry by ``math.isfinite``: no NumPy arithmetic, so an inf or a NaN sets
+    no floating-point flag and warns of nothing (a dot with zeros, tried before,
+    warned "invalid value" on an inf: ``inf * 0``).
     """
-    return bool(a.ravel().dot(np.zeros(a.size)) == 0.0)
+    return all(map(math.isfinite, a.ravel().tolist()))
 
 
 def nominal_energy(params: Params) -> float:
@@ -211,21 +217,24 @@ def gait_residual(params: Params, state: TouchdownState,
     out = np.full(pk.NOUT, math.nan)
     out[pk.OUT_TD : pk.OUT_TD + 5] = res.q
     out[pk.OUT_TS], out[pk.OUT_TF] = res.stance_time, res.flight_time
-    return _section_residual(q, int(res.status), out, params, params.v0)
+    return _section_residual(tuple(q.tolist()), int(res.status), out.tolist(), params.beta0,
+                             params.v0)
 
 
-def _section_residual(q: np.ndarray, status: int, out: np.ndarray,
-                      params: Params, v0: float) -> tuple[np.ndarray, float, float]:
+def _section_residual(q: tuple[float, ...], status: int, out: list[float], beta0: float,
+                      v0: float) -> tuple[np.ndarray, float, float]:
     """:func:`gait_residual` of the stride from section ``q`` that filled ``out``.
 
-    ``v0``: the touch-down speed the next touch-down must have (the search's).
+    ``q`` and ``out`` (the kernel's ``out`` vector) as Python floats; ``beta0``:
+    the touch-down angle and ``v0`` the touch-down speed the next touch-down must
+    have (the search's).
     """
-    ts, tf = float(out[pk.OUT_TS]), float(out[pk.OUT_TF])
-    if status != Status.OK:
-        return np.full(5, _FALL_PENALTY), ts, tf
-    b, ph, xd, yd, phd = out[pk.OUT_TD : pk.OUT_TD + 5].tolist()
+    ts, tf = out[pk.OUT_TS], out[pk.OUT_TF]
+    if status != _OK:
+        return _PENALTY.copy(), ts, tf
+    b, ph, xd, yd, phd = out[pk.OUT_TD : pk.OUT_TD + 5]
     r = np.array([
-        b - params.beta0,
+        b - beta0,
         ph - q[1],
         phd - q[4],
         math.atan2(yd, xd) - math.atan2(q[3], q[2]),
@@ -291,6 +300,12 @@ class GaitProblem:
     _ref_slot: int = field(init=False, repr=False, compare=False)
     _idx: dict[str, int] = field(init=False, repr=False, compare=False)
     _at: tuple[int, int, int, int, int] = field(init=False, repr=False, compare=False)
+    # residual_jacobian's constant parts: dq/dz's ones, and what r subtracts of q (held
+    # copies, read only)
+    _dq0: np.ndarray = field(init=False, repr=False, compare=False)
+    _dr0: np.ndarray = field(init=False, repr=False, compare=False)
+    # whether the touch-down speed moves with z (else it is params.v0: :meth:`speed`)
+    _moving_speed: bool = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not self.names:
@@ -327,6 +342,17 @@ class GaitProblem:
         gain = getattr(ctrl, "Kd", 1.0) if "alphad_ref" in self.names else 1.0
         object.__setattr__(self, "_ref_gain", float(gain))
         object.__setattr__(self, "_ref_slot", pk.P_THRUST if ref == "leg_thrust" else pk.P_C0)
+        n, (i_delta, i_phi, i_phid, _, _) = len(self.names), self._at
+        dq0, dr0 = np.zeros((5, n)), np.zeros((5, n))
+        if i_phi >= 0:
+            dq0[1, i_phi] = dr0[1, i_phi] = 1.0
+        if i_phid >= 0:
+            dq0[4, i_phid] = dr0[2, i_phid] = 1.0
+        dr0[3, i_delta] = 1.0
+        object.__setattr__(self, "_dq0", dq0)
+        object.__setattr__(self, "_dr0", dr0)
+        object.__setattr__(self, "_moving_speed",
+                           not (self.fix == "speed" and self.section == "touchdown"))
 
     @classmethod
     def from_params(cls, params: Params, options: IntegratorOptions | None = None, *,
@@ -389,7 +415,7 @@ class GaitProblem:
     def _unpack(self, z: Sequence[float] | np.ndarray
                 ) -> tuple[float, float, float, float, float]:
         """``(delta, phi, phid, alpha_r, reference)`` of ``z``; held values 0, no reference NaN."""
-        if len(z) != self.size:
+        if len(z) != len(self.names):
             raise ValueError(f"guess must have {self.size} entries {list(self.names)}, "
                              f"got {len(z)}")
         if type(z) is np.ndarray and z.dtype == _F64:
@@ -450,32 +476,35 @@ class GaitProblem:
 
     # -- costs ----------------------------------------------------------------
     def _stride(self, x: tuple[float, float, float, float, float], jacobian: bool = False,
-                ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray | None, float]:
+                ) -> tuple[np.ndarray, tuple[float, ...], int, np.ndarray, np.ndarray | None,
+                           float]:
         """``P``, section ``q``, a stride at ``x = _unpack(z)`` on the packed arrays, the speed.
 
         Writes ``alpha_r`` and the controller reference of ``z`` into ``P``
         exactly as :meth:`decode` followed by ``pack_params`` would. Where no
         state exists at ``z`` (energy too low) the stride is a ``NONFINITE``.
+        ``q`` is a tuple of floats (an array per stride cost more than its stride's
+        other Python).
         """
         delta, phi, phid, alpha_r, ref = x
         P = self._P.copy()
         P[pk.P_ALPHA] = alpha_r
         if self._at[4] >= 0:
             P[self._ref_slot] = self._ref_gain * ref
-        v = self.speed(delta, phi, phid)
-        q = np.array([self.params.beta0, phi, v * math.cos(delta), v * math.sin(delta), phid])
+        v = self.speed(delta, phi, phid) if self._moving_speed else self.params.v0
+        q = (self.params.beta0, phi, v * math.cos(delta), v * math.sin(delta), phid)
         out = _NAN_OUT.copy()
         J = _NAN_J.copy() if jacobian else None
         if not math.isfinite(v):
             return P, q, int(Status.NONFINITE), out, J, v
         if J is not None:
             return P, q, _packed.stride_jacobian(P, self._O, q, 0.0, J, out), out, J, v
-        return P, q, _packed.stride_map(P, self._O, q, 0.0, out), out, None, v
+        return P, q, _packed.stride_map_at(P, self._O, q, 0.0, out), out, None, v
 
     def evaluate(self, z: Sequence[float] | np.ndarray) -> tuple[np.ndarray, float, float]:
         """Residual, stance and flight time at ``z`` (see :func:`gait_residual`)."""
         _, q, st, out, _, v = self._stride(self._unpack(z))
-        return _section_residual(q, st, out, self.params, v)
+        return _section_residual(q, st, out.tolist(), self.params.beta0, v)
 
     def residual_jacobian(self, z: Sequence[float] | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Residual (5,) and its Jacobian ``dr/dz`` (5 x size) at ``z``.
@@ -488,23 +517,23 @@ class GaitProblem:
         """
         x = self._unpack(z)
         P, q, st, out, Jq, v = self._stride(x, jacobian=True)
-        r, _, _ = _section_residual(q, st, out, self.params, v)
-        n = self.size
-        if st != Status.OK or Jq is None or not _finite(Jq):
+        o = out.tolist()
+        r, _, _ = _section_residual(q, st, o, self.params.beta0, v)
+        n = len(self.names)
+        if st != _OK or Jq is None or not _finite(Jq):
             return r, np.full((5, n), math.nan)
         delta, phi, phid, _, ref = x
         i_delta, i_phi, i_phid, i_alpha, i_ref = self._at
-        dv = self._speed_gradient(delta, phi, phid, v)
+        # the touch-down speed held (the usual search) has no gradient
+        dv = self._speed_gradient(delta, phi, phid, v) if self._moving_speed else ()
         cd, sd = math.cos(delta), math.sin(delta)
-        dq = np.zeros((5, n))  # dq/dz, q = (beta0, phi, v cos delta, v sin delta, phid)
+        # dq/dz, q = (beta0, phi, v cos delta, v sin delta, phid): dq/dphi and dq/dphid
+        # are ones (self._dq0)
+        dq = self._dq0.copy()
         dq[2, i_delta], dq[3, i_delta] = -v * sd, v * cd
         for k, g in dv:  # the speed held by the section or the energy
             dq[2, k] += cd * g
             dq[3, k] += sd * g
-        if i_phi >= 0:
-            dq[1, i_phi] = 1.0
-        if i_phid >= 0:
-            dq[4, i_phid] = 1.0
         dqn = Jq @ dq  # dq'/dz through the state
         dqn[:, i_alpha] += _packed.alpha_r_column(P, out)
         if i_ref >= 0:
@@ -514,40 +543,40 @@ class GaitProblem:
                 return r, np.full((5, n), math.nan)
             dqn[:, i_ref] += column
         # r = (beta', phi' - phi, phid' - phid, atan2(yd', xd') - delta, |v'| - v0)
-        _, _, xd, yd, _ = out[pk.OUT_TD : pk.OUT_TD + 5].tolist()
+        _, _, xd, yd, _ = o[pk.OUT_TD : pk.OUT_TD + 5]
         v2 = xd * xd + yd * yd
         v = math.sqrt(v2)
-        D = np.zeros((5, 5))  # dr/dq'
-        D[0, 0] = D[1, 1] = D[2, 4] = 1.0
+        D = _D0.copy()  # dr/dq'
         D[3, 2], D[3, 3] = -yd / v2, xd / v2
         D[4, 2], D[4, 3] = xd / v, yd / v
         Jr = D @ dqn
-        if i_phi >= 0:
-            Jr[1, i_phi] -= 1.0
-        if i_phid >= 0:
-            Jr[2, i_phid] -= 1.0
-        Jr[3, i_delta] -= 1.0
+        # minus dphi/dphi, dphid/dphid, ddelta/ddelta (self._dr0; x - 0.0 is x, bit for bit)
+        Jr -= self._dr0
         for k, g in dv:
             Jr[4, k] -= g
         return r, Jr
 
-    def _ref_column(self, P: np.ndarray, q: np.ndarray, ref: float, h: float
+    def _ref_column(self, P: np.ndarray, q: tuple[float, ...], ref: float, h: float
                     ) -> np.ndarray | None:
         """``dq'/d ref`` by a central difference of step ``h``; None if a stride fails.
 
         The strides start from the section ``q`` of the stride at ``ref`` with
         ``P`` as :meth:`_stride` wrote it, only the reference's slot changed (as ``_stride``
-        writes it for ``ref +- h``).
+        writes it for ``ref +- h``; the slot is written back before returning).
         """
-        Pd = P.copy()
-        ends = []
-        for value in (ref + h, ref - h):
-            Pd[self._ref_slot] = self._ref_gain * value
-            out = _NAN_OUT.copy()
-            if _packed.stride_map(Pd, self._O, q, 0.0, out) != Status.OK:
-                return None
-            ends.append(out[pk.OUT_TD : pk.OUT_TD + 5])
-        return (ends[0] - ends[1]) / (2.0 * h)
+        slot = self._ref_slot
+        kept = P[slot]
+        outs = _NAN_OUT2.copy()  # one row per stride
+        try:
+            for out, value in zip(outs, (ref + h, ref - h)):
+                P[slot] = self._ref_gain * value
+                if _packed.stride_map_at(P, self._O, q, 0.0, out) != _OK:
+                    return None
+        finally:
+            P[slot] = kept
+        column = outs[0, pk.OUT_TD : pk.OUT_TD + 5] - outs[1, pk.OUT_TD : pk.OUT_TD + 5]
+        column /= 2.0 * h
+        return column
 
     def residual(self, z: Sequence[float] | np.ndarray) -> np.ndarray:
         """Periodicity residual (5,) at ``z``; the Newton search's function."""

@@ -19,6 +19,7 @@ same as the public functions', so the results are identical bit for bit.
 
 from __future__ import annotations
 
+import math
 import threading
 from typing import Any
 
@@ -27,17 +28,25 @@ import numpy as np
 from ..model import _pack as pk
 from . import _kernels as kn
 
-__all__ = ["touchdown", "stride_map", "stride_jacobian", "check_exact", "alpha_r_column", "run"]
+__all__ = ["touchdown", "stride_map", "stride_map_at", "stride_jacobian", "check_exact",
+           "alpha_r_column", "run"]
 
 _TX = np.empty(0)  # flat ground: no terrain breakpoints
 
 
-def touchdown(q: np.ndarray, h: float = 0.0) -> np.ndarray:
-    """The kernels' touch-down vector ``(beta, phi, xd, yd, phid, x=0, h)``."""
-    td = np.zeros(pk.NTD)
-    td[:5] = q
-    td[pk.TD_H] = h
-    return td
+#: The touch-down vector's layout that :func:`touchdown` builds directly.
+if (pk.TD_X, pk.TD_H, pk.NTD) != (5, 6, 7):  # pragma: no cover - a layout change
+    raise ImportError("_packed.touchdown assumes the touch-down layout (q, x, h)")
+_TH0 = np.zeros(1)  # flat ground at h = +0.0: the kernels only read it
+
+
+def touchdown(q: np.ndarray | tuple[float, ...], h: float = 0.0) -> np.ndarray:
+    """The kernels' touch-down vector ``(beta, phi, xd, yd, phid, x=0, h)``.
+
+    ``q``: the section as an array or as a tuple of floats. Built from one list
+    (a third of zeros-then-fill on this 7-vector; the same values).
+    """
+    return np.array([*(q.tolist() if isinstance(q, np.ndarray) else q), 0.0, float(h)])
 
 
 def stride_map(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E741
@@ -47,6 +56,13 @@ def stride_map(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E
     The next section is ``out[OUT_TD:OUT_TD + 5]``; as :func:`tslip.step_map`.
     """
     return int(kn.section_map(P, O, *q.tolist(), float(h), out))
+
+
+def stride_map_at(P: np.ndarray, O: np.ndarray, q: tuple[float, ...], h: float,  # noqa: E741
+                  out: np.ndarray) -> int:
+    """:func:`stride_map` from the section as a tuple of five floats (the gait search
+    holds it so, without building an array per stride)."""
+    return int(kn.section_map(P, O, *q, float(h), out))
 
 
 #: The last exact Jacobians, keyed by their exact inputs (P, O, q, h): gait search
@@ -81,8 +97,9 @@ def check_exact(P: np.ndarray) -> None:
                          "(method='fd')")
 
 
-def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E741
-                    J: np.ndarray, out: np.ndarray) -> int:
+def stride_jacobian(P: np.ndarray, O: np.ndarray,  # noqa: E741
+                    q: np.ndarray | tuple[float, ...], h: float, J: np.ndarray,
+                    out: np.ndarray) -> int:
     """As :func:`stride_map`, and the exact Jacobian ``dq'/dq`` (5 x 5) into ``J``.
 
     Variational equations through the stance steps plus the saltation terms
@@ -90,7 +107,8 @@ def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # no
     deterministic, so a call with the same inputs as one of the last
     ``_JACOBIANS_KEPT`` returns its stored result (identical bits).
     """
-    check_exact(P)
+    if P[pk.P_NEXP] < 1.0:
+        check_exact(P)
     td = touchdown(q, h)
     key = P.tobytes() + O.tobytes() + td.tobytes()
     hit = _JACOBIANS.get(key)  # one atomic look-up: the lock guards only the eviction
@@ -98,7 +116,8 @@ def stride_jacobian(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # no
         J[:] = hit[1]
         out[:] = hit[2]
         return hit[0]
-    st = int(_variational().stride_jacobian(P, O, td, _TX, np.array([h]), J, out))
+    th = _TH0 if h == 0.0 and math.copysign(1.0, h) > 0.0 else np.array([h])
+    st = int(_variational().stride_jacobian(P, O, td, _TX, th, J, out))
     with _JACOBIANS_LOCK:
         if len(_JACOBIANS) >= _JACOBIANS_KEPT:
             del _JACOBIANS[next(iter(_JACOBIANS))]  # the oldest
