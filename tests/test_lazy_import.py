@@ -80,3 +80,15 @@ def test_a_planar_study_loads_no_3d_gait_search():
     heavy = {"tslip.spatial.gait", "tslip.spatial.lateral", "tslip.spatial.trunk_section",
              "tslip.sweeps.spatial_point"}
     assert not loaded & heavy, loaded & heavy
+
+
+def test_the_study_code_loads_scipy_optimize_only_when_it_solves():
+    """``scipy.optimize`` (0.2-0.5 s to import) loads with the first least-squares gait
+    search, root bracket or impulse quadrature (``scipy.integrate`` imports it), not with
+    ``import tslip.sweeps`` and the report (every command, every warm rerun)."""
+    loaded = _loaded_after("import tslip.sweeps, tslip.sweeps.reproduce, tslip.gait.impulse")
+    assert "scipy.linalg" in loaded  # the check above can see scipy (Floquet needs LAPACK)
+    assert not {"scipy.optimize", "scipy.integrate"} & loaded
+    solved = _loaded_after("import numpy as np; from tslip.gait.impulse import _simpson; "
+                           "_simpson(np.ones(3), np.arange(3.0))")
+    assert "scipy.optimize" in solved

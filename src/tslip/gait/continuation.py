@@ -37,7 +37,6 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import brentq
 
 from .._results import Result, with_units
 from ..model.parameters import PARAMETER_TABLE, Params
@@ -564,6 +563,8 @@ def stability_boundaries(
                 raise RuntimeError(f"no gait at {branch.param} = {x}: {g.message}")
             f = floquet(g, options=branch.options, section=branch.section)
             return f.max_nontrivial - level
+
+        from scipy.optimize import brentq  # here: scipy.optimize costs 0.2-0.5 s to import
 
         try:
             out.append(float(brentq(f, float(v[i]), float(v[i + 1]), xtol=xtol)))

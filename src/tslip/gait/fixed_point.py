@@ -50,7 +50,6 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.linalg import _umath_linalg
-from scipy.optimize import least_squares
 
 from .._results import Result, frame
 from ..model._pack import packed_params
@@ -251,6 +250,8 @@ def newton_solve(
                 if best is None or err < best[0]:
                     best = (err, z)
                 continue
+        from scipy.optimize import least_squares  # here: 0.2-0.5 s to import, rarely used
+
         try:
             sol = least_squares(residual, z0, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
                                 max_nfev=400 * len(z0), diff_step=1e-7)

@@ -40,7 +40,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.integrate import simpson
 
 from .._results import Result, frame
 from ..model.parameters import Params
@@ -199,6 +198,9 @@ class Impulse(Result):
 
 
 def _simpson(f: np.ndarray, t: np.ndarray) -> float:
+    from scipy.integrate import simpson  # here: scipy.integrate imports scipy.optimize, which
+    # every tslip command would pay 0.2-0.5 s for
+
     return float(simpson(f, x=t))
 
 
