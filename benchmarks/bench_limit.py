@@ -74,7 +74,10 @@ fresh step to it); nothing else (no other event, guard, record or run-time choic
 pair). Its breakdown is the stride breakdown's, the per-step control split into the error
 norm, the step size (``pow``) and the rest (lift-off location, starting step, and each
 step waiting for its size); ``floor / RHS-bound limit`` is the least the headline ratio
-could be with this method, before any touch-down, flight or batch loop (it is not printed
+could be with this method, before any touch-down, flight or batch loop, also with the
+faster stage arithmetic of the two (the floor's stages, constants and all, ran slower
+than the kernel's on 2026-12-06: that part of the floor is not a floor), and with the
+stride's per-stride work added (it is not printed
 for gaits whose stance the floor does not reproduce: leg thrust, lift-off on the spring).
 """
 
