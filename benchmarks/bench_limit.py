@@ -63,6 +63,22 @@ Definitions:
   ``benchmarks/_study_limit.py``'s ``measure(rounds, clock) -> (point seconds,
   kernel seconds)``, its own ``--rounds`` rounds after the others; ``n/a`` if that
   module is missing.
+
+Context lines after the stride breakdown (issue 41) give **the method floor**
+(``benchmarks/_method_floor.py``, where it is defined in full): the time of one stance by
+a minimal hand-written dopri5 loop with the same right-hand side (``rhs_inline``),
+tolerances, starting step, error norm and step-size rule as the kernel, so that it takes
+the same steps (checked: the same final state, bit for bit), and the lift-off event alone
+(``F_y`` from > 0 to <= 0 over a step, located by Illinois on the dense output, then a
+fresh step to it); nothing else (no other event, guard, record or run-time choice of the
+pair). Its breakdown is the stride breakdown's, the per-step control split into the error
+norm, the step size (``pow``) and the rest (lift-off location, starting step, and each
+step waiting for its size); ``floor / RHS-bound limit`` is the least the headline ratio
+could be with this method, before any touch-down, flight or batch loop, also with the
+faster stage arithmetic of the two (the floor's stages, constants and all, ran slower
+than the kernel's on 2026-12-06: that part of the floor is not a floor), and with the
+stride's per-stride work added (it is not printed
+for gaits whose stance the floor does not reproduce: leg thrust, lift-off on the spring).
 """
 
 from __future__ import annotations
@@ -85,6 +101,11 @@ from tslip.model import _pack as pk
 from tslip.simulation import _kernels as kn
 from tslip.simulation import _rk, _stance
 from tslip.simulation._stepper import rk_step
+
+try:  # the method floor (issue 41); a checkout without stance_terms / put_rhs has none
+    import _method_floor
+except (ImportError, AttributeError):
+    _method_floor = None
 
 #: Right-hand sides of the Table 6.1 stride at dopri5 1e-8 with the kernel of
 #: revision 3b38fb1 (frozen: the limit does not move when the kernel takes fewer steps).
@@ -241,6 +262,11 @@ def main() -> None:
         "steps": lambda: _steps_loop(P, y0, hs, a.reps),
         "stance": lambda: _stance_loop(stance, P, O, y0, a.reps),
     }
+    mf = _method_floor
+    floor = mf is not None and mf.applies(P)
+    if floor:
+        fns.update(mf.floor_fns(P, O, y0, hs, a.reps))
+        same = mf.same_as_kernel(P, O, y0, yout, stats)
     t = ab(fns, a.rounds, clock=clock).median
     rows = len(beta)
     t_rhs = t["rhs"] / (a.reps * len(Y))
@@ -272,11 +298,15 @@ def main() -> None:
           f"per-step control (error norm, step size, events, initial step) "
           f"{(t_stance - t_steps - t_rhs * (n_now - n_steps_rhs)) * 1e6:.2f} us, "
           f"per-stride work (touch-down, flight, batch loop) {(stride - t_stance) * 1e6:.2f} us")
-    floor = t["simulate"] + t["trig"] + t["fresh table"]
+    if floor:
+        for line in mf.floor_lines(t, a.reps, t_rhs, n_now, N_RHS, len(hs), int(stats[1]), stride,
+                                same):
+            print(line)
+    df_floor = t["simulate"] + t["trig"] + t["fresh table"]
     print(f"to_dataframe adds {(t['simulate + df'] - t['simulate']) * 1e3:.2f} ms; its floor: "
           f"sin and cos of both angles of each sample {t['trig'] * 1e3:.2f} ms, a fresh "
           f"table written once {t['fresh table'] * 1e3:.2f} ms; simulate + these / unrecorded "
-          f"strides: {floor / t['strides']:.2f}")
+          f"strides: {df_floor / t['strides']:.2f}")
     if study is not None:
         print(f"study point {study[0] * 1e3:.3f} ms, its compiled kernel calls "
               f"{study[1] * 1e3:.3f} ms (replayed in compiled loops; {what} time)")
