@@ -92,3 +92,38 @@ def test_the_study_code_loads_scipy_optimize_only_when_it_solves():
     solved = _loaded_after("import numpy as np; from tslip.gait.impulse import _simpson; "
                            "_simpson(np.ones(3), np.arange(3.0))")
     assert "scipy.optimize" in solved
+
+
+def test_the_report_loads_matplotlib_only_to_draw():
+    """``tslip reproduce`` imports the report module; matplotlib (about 0.6 s) loads only
+    when a figure is drawn, never for a rerun whose figures are all in the folder."""
+    loaded = _loaded_after("import tslip.plotting.report, tslip.cli.studies")
+    assert "tslip.plotting.report" in loaded
+    assert not {m for m in loaded if m.split(".")[0] in ("matplotlib", "PIL")}
+    drawn = _loaded_after("import tslip.plotting; tslip.plotting.plot_trajectory")
+    assert "matplotlib.figure" in drawn
+
+
+def test_the_plotting_names_are_its_modules_names():
+    """``tslip.plotting``'s lazy table is its ``TYPE_CHECKING`` imports, and each name is
+    the function of that module."""
+    import ast
+    import importlib
+    from pathlib import Path
+
+    import tslip.plotting as plotting
+
+    tree = ast.parse(Path(plotting.__file__).read_text(encoding="utf-8"))
+    static = {a.name: node.module for node in ast.walk(tree)
+              if isinstance(node, ast.ImportFrom) and node.level == 1 for a in node.names}
+    assert static == plotting._LAZY
+    assert set(static) == set(plotting.__all__) <= set(dir(plotting))
+    for name, module in static.items():
+        assert getattr(plotting, name) is getattr(
+            importlib.import_module(f"tslip.plotting.{module}"), name)
+    try:
+        plotting.no_such_plot  # noqa: B018
+    except AttributeError as e:
+        assert "no_such_plot" in str(e)
+    else:
+        raise AssertionError("tslip.plotting.no_such_plot did not raise")

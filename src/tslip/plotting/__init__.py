@@ -4,17 +4,33 @@ Nothing here calls ``pyplot``; figures are built with the matplotlib object
 API so they work headless. Save with ``fig.savefig(path)``.
 """
 
-from .animation import animate, frame_times, render_frames
-from .gait import (
-    plot_friction,
-    plot_impulse_linearisation,
-    plot_pitch_impulse,
-    plot_step_down_response,
-    plot_velocity_angle_effect,
-)
-from .sweeps import plot_branch
-from .trajectories import flight_intervals, ground_profile, plot_touchdowns, plot_trajectory
-from .viability import plot_basin, plot_viability
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the names below load on first use (PEP 562): see _LAZY
+    from .animation import animate, frame_times, render_frames
+    from .gait import (
+        plot_friction,
+        plot_impulse_linearisation,
+        plot_pitch_impulse,
+        plot_step_down_response,
+        plot_velocity_angle_effect,
+    )
+    from .sweeps import plot_branch
+    from .trajectories import flight_intervals, ground_profile, plot_touchdowns, plot_trajectory
+    from .viability import plot_basin, plot_viability
+
+#: Each public name -> the module defining it, imported on first use: ``tslip reproduce``
+#: imports :mod:`.report`, which needs matplotlib only to draw a figure the report folder
+#: does not hold (a warm rerun draws none: matplotlib costs about 0.6 s to import).
+_LAZY = {
+    **dict.fromkeys(("animate", "frame_times", "render_frames"), "animation"),
+    **dict.fromkeys(("plot_friction", "plot_impulse_linearisation", "plot_pitch_impulse",
+                     "plot_step_down_response", "plot_velocity_angle_effect"), "gait"),
+    "plot_branch": "sweeps",
+    **dict.fromkeys(("flight_intervals", "ground_profile", "plot_touchdowns",
+                     "plot_trajectory"), "trajectories"),
+    **dict.fromkeys(("plot_basin", "plot_viability"), "viability"),
+}
 
 __all__ = [
     "animate",
@@ -33,3 +49,17 @@ __all__ = [
     "plot_viability",
     "render_frames",
 ]
+
+
+def __getattr__(name: str) -> object:
+    if name not in _LAZY:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    globals()[name] = value  # later look-ups find it directly
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

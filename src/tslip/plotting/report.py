@@ -27,11 +27,9 @@ import pickle
 from collections.abc import Callable, Mapping, Sequence
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from .. import __version__
 from .._codehash import code_hash
@@ -40,6 +38,9 @@ from .._results import encode
 from ..model.units import UNIT
 from ..sweeps.claims import Verdict, count_verdicts
 from .notation import axis_label, key_html, tex_html, unit_html, value
+
+if TYPE_CHECKING:  # matplotlib is imported where a figure is drawn: a warm rerun draws none
+    from matplotlib.figure import Figure
 
 __all__ = ["CLAIMS_SCHEMA", "PLOT_SECONDS", "SECTIONS", "ReportPlots", "claims_json", "compute",
            "figure_inputs", "figure_key", "figure_png", "plot_task", "png_key", "read_claims",
@@ -67,6 +68,8 @@ def figure_png(fig: Figure, dpi: int = DPI, key: str | None = None) -> str:
     if engine is None:
         fig.savefig(buf, format="png", dpi=dpi, metadata=meta)
     else:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
         fig.dpi = dpi
         FigureCanvasAgg(fig)
         engine.execute(fig)
@@ -221,6 +224,8 @@ def _plots(data: Mapping[str, Any]) -> dict[str, Callable[[], Figure]]:
                     data[name], title=f"Robustness over varying {words}")}
 
     def fig44() -> Figure:
+        from matplotlib.figure import Figure
+
         h = data["4.4"]
         fig = Figure(figsize=(8.0, 3.2), layout="constrained")
         axes = fig.subplots(1, 2, sharey=True)
@@ -572,8 +577,10 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
     our numbers, the verdict, its evidence and a note), and the studies.
     ``images``: figures already rendered (:func:`render_ready`), by key.
     """
-    plots = _plots(data)
     images = images or {}
+    # the plots import matplotlib (0.6 s): only for a figure not among the images
+    plots: Mapping[str, Callable[[], Figure] | None] = (
+        _plots(data) if set(figure_inputs()) - set(images) else dict.fromkeys(figure_inputs()))
     ids = _claim_ids(claims)
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'>"
              f"<title>tslip reproduce</title><style>{_CSS}</style></head><body>",
@@ -591,7 +598,7 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
         for fkey in figs:
             if fkey in plots:
                 try:
-                    src = images.get(fkey) or figure_png(plots[fkey]())
+                    src = images.get(fkey) or figure_png(plots[fkey]())  # type: ignore[misc]
                     parts.append(f"<img alt='Figure {fkey}' src='{src}'>")
                 except KeyError:
                     parts.append(f"<p class='note'>Figure {fkey}: data not computed.</p>")
