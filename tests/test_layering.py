@@ -21,7 +21,7 @@ ALLOWED = {
     "plotting": {"model", "simulation", "gait", "sweeps", "experiment", "biped", "spatial"},
 }
 TOP = {"_io", "_lines", "_safefile", "_results", "_checks", "_gridsize", "_kernel_cache",
-       "_nrt", "_codehash", "_first_failure", "_conform",
+       "_nrt", "_codehash", "_first_failure", "_conform", "_lazy",
        "_renamed", "protocols", "__init__", "__main__", "_typing", "__version__"}
 
 

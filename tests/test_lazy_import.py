@@ -4,9 +4,14 @@ Checked by which modules a fresh interpreter has loaded, never by timing
 (``benchmarks/bench_coldstart.py`` times it).
 """
 
+import ast
 import json
 import subprocess
 import sys
+import types
+from pathlib import Path
+
+import pytest
 
 import tslip
 
@@ -27,6 +32,13 @@ def _loaded_after(code: str) -> set[str]:
                          text=True, check=True)
     return set(json.loads(out.stdout.strip().splitlines()[-1]))
 
+
+def _static_imports(package: types.ModuleType) -> dict[str, str]:
+    """A package's relative ``from .module import name`` lines (its ``TYPE_CHECKING``
+    block): name -> module."""
+    tree = ast.parse(Path(package.__file__ or "").read_text(encoding="utf-8"))
+    return {a.name: node.module or "" for node in ast.walk(tree)
+            if isinstance(node, ast.ImportFrom) and node.level == 1 for a in node.names}
 
 def test_import_tslip_loads_no_heavy_module():
     loaded = _loaded_after("import tslip")
@@ -53,23 +65,14 @@ def test_public_names_are_listed_and_resolve():
 
 def test_lazy_table_matches_the_static_imports():
     """The name -> subpackage table is the ``TYPE_CHECKING`` imports (what type checkers see)."""
-    import ast
-    from pathlib import Path
-
-    tree = ast.parse(Path(tslip.__file__).read_text(encoding="utf-8"))
-    static = {a.name: node.module for node in ast.walk(tree)
-              if isinstance(node, ast.ImportFrom) and node.level == 1 for a in node.names}
+    static = _static_imports(tslip)
     assert static == tslip._SUBPACKAGE
     assert set(static) | {"__version__"} == set(tslip.__all__)
 
 
 def test_unknown_attribute_is_an_attribute_error():
-    try:
+    with pytest.raises(AttributeError, match="no_such_name"):
         tslip.no_such_name  # noqa: B018
-    except AttributeError as e:
-        assert "no_such_name" in str(e)
-    else:
-        raise AssertionError("tslip.no_such_name did not raise")
 
 
 def test_a_planar_study_loads_no_3d_gait_search():
@@ -107,23 +110,15 @@ def test_the_report_loads_matplotlib_only_to_draw():
 def test_the_plotting_names_are_its_modules_names():
     """``tslip.plotting``'s lazy table is its ``TYPE_CHECKING`` imports, and each name is
     the function of that module."""
-    import ast
     import importlib
-    from pathlib import Path
 
     import tslip.plotting as plotting
 
-    tree = ast.parse(Path(plotting.__file__).read_text(encoding="utf-8"))
-    static = {a.name: node.module for node in ast.walk(tree)
-              if isinstance(node, ast.ImportFrom) and node.level == 1 for a in node.names}
+    static = _static_imports(plotting)
     assert static == plotting._LAZY
     assert set(static) == set(plotting.__all__) <= set(dir(plotting))
     for name, module in static.items():
         assert getattr(plotting, name) is getattr(
             importlib.import_module(f"tslip.plotting.{module}"), name)
-    try:
+    with pytest.raises(AttributeError, match="no_such_plot"):
         plotting.no_such_plot  # noqa: B018
-    except AttributeError as e:
-        assert "no_such_plot" in str(e)
-    else:
-        raise AssertionError("tslip.plotting.no_such_plot did not raise")

@@ -91,6 +91,17 @@ def test_packed_residual_equals_gait_residual_bit_for_bit(name):
 # ---------------------------------------------------------------------------
 
 
+def _assert_jacobian_is_central_differences(prob: GaitProblem, z: np.ndarray) -> None:
+    """``residual_jacobian`` at ``z``: its residual is ``residual``'s, its Jacobian central
+    differences of ``residual`` (step 1e-6)."""
+    r, J = prob.residual_jacobian(z)
+    np.testing.assert_array_equal(r, prob.residual(z))
+    h = 1e-6
+    Jfd = np.column_stack([(prob.residual(z + h * e) - prob.residual(z - h * e)) / (2 * h)
+                           for e in np.eye(prob.size)])
+    np.testing.assert_allclose(J, Jfd, rtol=0, atol=2e-7 * max(1.0, np.abs(Jfd).max()))
+
+
 @pytest.mark.parametrize("name", PRESETS + ["global-reset"])
 def test_residual_jacobian_agrees_with_central_differences(name):
     if name == "global-reset":
@@ -100,13 +111,7 @@ def test_residual_jacobian_agrees_with_central_differences(name):
     g = tslip.find_gait(p)
     assert g.converged
     prob = GaitProblem.from_params(g.params)
-    z = prob.encode(g) + 2e-3  # off the fixed point
-    r, J = prob.residual_jacobian(z)
-    np.testing.assert_array_equal(r, prob.residual(z))
-    h = 1e-6
-    Jfd = np.column_stack([(prob.residual(z + h * e) - prob.residual(z - h * e)) / (2 * h)
-                           for e in np.eye(prob.size)])
-    np.testing.assert_allclose(J, Jfd, rtol=0, atol=2e-7 * max(1.0, np.abs(Jfd).max()))
+    _assert_jacobian_is_central_differences(prob, prob.encode(g) + 2e-3)  # off the gait
 
 
 @pytest.mark.parametrize(("name", "kw"), [
@@ -126,13 +131,7 @@ def test_residual_jacobian_of_every_held_quantity_agrees_with_central_difference
     prob = GaitProblem.from_params(g.params, fix=g.fix, section=g.section,
                                    energy=g.energy if g.fix == "energy" else None)
     assert name != "leg-thrust" or prob.names[-1] == "leg_thrust"
-    z = prob.encode(g) + 2e-3
-    r, J = prob.residual_jacobian(z)
-    np.testing.assert_array_equal(r, prob.residual(z))
-    h = 1e-6
-    Jfd = np.column_stack([(prob.residual(z + h * e) - prob.residual(z - h * e)) / (2 * h)
-                           for e in np.eye(prob.size)])
-    np.testing.assert_allclose(J, Jfd, rtol=0, atol=2e-7 * max(1.0, np.abs(Jfd).max()))
+    _assert_jacobian_is_central_differences(prob, prob.encode(g) + 2e-3)
 
 
 def test_finite_is_numpys_isfinite_all():

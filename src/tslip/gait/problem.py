@@ -170,6 +170,8 @@ _D0[0, 0] = _D0[1, 1] = _D0[2, 4] = 1.0
 _PENALTY = np.full(5, _FALL_PENALTY)
 _F64 = np.dtype(np.float64)
 _OK = int(Status.OK)
+
+
 def _finite(a: np.ndarray) -> bool:
     """``np.isfinite(a).all()`` of a float array, at about half its cost on a 5 x 5.
 

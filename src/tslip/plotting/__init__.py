@@ -6,6 +6,8 @@ API so they work headless. Save with ``fig.savefig(path)``.
 
 from typing import TYPE_CHECKING
 
+from .._lazy import lazy_names
+
 if TYPE_CHECKING:  # the names below load on first use (PEP 562): see _LAZY
     from .animation import animate, frame_times, render_frames
     from .gait import (
@@ -51,15 +53,5 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> object:
-    if name not in _LAZY:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    import importlib
-
-    value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
-    globals()[name] = value  # later look-ups find it directly
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__ = lazy_names(__name__, {name: (module, name)
+                                              for name, module in _LAZY.items()})

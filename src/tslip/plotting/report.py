@@ -578,9 +578,9 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
     ``images``: figures already rendered (:func:`render_ready`), by key.
     """
     images = images or {}
+    drawn = figure_inputs()  # the report's figures (the keys of _plots)
     # the plots import matplotlib (0.6 s): only for a figure not among the images
-    plots: Mapping[str, Callable[[], Figure] | None] = (
-        _plots(data) if set(figure_inputs()) - set(images) else dict.fromkeys(figure_inputs()))
+    plots = _plots(data) if set(drawn) - set(images) else {}
     ids = _claim_ids(claims)
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'>"
              f"<title>tslip reproduce</title><style>{_CSS}</style></head><body>",
@@ -596,9 +596,9 @@ def write_report(path: str | Path, data: Mapping[str, Any], claims: Sequence[Any
     for figs, title in SECTIONS:
         parts.append(f"<section id='{_sec_id(figs)}'><h2>{_e(title)}{_UP}</h2>")
         for fkey in figs:
-            if fkey in plots:
+            if fkey in drawn:
                 try:
-                    src = images.get(fkey) or figure_png(plots[fkey]())  # type: ignore[misc]
+                    src = images.get(fkey) or figure_png(plots[fkey]())
                     parts.append(f"<img alt='Figure {fkey}' src='{src}'>")
                 except KeyError:
                     parts.append(f"<p class='note'>Figure {fkey}: data not computed.</p>")

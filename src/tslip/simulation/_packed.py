@@ -55,11 +55,11 @@ def stride_map(P: np.ndarray, O: np.ndarray, q: np.ndarray, h: float,  # noqa: E
 
     The next section is ``out[OUT_TD:OUT_TD + 5]``; as :func:`tslip.step_map`.
     """
-    return int(kn.section_map(P, O, *q.tolist(), float(h), out))
+    return stride_map_at(P, O, q.tolist(), h, out)
 
 
-def stride_map_at(P: np.ndarray, O: np.ndarray, q: tuple[float, ...], h: float,  # noqa: E741
-                  out: np.ndarray) -> int:
+def stride_map_at(P: np.ndarray, O: np.ndarray,  # noqa: E741
+                  q: tuple[float, ...] | list[float], h: float, out: np.ndarray) -> int:
     """:func:`stride_map` from the section as a tuple of five floats (the gait search
     holds it so, without building an array per stride)."""
     return int(kn.section_map(P, O, *q, float(h), out))
@@ -107,8 +107,7 @@ def stride_jacobian(P: np.ndarray, O: np.ndarray,  # noqa: E741
     deterministic, so a call with the same inputs as one of the last
     ``_JACOBIANS_KEPT`` returns its stored result (identical bits).
     """
-    if P[pk.P_NEXP] < 1.0:
-        check_exact(P)
+    check_exact(P)
     td = touchdown(q, h)
     key = P.tobytes() + O.tobytes() + td.tobytes()
     hit = _JACOBIANS.get(key)  # one atomic look-up: the lock guards only the eviction

@@ -29,6 +29,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from .._lazy import lazy_names
+
 if TYPE_CHECKING:  # the names as the type checker sees them
     from .gait import Multipliers, SymmetricGait, floquet, symmetric_gaits
     from .parameters import HEADINGS, SpatialParams, preset, preset_description, presets
@@ -113,16 +115,4 @@ __all__ = ["HEADINGS", "SpatialParams", "preset", "preset_description", "presets
            "two_step_map", "yaw_rotated", "TrunkRun", "trunk_run"]
 
 
-def __getattr__(name: str) -> object:
-    if name not in _LAZY:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    import importlib
-
-    module, attr = _LAZY[name]
-    value = getattr(importlib.import_module(f".{module}", __name__), attr)
-    globals()[name] = value  # later look-ups find it directly
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__ = lazy_names(__name__, _LAZY)
